@@ -1,0 +1,335 @@
+"""Bearing description: geometry, materials, masses and lubricant, in SI units.
+
+All classes are frozen dataclasses that validate themselves on construction:
+an impossible bearing cannot exist as an object. Every error names the field
+and the rule it broke (:class:`~cageless.errors.GeometryError`,
+:class:`~cageless.errors.ParameterError`).
+
+The default bearing is the paper's (Wang et al. 2026, Table 1; DESIGN §6),
+defined in :mod:`cageless.parameter_sets.wang2026`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from cageless.errors import GeometryError, ParameterError, suggest
+
+__all__ = ["Geometry", "Material", "Masses", "Lubricant", "Bearing", "default_bearing"]
+
+#: Clearances smaller than this (m) are round-off of the race diameters and are taken as 0.
+_CLEARANCE_ROUND_OFF_M = 1e-12
+
+
+def _check_positive(owner: str, name: str, value: object) -> None:
+    """Raise :class:`ParameterError` unless ``value`` is a finite real number > 0."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ParameterError(f"{owner}.{name}", "must be a number", value)
+    if not math.isfinite(value) or value <= 0:
+        raise ParameterError(f"{owner}.{name}", "must be a finite number > 0", value)
+
+
+def _check_all_positive(obj: object, owner: str, skip: tuple[str, ...] = ()) -> None:
+    for f in dataclasses.fields(obj):  # type: ignore[arg-type]
+        if f.name not in skip:
+            _check_positive(owner, f.name, getattr(obj, f.name))
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """Internal geometry of a radial deep-groove ball bearing.
+
+    Parameters
+    ----------
+    inner_race_diameter_m
+        Diameter of the inner-ring groove bottom, d_i (m).
+    outer_race_diameter_m
+        Diameter of the outer-ring groove bottom, d_o (m).
+    ball_diameter_m
+        Ball diameter, D (m).
+    inner_curvature_factor
+        Inner groove radius over ball diameter, f_i = r_i / D (> 0.5).
+    outer_curvature_factor
+        Outer groove radius over ball diameter, f_o = r_o / D (> 0.5).
+    n_balls
+        Number of balls, Z.
+
+    Notes
+    -----
+    The pitch diameter is ``(d_i + d_o) / 2`` and the diametral clearance is
+    ``d_o - d_i - 2 D`` (Harris & Kotzalas, *Rolling Bearing Analysis*, 5th ed.,
+    vol. 1, ch. 2). A negative clearance (interference) is not supported.
+    """
+
+    inner_race_diameter_m: float
+    outer_race_diameter_m: float
+    ball_diameter_m: float
+    inner_curvature_factor: float
+    outer_curvature_factor: float
+    n_balls: int
+
+    def __post_init__(self) -> None:
+        _check_all_positive(self, "geometry", skip=("n_balls",))
+        if isinstance(self.n_balls, bool) or not isinstance(self.n_balls, int) or self.n_balls < 3:
+            raise GeometryError("geometry.n_balls", "must be a whole number >= 3", self.n_balls)
+        for name in ("inner_curvature_factor", "outer_curvature_factor"):
+            if getattr(self, name) <= 0.5:
+                raise GeometryError(
+                    f"geometry.{name}",
+                    "must be > 0.5 (the groove radius f*D must exceed the ball radius D/2)",
+                    getattr(self, name),
+                )
+        if self.outer_race_diameter_m <= self.inner_race_diameter_m:
+            raise GeometryError(
+                "geometry.outer_race_diameter_m",
+                "must exceed geometry.inner_race_diameter_m",
+                self.outer_race_diameter_m,
+            )
+        if self.diametral_clearance_m < 0:
+            raise GeometryError(
+                "geometry.ball_diameter_m",
+                "the ball does not fit between the races: diametral clearance "
+                f"d_o - d_i - 2D = {self.diametral_clearance_m * 1e6:.3f} um < 0 "
+                "(interference fits are not supported)",
+                self.ball_diameter_m,
+            )
+        if self.n_balls > self.max_ball_count:
+            raise GeometryError(
+                "geometry.n_balls",
+                f"{self.n_balls} balls of diameter {self.ball_diameter_m * 1e3:.4g} mm do not fit "
+                f"on a pitch circle of {self.pitch_diameter_m * 1e3:.4g} mm; at most "
+                f"{self.max_ball_count} fit (adjacent ball centres must be at least D apart)",
+                self.n_balls,
+            )
+
+    @property
+    def pitch_diameter_m(self) -> float:
+        """Pitch diameter d_m = (d_i + d_o) / 2 (m)."""
+        return 0.5 * (self.inner_race_diameter_m + self.outer_race_diameter_m)
+
+    @property
+    def diametral_clearance_m(self) -> float:
+        """Diametral clearance P_d = d_o - d_i - 2D (m); round-off below 1 pm is 0."""
+        c = self.outer_race_diameter_m - self.inner_race_diameter_m - 2.0 * self.ball_diameter_m
+        return 0.0 if abs(c) < _CLEARANCE_ROUND_OFF_M else c
+
+    @property
+    def max_ball_count(self) -> int:
+        """Largest Z whose balls fit on the pitch circle without overlapping.
+
+        Adjacent centres on a circle of radius d_m/2 are a chord ``d_m sin(pi/Z)``
+        apart; they fit while that chord is at least D.
+        """
+        ratio = self.ball_diameter_m / self.pitch_diameter_m
+        if ratio >= 1.0:
+            return 0
+        return math.floor(math.pi / math.asin(ratio) + 1e-9)
+
+    @property
+    def inner_groove_radius_m(self) -> float:
+        """Inner groove curvature radius r_i = f_i D (m)."""
+        return self.inner_curvature_factor * self.ball_diameter_m
+
+    @property
+    def outer_groove_radius_m(self) -> float:
+        """Outer groove curvature radius r_o = f_o D (m)."""
+        return self.outer_curvature_factor * self.ball_diameter_m
+
+
+@dataclass(frozen=True)
+class Material:
+    """Elastic material of balls and rings (the same for both).
+
+    Parameters
+    ----------
+    density_kg_m3
+        Mass density (kg/m^3).
+    youngs_modulus_pa
+        Young's modulus E (Pa).
+    poisson_ratio
+        Poisson's ratio nu, with -1 < nu < 0.5.
+    """
+
+    density_kg_m3: float
+    youngs_modulus_pa: float
+    poisson_ratio: float
+
+    def __post_init__(self) -> None:
+        _check_all_positive(self, "material", skip=("poisson_ratio",))
+        nu = self.poisson_ratio
+        if isinstance(nu, bool) or not isinstance(nu, int | float) or not (-1.0 < nu < 0.5):
+            raise ParameterError("material.poisson_ratio", "must lie in (-1, 0.5)", nu)
+
+    @property
+    def effective_modulus_pa(self) -> float:
+        """Contact modulus E' = E / (1 - nu^2) of two bodies of this material (Pa).
+
+        This is half the 'reduced modulus' 2/E' = (1-nu1^2)/E1 + (1-nu2^2)/E2
+        of Hamrock & Dowson for identical bodies.
+        """
+        return self.youngs_modulus_pa / (1.0 - self.poisson_ratio**2)
+
+
+@dataclass(frozen=True)
+class Masses:
+    """Masses of the moving parts.
+
+    Parameters
+    ----------
+    ball_mass_kg
+        Mass of one ball (kg).
+    inner_ring_mass_kg
+        Mass of the inner ring (kg).
+    shaft_mass_kg
+        Mass of the shaft carried with the inner ring (kg).
+    """
+
+    ball_mass_kg: float
+    inner_ring_mass_kg: float
+    shaft_mass_kg: float
+
+    def __post_init__(self) -> None:
+        _check_all_positive(self, "masses")
+
+    @property
+    def ring_translational_mass_kg(self) -> float:
+        """Mass that translates with the inner ring: ring plus shaft (kg)."""
+        return self.inner_ring_mass_kg + self.shaft_mass_kg
+
+
+@dataclass(frozen=True)
+class Lubricant:
+    """Lubricant properties (Barus pressure and exponential temperature laws).
+
+    Parameters
+    ----------
+    density_kg_m3
+        Density (kg/m^3).
+    dynamic_viscosity_pa_s
+        Dynamic viscosity eta_0 at the reference temperature and ambient pressure (Pa s).
+    pressure_viscosity_coefficient_1_pa
+        Barus pressure-viscosity coefficient alpha (1/Pa).
+    temperature_viscosity_coefficient_1_k
+        Temperature-viscosity coefficient beta (1/K).
+    reference_temperature_k
+        Temperature at which ``dynamic_viscosity_pa_s`` holds (K).
+    """
+
+    density_kg_m3: float
+    dynamic_viscosity_pa_s: float
+    pressure_viscosity_coefficient_1_pa: float
+    temperature_viscosity_coefficient_1_k: float
+    reference_temperature_k: float
+
+    def __post_init__(self) -> None:
+        _check_all_positive(self, "lubricant")
+
+
+@dataclass(frozen=True)
+class Bearing:
+    """A complete bearing: geometry, material, masses and (optionally) lubricant.
+
+    Parameters
+    ----------
+    geometry, material, masses
+        See the respective classes.
+    lubricant
+        The lubricant, or ``None`` for a dry bearing.
+    name
+        A label for reports.
+    """
+
+    geometry: Geometry
+    material: Material
+    masses: Masses
+    lubricant: Lubricant | None = None
+    name: str = "custom"
+
+    def to_dict(self) -> dict[str, Any]:
+        """Return a JSON-ready nested dict (SI units, field names carry the unit)."""
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Bearing:
+        """Build a bearing from :meth:`to_dict` output, validating every field.
+
+        Raises
+        ------
+        ParameterError
+            For a missing or unknown section or field, or an invalid value.
+        """
+        parts: dict[str, Any] = {}
+        for section, kind in _SECTIONS.items():
+            raw = data.get(section)
+            if raw is None:
+                if section == "lubricant":
+                    parts[section] = None
+                    continue
+                raise ParameterError(f"bearing.{section}", "is missing")
+            parts[section] = _build_section(kind, section, raw)
+        unknown = set(data) - set(_SECTIONS) - {"name"}
+        if unknown:
+            bad = sorted(unknown)[0]
+            raise ParameterError(f"bearing.{bad}", "is not a bearing section" + suggest(bad, _SECTIONS))
+        return cls(name=str(data.get("name", "custom")), **parts)
+
+    def with_overrides(self, overrides: Mapping[str, Any]) -> Bearing:
+        """Return a copy with dotted-name overrides applied, e.g. ``{"geometry.n_balls": 13}``.
+
+        Raises
+        ------
+        ParameterError
+            For an unknown name (with a suggestion) or an invalid value.
+        """
+        data = self.to_dict()
+        valid = sorted(_dotted_names(data))
+        for key, value in overrides.items():
+            section, _, name = key.partition(".")
+            if key not in valid:
+                if section == "lubricant" and data.get("lubricant") is None:
+                    raise ParameterError(key, "the bearing is dry; set the whole lubricant section")
+                raise ParameterError(key, "is not a bearing parameter" + suggest(key, valid))
+            data[section][name] = value
+        return Bearing.from_dict(data)
+
+
+_SECTIONS: dict[str, type] = {
+    "geometry": Geometry,
+    "material": Material,
+    "masses": Masses,
+    "lubricant": Lubricant,
+}
+
+
+def _build_section(kind: type, section: str, raw: Mapping[str, Any]) -> Any:
+    names = [f.name for f in dataclasses.fields(kind)]
+    for key in raw:
+        if key not in names:
+            raise ParameterError(
+                f"{section}.{key}", f"is not a {section} field" + suggest(key, names)
+            )
+    missing = [n for n in names if n not in raw]
+    if missing:
+        raise ParameterError(f"{section}.{missing[0]}", "is missing")
+    return kind(**raw)
+
+
+def _dotted_names(data: Mapping[str, Any]) -> list[str]:
+    return [
+        f"{section}.{name}"
+        for section, values in data.items()
+        if isinstance(values, Mapping)
+        for name in values
+    ]
+
+
+def default_bearing() -> Bearing:
+    """Return the paper's bearing (Wang et al. 2026, Table 1), lubricated."""
+    from cageless.parameter_sets import wang2026
+
+    return wang2026.bearing()
+

@@ -1,0 +1,92 @@
+"""The ``cageless`` command line: one console script with subcommands (DESIGN §2).
+
+Each subcommand lives in its own module exposing ``register(subparsers, parent)``
+and ``run(args, config) -> int``; :data:`SUBCOMMANDS` lists them in help order.
+Later issues add ``track``, ``simulate``, ``compare``, ``report``, ``bench``
+and ``sample`` by adding a module name here.
+
+Exit codes: 0 success, 1 some inputs failed (the rest done), 2 usage error.
+"""
+
+from __future__ import annotations
+
+import importlib
+import logging
+import sys
+from collections.abc import Sequence
+
+from cageless._version import __version__
+from cageless.cli.common import ArgumentParser, apply_config_defaults, common_options, setup_logging
+from cageless.errors import CagelessError, ParameterError, UsageError
+
+__all__ = ["main", "entry_point", "build_parser", "SUBCOMMANDS"]
+
+SUBCOMMANDS: tuple[str, ...] = ("info",)
+
+EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
+
+log = logging.getLogger("cageless")
+
+_EPILOG = """\
+examples:
+  cageless info                       the default bearing and its kinematics at 3000 rpm
+  cageless info --speed-rpm 6000 --json
+  cageless COMMAND --help             help and examples for one command
+
+exit codes: 0 success, 1 some inputs failed (the rest done), 2 usage error
+"""
+
+
+def build_parser() -> ArgumentParser:
+    """Build the top-level parser with every registered subcommand."""
+    parser = ArgumentParser(
+        prog="cageless",
+        description="Track, simulate and compare the balls of cageless ball bearings.",
+        epilog=_EPILOG,
+        formatter_class=__import__("argparse").RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--version", action="version", version=f"cageless {__version__}")
+    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=ArgumentParser)
+    parent = common_options()
+    for name in SUBCOMMANDS:
+        importlib.import_module(f"cageless.cli.{name}").register(subparsers, parent)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the CLI in-process and return its exit code.
+
+    Parameters
+    ----------
+    argv
+        Arguments without the program name; ``None`` means ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        0 on success, 1 if some inputs failed, 2 on a usage error.
+    """
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+        if args.command is None:
+            parser.print_help()
+            return EXIT_USAGE
+        args, config = apply_config_defaults(parser, args.command, argv, args)
+        setup_logging(args.quiet, args.verbose)
+        module = importlib.import_module(f"cageless.cli.{args.command}")
+        return int(module.run(args, config))
+    except SystemExit as exc:  # --help and --version exit through argparse
+        return int(exc.code or 0) if isinstance(exc.code, int | None) else EXIT_USAGE
+    except (UsageError, ParameterError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except CagelessError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return EXIT_FAILED
+
+
+def entry_point() -> None:
+    """Console-script entry: exit with :func:`main`'s code."""
+    sys.exit(main())

@@ -1,0 +1,85 @@
+"""Shared pieces of the command-line interface: parser, common options, logging."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import math
+import re
+from collections.abc import Sequence
+from typing import Any, NoReturn
+
+from cageless.config import load_config
+from cageless.errors import UsageError, suggest
+
+__all__ = [
+    "ArgumentParser", "common_options", "apply_config_defaults", "setup_logging", "finite_float",
+]
+
+
+class ArgumentParser(argparse.ArgumentParser):
+    """An argparse parser that raises :class:`UsageError` instead of exiting.
+
+    This keeps :func:`cageless.cli.main` testable in-process and lets the error
+    carry a suggestion for a misspelled subcommand or option.
+    """
+
+    def error(self, message: str) -> NoReturn:  # noqa: D401 - argparse API
+        m = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)", message)
+        if m:
+            choices = re.findall(r"'([^']*)'", m.group(2)) or [c.strip() for c in m.group(2).split(",")]
+            hint = suggest(m.group(1), choices) or f" Choose from: {', '.join(choices)}."
+            message = f"unknown command '{m.group(1)}'.{hint}"
+        raise UsageError(f"{self.prog}: {message}\nRun '{self.prog} --help' for usage.")
+
+
+def finite_float(text: str) -> float:
+    """argparse type: a finite float (refuses 'nan' and 'inf' with a clear message)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number, got {text!r}") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"must be a finite number, got {text!r}")
+    return value
+
+
+def common_options() -> ArgumentParser:
+    """Return a parent parser with the options every subcommand has (DESIGN §2)."""
+    parent = ArgumentParser(add_help=False)
+    group = parent.add_argument_group("common options")
+    group.add_argument("--config", metavar="FILE.toml", help="read defaults and bearing overrides from a TOML file")
+    group.add_argument("-q", "--quiet", action="store_true", help="no progress bars, warnings and errors only")
+    group.add_argument("-v", "--verbose", action="count", default=0, help="more log output (-vv for debug)")
+    return parent
+
+
+def apply_config_defaults(
+    parser: argparse.ArgumentParser, command: str, argv: Sequence[str], args: argparse.Namespace
+) -> tuple[argparse.Namespace, dict[str, Any]]:
+    """Re-parse ``argv`` with the ``[command]`` table of ``--config`` as defaults.
+
+    Returns the new namespace and the whole configuration (empty without ``--config``).
+    """
+    if not getattr(args, "config", None):
+        return args, {}
+    config = load_config(args.config)
+    table = config.get(command, {})
+    sub = parser._subparsers._group_actions[0].choices[command]  # type: ignore[union-attr]
+    dests = {a.dest for a in sub._actions if a.dest not in ("help", "config")}
+    defaults = {}
+    for key, value in table.items():
+        dest = key.replace("-", "_")
+        if dest not in dests:
+            raise UsageError(
+                f"--config {args.config}: [{command}] has unknown option '{key}'." + suggest(dest, dests)
+            )
+        defaults[dest] = value
+    sub.set_defaults(**defaults)
+    return parser.parse_args(argv), config
+
+
+def setup_logging(quiet: bool, verbose: int) -> None:
+    """Configure the root logger for the CLI."""
+    level = logging.WARNING if quiet or verbose == 0 else (logging.INFO if verbose == 1 else logging.DEBUG)
+    logging.basicConfig(level=level, format="%(levelname)s: %(message)s", force=True)

@@ -1,0 +1,401 @@
+"""Operating conditions of a video and where they come from (DESIGN §5).
+
+A video's conditions are merged key by key from three sources, highest
+precedence first:
+
+1. a sidecar with the video's stem: ``n3000.toml`` or ``n3000.json`` beside
+   ``n3000.cine``;
+2. a ``conditions.csv`` in the folder, with columns ``file, speed_rpm``
+   and optionally ``radial_load_n, axial_load_n, fps, px_per_mm, camera_roll_deg``;
+3. the file name, e.g. ``n3000_Fr500_Fa0.cine``.
+
+Only ``speed_rpm`` is required; the loads default to 0 and the camera keys to
+what the video file says (``None`` here). A malformed source is an error, never
+silently skipped, and every error names the file it is about.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import re
+import tomllib
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from cageless.errors import CagelessError, ConditionsError, ParameterError, suggest
+from cageless.units import rpm_to_rad_s
+
+__all__ = [
+    "CONDITION_KEYS",
+    "VIDEO_SUFFIXES",
+    "IMAGE_SUFFIXES",
+    "OperatingConditions",
+    "ResolvedConditions",
+    "LabEntry",
+    "read_sidecar",
+    "read_conditions_csv",
+    "parse_file_name",
+    "resolve_conditions",
+    "find_videos",
+    "discover_lab",
+]
+
+log = logging.getLogger(__name__)
+
+CONDITION_KEYS = ("speed_rpm", "radial_load_n", "axial_load_n", "fps", "px_per_mm", "camera_roll_deg")
+VIDEO_SUFFIXES = (".cine", ".avi", ".mp4", ".mkv")
+IMAGE_SUFFIXES = (".tif", ".tiff", ".png")
+CONDITIONS_CSV = "conditions.csv"
+_POSITIVE_KEYS = ("speed_rpm", "fps", "px_per_mm")
+_NON_NEGATIVE_KEYS = ("radial_load_n", "axial_load_n")
+
+
+@dataclass(frozen=True)
+class OperatingConditions:
+    """The conditions a video was shot at (or a simulation is run for).
+
+    Parameters
+    ----------
+    speed_rpm
+        Inner-ring speed (rpm), finite and > 0.
+    radial_load_n
+        Radial load on the inner ring (N), >= 0; it acts toward -z (DESIGN §3).
+    axial_load_n
+        Axial load (N), >= 0.
+    fps
+        Frame rate override (frames/s), or ``None`` to take it from the video.
+    px_per_mm
+        Image scale override (pixels/mm), or ``None`` to measure it from the ring.
+    camera_roll_deg
+        Camera roll (deg), counter-clockwise from the bearing frame; ``None`` means 0.
+    """
+
+    speed_rpm: float
+    radial_load_n: float = 0.0
+    axial_load_n: float = 0.0
+    fps: float | None = None
+    px_per_mm: float | None = None
+    camera_roll_deg: float | None = None
+
+    def __post_init__(self) -> None:
+        for key in CONDITION_KEYS:
+            value = getattr(self, key)
+            if value is None and key not in ("speed_rpm", "radial_load_n", "axial_load_n"):
+                continue
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise ParameterError(key, "must be a number", value)
+            if not math.isfinite(value):
+                raise ParameterError(key, "must be finite", value)
+            if key in _POSITIVE_KEYS and value <= 0:
+                raise ParameterError(key, "must be > 0", value)
+            if key in _NON_NEGATIVE_KEYS and value < 0:
+                raise ParameterError(
+                    key, "must be >= 0 (the load direction is fixed by the bearing frame)", value
+                )
+
+    @property
+    def speed_rad_s(self) -> float:
+        """Inner-ring speed in rad/s."""
+        return rpm_to_rad_s(self.speed_rpm)
+
+    def to_dict(self) -> dict[str, float | None]:
+        """Return the conditions as a plain dict keyed as in ``CONDITION_KEYS``."""
+        return asdict(self)
+
+    @classmethod
+    def from_mapping(cls, values: Mapping[str, Any]) -> OperatingConditions:
+        """Build conditions from a mapping, refusing unknown keys with a suggestion."""
+        for key in values:
+            if key not in CONDITION_KEYS:
+                raise ParameterError(key, "is not a condition key" + suggest(key, CONDITION_KEYS))
+        if "speed_rpm" not in values:
+            raise ParameterError("speed_rpm", "is required")
+        return cls(**dict(values))
+
+
+@dataclass(frozen=True)
+class ResolvedConditions:
+    """Conditions of one video together with where each value came from.
+
+    Attributes
+    ----------
+    video
+        The video file (or image-sequence folder).
+    conditions
+        The merged conditions.
+    origin
+        For each key that a source gave, a description of that source.
+    """
+
+    video: Path
+    conditions: OperatingConditions
+    origin: dict[str, str] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class LabEntry:
+    """One video of a lab folder: its conditions, or the error that stops it."""
+
+    video: Path
+    resolved: ResolvedConditions | None = None
+    error: CagelessError | None = None
+
+    @property
+    def ok(self) -> bool:
+        """True when the conditions were resolved."""
+        return self.error is None
+
+
+def _check_number(path: Path, key: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ConditionsError(path, f"'{key}' must be a number, got {value!r}.")
+    return float(value)
+
+
+def read_sidecar(path: str | Path) -> dict[str, float]:
+    """Read a ``.toml`` or ``.json`` sidecar of condition keys.
+
+    Raises
+    ------
+    ConditionsError
+        On a syntax error, a non-table document, an unknown key or a non-numeric value.
+    """
+    path = Path(path)
+    text = path.read_text(encoding="utf-8")
+    try:
+        data = tomllib.loads(text) if path.suffix == ".toml" else json.loads(text)
+    except (tomllib.TOMLDecodeError, json.JSONDecodeError) as exc:
+        raise ConditionsError(path, f"cannot parse the sidecar: {exc}.", "Fix its syntax.") from exc
+    if not isinstance(data, dict):
+        raise ConditionsError(path, "the sidecar must hold a table of condition keys.")
+    out: dict[str, float] = {}
+    for key, value in data.items():
+        if key not in CONDITION_KEYS:
+            hint = suggest(key, CONDITION_KEYS).strip() or f"Valid keys: {', '.join(CONDITION_KEYS)}."
+            raise ConditionsError(path, f"unknown key '{key}'.", hint)
+        out[key] = _check_number(path, key, value)
+    return out
+
+
+def read_conditions_csv(path: str | Path) -> dict[str, dict[str, float]]:
+    """Read a folder's ``conditions.csv`` into ``{file name: {key: value}}``.
+
+    Empty cells are left out (they take the default). Rows are matched to videos
+    by file name or by stem.
+
+    Raises
+    ------
+    ConditionsError
+        On a missing ``file`` or ``speed_rpm`` column, an unknown column, a
+        non-numeric cell or a duplicated file.
+    """
+    path = Path(path)
+    try:
+        table = pd.read_csv(path, dtype={"file": str}, skipinitialspace=True)
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
+        raise ConditionsError(path, f"cannot parse the CSV: {exc}.") from exc
+    table.columns = [str(c).strip() for c in table.columns]
+    for required in ("file", "speed_rpm"):
+        if required not in table.columns:
+            raise ConditionsError(
+                path, f"missing column '{required}'.",
+                f"Columns are: file, {', '.join(CONDITION_KEYS)} (only file and speed_rpm are required).",
+            )
+    for col in table.columns:
+        if col != "file" and col not in CONDITION_KEYS:
+            raise ConditionsError(path, f"unknown column '{col}'." + suggest(col, CONDITION_KEYS))
+    rows: dict[str, dict[str, float]] = {}
+    for i, row in table.iterrows():
+        line = int(i) + 2  # 1-based, after the header
+        name = str(row["file"]).strip()
+        if not name or name == "nan":
+            raise ConditionsError(path, f"line {line}: empty 'file' cell.")
+        if name in rows:
+            raise ConditionsError(path, f"line {line}: '{name}' is listed twice.", "Keep one row per video.")
+        values: dict[str, float] = {}
+        for key in CONDITION_KEYS:
+            if key not in table.columns or pd.isna(row[key]):
+                continue
+            try:
+                values[key] = float(row[key])
+            except (TypeError, ValueError):
+                raise ConditionsError(path, f"line {line}: '{key}' = {row[key]!r} is not a number.") from None
+        rows[name] = values
+    return rows
+
+
+_NUMBER = r"(\d+(?:\.\d+)?)"
+_TOKEN_PATTERNS = {
+    "speed_rpm": re.compile(rf"^n{_NUMBER}(?:rpm)?$", re.IGNORECASE),
+    "radial_load_n": re.compile(rf"^fr{_NUMBER}n?$", re.IGNORECASE),
+    "axial_load_n": re.compile(rf"^fa{_NUMBER}n?$", re.IGNORECASE),
+}
+_SUSPECT = re.compile(r"^(?:n\d|f[ra](?![a-z]))", re.IGNORECASE)
+
+
+def parse_file_name(path: str | Path) -> dict[str, float] | None:
+    """Read conditions from a file name such as ``n3000_Fr500_Fa0.cine``.
+
+    Tokens are separated by ``_``, ``-`` or spaces: ``n<rpm>``, ``Fr<N>``,
+    ``Fa<N>`` (case-insensitive, optional ``rpm``/``N`` suffix). Other tokens
+    are ignored.
+
+    Returns
+    -------
+    dict or None
+        The keys found, or ``None`` when the name carries no conditions.
+
+    Raises
+    ------
+    ConditionsError
+        When a token looks like a condition but cannot be read, a key repeats,
+        or loads are given without a speed.
+    """
+    path = Path(path)
+    stem = path.name if path.is_dir() else path.stem
+    found: dict[str, float] = {}
+    for token in re.split(r"[_\-\s]+", stem):
+        matched = False
+        for key, pattern in _TOKEN_PATTERNS.items():
+            m = pattern.match(token)
+            if m:
+                if key in found:
+                    raise ConditionsError(path, f"the file name gives '{key}' twice.")
+                found[key] = float(m.group(1))
+                matched = True
+        if not matched and _SUSPECT.match(token):
+            raise ConditionsError(
+                path, f"cannot read the file-name token '{token}'.",
+                "Use the pattern n3000_Fr500_Fa0 (speed in rpm, loads in N), or give a sidecar.",
+            )
+    if not found:
+        return None
+    if "speed_rpm" not in found:
+        raise ConditionsError(path, "the file name gives loads but no speed (e.g. n3000).")
+    return found
+
+
+def _sidecar_for(video: Path) -> Path | None:
+    stem = video.name if video.is_dir() else video.stem
+    candidates = [video.with_name(stem + ext) for ext in (".toml", ".json")]
+    present = [c for c in candidates if c.is_file()]
+    if len(present) > 1:
+        raise ConditionsError(video, f"both {present[0].name} and {present[1].name} exist.", "Keep one sidecar.")
+    return present[0] if present else None
+
+
+def _csv_row(video: Path, table: Mapping[str, Mapping[str, float]]) -> Mapping[str, float] | None:
+    stem = video.name if video.is_dir() else video.stem
+    return table.get(video.name, table.get(stem))
+
+
+def resolve_conditions(
+    video: str | Path, csv_table: Mapping[str, Mapping[str, float]] | None = None
+) -> ResolvedConditions:
+    """Merge a video's conditions from sidecar, ``conditions.csv`` and file name.
+
+    Parameters
+    ----------
+    video
+        The video file or image-sequence folder.
+    csv_table
+        An already-read ``conditions.csv`` (see :func:`read_conditions_csv`). When
+        ``None``, the folder's ``conditions.csv`` is read if present.
+
+    Raises
+    ------
+    ConditionsError
+        When a source is malformed, or no source gives ``speed_rpm``.
+    """
+    video = Path(video)
+    if csv_table is None:
+        csv_path = video.parent / CONDITIONS_CSV
+        csv_table = read_conditions_csv(csv_path) if csv_path.is_file() else {}
+    sources: list[tuple[str, Mapping[str, float] | None]] = []
+    sidecar = _sidecar_for(video)
+    sources.append((f"sidecar {sidecar.name}" if sidecar else "", read_sidecar(sidecar) if sidecar else None))
+    sources.append((CONDITIONS_CSV, _csv_row(video, csv_table)))
+    sources.append(("file name", parse_file_name(video)))
+    merged: dict[str, float] = {}
+    origin: dict[str, str] = {}
+    for label, values in reversed(sources):  # lowest precedence first, higher ones overwrite
+        for key, value in (values or {}).items():
+            merged[key] = value
+            origin[key] = label
+    if "speed_rpm" not in merged:
+        raise ConditionsError(
+            video, "no operating conditions found.",
+            f"Give them in a sidecar ({video.stem}.toml with speed_rpm = ...), a row of "
+            f"{CONDITIONS_CSV}, or the file name (e.g. n3000_Fr500_Fa0{video.suffix}).",
+        )
+    try:
+        conditions = OperatingConditions.from_mapping(merged)
+    except ParameterError as exc:
+        raise ConditionsError(video, f"invalid condition from {origin.get(exc.parameter, 'a source')}: {exc}") from exc
+    return ResolvedConditions(video=video, conditions=conditions, origin=origin)
+
+
+def _is_image_sequence(folder: Path) -> bool:
+    return any(
+        p.suffix.lower() in IMAGE_SUFFIXES and re.search(r"\d", p.stem) for p in folder.iterdir()
+    )
+
+
+def find_videos(folder: str | Path) -> list[Path]:
+    """List the videos of a lab folder: video files and numbered image-sequence sub-folders.
+
+    Raises
+    ------
+    ConditionsError
+        When ``folder`` is not a directory.
+    """
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise ConditionsError(folder, "is not a folder.", "Point at the lab folder that holds the videos.")
+    found = []
+    for p in sorted(folder.iterdir()):
+        if p.name.startswith("."):
+            continue
+        if p.is_file() and p.suffix.lower() in VIDEO_SUFFIXES:
+            found.append(p)
+        elif p.is_dir() and _is_image_sequence(p):
+            found.append(p)
+    return found
+
+
+def discover_lab(folder: str | Path) -> list[LabEntry]:
+    """Find every video of a lab folder and resolve its conditions.
+
+    A video whose conditions cannot be resolved gets an entry carrying the
+    error; the others are unaffected. A malformed ``conditions.csv`` is an error
+    for every video, since any of them may depend on it.
+    """
+    folder = Path(folder)
+    videos = find_videos(folder)
+    csv_path = folder / CONDITIONS_CSV
+    csv_error: ConditionsError | None = None
+    table: dict[str, dict[str, float]] = {}
+    if csv_path.is_file():
+        try:
+            table = read_conditions_csv(csv_path)
+        except ConditionsError as exc:
+            csv_error = exc
+    known = {v.name for v in videos} | {v.stem for v in videos}
+    for name in sorted(set(table) - known):
+        log.warning("%s: row '%s' matches no video in the folder", csv_path, name)
+    entries = []
+    for video in videos:
+        if csv_error is not None:
+            entries.append(LabEntry(video=video, error=csv_error))
+            continue
+        try:
+            entries.append(LabEntry(video=video, resolved=resolve_conditions(video, table)))
+        except ConditionsError as exc:
+            entries.append(LabEntry(video=video, error=exc))
+    return entries

@@ -1,0 +1,207 @@
+"""Pure-rolling kinematics and characteristic frequencies of a ball bearing.
+
+Closed forms for a rotating inner ring and a fixed outer ring, from Harris &
+Kotzalas, *Rolling Bearing Analysis*, 5th ed., vol. 1 (2006), ch. 8
+("Bearing kinematics"). With ``gamma = D cos(alpha) / d_m``:
+
+* cage (fundamental train) speed: ``omega_c = omega_i (1 - gamma) / 2``;
+* ball spin about its own axis, relative to the cage:
+  ``omega_R = omega_i (d_m / 2D) (1 - gamma^2)``;
+* FTF = f_i (1 - gamma)/2, BPFO = Z FTF, BPFI = Z f_i (1 + gamma)/2,
+  BSF = f_i (d_m / 2D)(1 - gamma^2).
+
+The theoretical cage speed is the reference of the slip rate
+``s = 1 - theta_dot / omega_c`` (DESIGN §3).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from cageless.bearing import Geometry, Masses
+from cageless.errors import ParameterError
+from cageless.units import rpm_to_hz, rpm_to_rad_s
+
+__all__ = [
+    "KinematicRatios",
+    "CharacteristicFrequencies",
+    "kinematic_ratios",
+    "characteristic_frequencies",
+    "theoretical_cage_speed",
+    "slip_rate",
+    "centrifugal_force",
+]
+
+
+def _check_angle(contact_angle_rad: float) -> None:
+    if not math.isfinite(contact_angle_rad) or not (0.0 <= contact_angle_rad < 0.5 * math.pi):
+        raise ParameterError("contact_angle_rad", "must be finite and in [0, pi/2)", contact_angle_rad)
+
+
+def _check_speed(name: str, value: float) -> None:
+    if not math.isfinite(value):
+        raise ParameterError(name, "must be finite", value)
+
+
+@dataclass(frozen=True)
+class KinematicRatios:
+    """Dimensionless pure-rolling ratios, all relative to the inner-ring speed.
+
+    Attributes
+    ----------
+    gamma
+        D cos(alpha) / d_m.
+    cage_ratio
+        omega_c / omega_i = (1 - gamma) / 2.
+    ball_spin_ratio
+        Ball rotation about its own axis relative to the cage, over omega_i:
+        (d_m / 2D)(1 - gamma^2) (Harris & Kotzalas).
+    ball_spin_ratio_inertial
+        Ball rotation about the bearing axis in the fixed frame, over omega_i:
+        -(d_m / D) cage_ratio. Negative: the ball turns against the ring.
+    """
+
+    gamma: float
+    cage_ratio: float
+    ball_spin_ratio: float
+    ball_spin_ratio_inertial: float
+
+    def to_dict(self) -> dict[str, float]:
+        """Return the ratios as a plain dict."""
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class CharacteristicFrequencies:
+    """Characteristic frequencies (Hz) at one inner-ring speed.
+
+    Attributes
+    ----------
+    shaft_hz
+        Inner-ring rotation frequency f_i.
+    ftf_hz
+        Fundamental train (cage) frequency.
+    bpfo_hz
+        Ball-pass frequency, outer race.
+    bpfi_hz
+        Ball-pass frequency, inner race.
+    bsf_hz
+        Ball spin frequency (rotation of a ball about its own axis relative to the cage).
+    """
+
+    shaft_hz: float
+    ftf_hz: float
+    bpfo_hz: float
+    bpfi_hz: float
+    bsf_hz: float
+
+    def to_dict(self) -> dict[str, float]:
+        """Return the frequencies as a plain dict."""
+        return asdict(self)
+
+
+def kinematic_ratios(geometry: Geometry, contact_angle_rad: float = 0.0) -> KinematicRatios:
+    """Pure-rolling speed ratios for a turning inner ring and a fixed outer ring.
+
+    Parameters
+    ----------
+    geometry
+        The bearing geometry.
+    contact_angle_rad
+        Contact angle alpha (rad); 0 for a radially loaded deep-groove bearing.
+
+    Returns
+    -------
+    KinematicRatios
+    """
+    _check_angle(contact_angle_rad)
+    d, dm = geometry.ball_diameter_m, geometry.pitch_diameter_m
+    gamma = d * math.cos(contact_angle_rad) / dm
+    cage = 0.5 * (1.0 - gamma)
+    return KinematicRatios(
+        gamma=gamma,
+        cage_ratio=cage,
+        ball_spin_ratio=dm / (2.0 * d) * (1.0 - gamma**2),
+        ball_spin_ratio_inertial=-(dm / d) * cage,
+    )
+
+
+def characteristic_frequencies(
+    geometry: Geometry, speed_rpm: float, contact_angle_rad: float = 0.0
+) -> CharacteristicFrequencies:
+    """Characteristic defect frequencies at an inner-ring speed.
+
+    Parameters
+    ----------
+    geometry
+        The bearing geometry.
+    speed_rpm
+        Inner-ring speed (rpm).
+    contact_angle_rad
+        Contact angle alpha (rad).
+
+    Returns
+    -------
+    CharacteristicFrequencies
+    """
+    _check_speed("speed_rpm", speed_rpm)
+    r = kinematic_ratios(geometry, contact_angle_rad)
+    f_i = rpm_to_hz(speed_rpm)
+    ftf = r.cage_ratio * f_i
+    return CharacteristicFrequencies(
+        shaft_hz=f_i,
+        ftf_hz=ftf,
+        bpfo_hz=geometry.n_balls * ftf,
+        bpfi_hz=geometry.n_balls * 0.5 * (1.0 + r.gamma) * f_i,
+        bsf_hz=r.ball_spin_ratio * f_i,
+    )
+
+
+def theoretical_cage_speed(
+    geometry: Geometry, inner_speed_rad_s: float, contact_angle_rad: float = 0.0
+) -> float:
+    """Pure-rolling cage speed omega_c = omega_i (1 - D cos(alpha)/d_m) / 2 (rad/s).
+
+    This is the reference speed of the slip rate (DESIGN §3).
+    """
+    _check_speed("inner_speed_rad_s", inner_speed_rad_s)
+    return kinematic_ratios(geometry, contact_angle_rad).cage_ratio * inner_speed_rad_s
+
+
+def slip_rate(
+    orbital_speed_rad_s: npt.ArrayLike, cage_speed_rad_s: float
+) -> npt.NDArray[np.float64]:
+    """Slip rate s = 1 - theta_dot / omega_c (DESIGN §3).
+
+    Parameters
+    ----------
+    orbital_speed_rad_s
+        Ball revolution speeds theta_dot (rad/s), any shape.
+    cage_speed_rad_s
+        The pure-rolling cage speed omega_c (rad/s), non-zero.
+
+    Returns
+    -------
+    numpy.ndarray
+        The slip rates, same shape as ``orbital_speed_rad_s`` (dimensionless; x100 for %).
+    """
+    if not math.isfinite(cage_speed_rad_s) or cage_speed_rad_s == 0.0:
+        raise ParameterError(
+            "cage_speed_rad_s", "must be finite and non-zero to define a slip rate", cage_speed_rad_s
+        )
+    return 1.0 - np.asarray(orbital_speed_rad_s, dtype=np.float64) / cage_speed_rad_s
+
+
+def centrifugal_force(masses: Masses, geometry: Geometry, cage_speed_rad_s: float) -> float:
+    """Centrifugal force m (d_m/2) omega_c^2 on one ball orbiting at the pitch radius (N)."""
+    _check_speed("cage_speed_rad_s", cage_speed_rad_s)
+    return masses.ball_mass_kg * 0.5 * geometry.pitch_diameter_m * cage_speed_rad_s**2
+
+
+def speed_rpm_to_cage_speed(geometry: Geometry, speed_rpm: float) -> float:
+    """Convenience: pure-rolling cage speed (rad/s) at an inner-ring speed in rpm."""
+    return theoretical_cage_speed(geometry, rpm_to_rad_s(speed_rpm))

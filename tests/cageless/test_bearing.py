@@ -1,0 +1,111 @@
+"""Validation of the bearing description: impossible geometries are refused with the rule named."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import pytest
+
+from cageless.bearing import Bearing, Geometry, Lubricant, Material, default_bearing
+from cageless.config import bearing_from_config
+from cageless.errors import GeometryError, ParameterError
+from cageless.parameter_sets import wang2026
+
+
+def _geometry(**changes):
+    return dataclasses.replace(wang2026.geometry(), **changes)
+
+
+def test_default_bearing_is_the_papers():
+    b = default_bearing()
+    assert b.name == "wang2026"
+    assert b.geometry.n_balls == 14
+    assert b.geometry.ball_diameter_m == 9.525e-3
+    assert b.masses.ring_translational_mass_kg == pytest.approx(6.2356e-2 + 2.0)
+    assert b.lubricant is not None and b.lubricant.dynamic_viscosity_pa_s == 0.04
+
+
+def test_sixteen_balls_do_not_fit():
+    with pytest.raises(GeometryError) as err:
+        _geometry(n_balls=16)
+    assert err.value.parameter == "geometry.n_balls"
+    assert "at most 15 fit" in str(err.value)
+
+
+def test_fifteen_balls_fit():
+    assert _geometry(n_balls=15).n_balls == 15
+
+
+@pytest.mark.parametrize("field", ["inner_curvature_factor", "outer_curvature_factor"])
+@pytest.mark.parametrize("value", [0.5, 0.45])
+def test_curvature_factor_must_exceed_half(field, value):
+    with pytest.raises(GeometryError, match=r"must be > 0.5") as err:
+        _geometry(**{field: value})
+    assert err.value.parameter == f"geometry.{field}"
+
+
+@pytest.mark.parametrize("value", [-9.525e-3, 0.0, math.nan, math.inf])
+def test_ball_diameter_must_be_positive_and_finite(value):
+    with pytest.raises(ParameterError, match="finite number > 0") as err:
+        _geometry(ball_diameter_m=value)
+    assert err.value.parameter == "geometry.ball_diameter_m"
+
+
+def test_non_numbers_are_refused():
+    with pytest.raises(ParameterError, match="must be a number"):
+        _geometry(ball_diameter_m="9.5")
+    with pytest.raises(GeometryError, match="whole number"):
+        _geometry(n_balls=14.0)
+    with pytest.raises(GeometryError, match="whole number"):
+        _geometry(n_balls=True)
+
+
+def test_races_must_make_room_for_the_ball():
+    with pytest.raises(GeometryError, match="must exceed geometry.inner_race_diameter_m"):
+        _geometry(outer_race_diameter_m=30e-3)
+    with pytest.raises(GeometryError, match="does not fit between the races"):
+        _geometry(ball_diameter_m=9.6e-3)
+
+
+def test_material_and_lubricant_rules():
+    with pytest.raises(ParameterError, match=r"\(-1, 0.5\)") as err:
+        Material(density_kg_m3=7810.0, youngs_modulus_pa=208e9, poisson_ratio=0.5)
+    assert err.value.parameter == "material.poisson_ratio"
+    with pytest.raises(ParameterError) as err:
+        dataclasses.replace(wang2026.lubricant(), dynamic_viscosity_pa_s=math.nan)
+    assert err.value.parameter == "lubricant.dynamic_viscosity_pa_s"
+    assert isinstance(wang2026.lubricant(), Lubricant)
+
+
+def test_effective_modulus():
+    # E' = E / (1 - nu^2) = 208 GPa / 0.91 = 228.5714 GPa
+    assert wang2026.material().effective_modulus_pa == pytest.approx(228.5714e9, rel=1e-6)
+
+
+def test_dict_round_trip_and_overrides():
+    b = default_bearing()
+    assert Bearing.from_dict(b.to_dict()) == b
+    b13 = b.with_overrides({"geometry.n_balls": 13})
+    assert b13.geometry.n_balls == 13
+    with pytest.raises(ParameterError, match="Did you mean 'geometry.n_balls'"):
+        b.with_overrides({"geometry.n_ball": 13})
+    with pytest.raises(GeometryError):
+        b.with_overrides({"geometry.n_balls": 16})
+    with pytest.raises(ParameterError, match="is missing"):
+        Bearing.from_dict({"geometry": b.to_dict()["geometry"]})
+
+
+def test_bearing_from_config():
+    b = bearing_from_config({"bearing": {"geometry": {"n_balls": 12}, "lubricant": False}})
+    assert b.geometry.n_balls == 12
+    assert b.lubricant is None
+    assert b.name == "wang2026+overrides"
+    assert bearing_from_config({}) == default_bearing()
+
+
+def test_geometry_is_frozen():
+    g = wang2026.geometry()
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        g.n_balls = 3  # type: ignore[misc]
+    assert isinstance(g, Geometry)

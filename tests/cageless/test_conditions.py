@@ -1,0 +1,183 @@
+"""Operating conditions: the three sources, their precedence, and per-file errors (DESIGN §5)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+
+from cageless.conditions import (
+    OperatingConditions,
+    discover_lab,
+    find_videos,
+    parse_file_name,
+    read_conditions_csv,
+    read_sidecar,
+    resolve_conditions,
+)
+from cageless.errors import ConditionsError, ParameterError
+
+
+def _touch(path: Path) -> Path:
+    path.write_bytes(b"\0")
+    return path
+
+
+def test_file_name_pattern(tmp_path):
+    assert parse_file_name(tmp_path / "n3000_Fr500_Fa0.cine") == {
+        "speed_rpm": 3000.0, "radial_load_n": 500.0, "axial_load_n": 0.0,
+    }
+    assert parse_file_name(tmp_path / "run2-n1800rpm-Fr1000N.avi") == {"speed_rpm": 1800.0, "radial_load_n": 1000.0}
+    assert parse_file_name(tmp_path / "notes_fast.avi") is None
+
+
+@pytest.mark.parametrize(
+    ("name", "match"),
+    [
+        ("n3000_Fr_Fa0.cine", "token 'Fr'"),
+        ("n3k_Fr500.cine", "token 'n3k'"),
+        ("n3000_Fr500x.cine", "token 'Fr500x'"),
+        ("n3000_n1800.cine", "twice"),
+        ("Fr500_Fa0.cine", "no speed"),
+    ],
+)
+def test_unparsable_names_are_errors_naming_the_file(tmp_path, name, match):
+    with pytest.raises(ConditionsError, match=match) as err:
+        parse_file_name(tmp_path / name)
+    assert err.value.path.name == name
+
+
+def test_sidecar_toml_and_json(tmp_path):
+    (tmp_path / "a.toml").write_text("speed_rpm = 6000\nradial_load_n = 500.5\ncamera_roll_deg = -1.5\n")
+    assert read_sidecar(tmp_path / "a.toml") == {"speed_rpm": 6000.0, "radial_load_n": 500.5, "camera_roll_deg": -1.5}
+    (tmp_path / "b.json").write_text(json.dumps({"speed_rpm": 1800, "fps": 10000}))
+    assert read_sidecar(tmp_path / "b.json") == {"speed_rpm": 1800.0, "fps": 10000.0}
+
+
+@pytest.mark.parametrize(
+    ("name", "text", "match"),
+    [
+        ("bad.toml", "speed_rpm = = 3", "cannot parse"),
+        ("bad.json", "{speed_rpm: 3}", "cannot parse"),
+        ("typo.toml", "speed_rmp = 3000", "Did you mean 'speed_rpm'"),
+        ("str.toml", 'speed_rpm = "fast"', "must be a number"),
+        ("list.json", "[1, 2]", "table of condition keys"),
+    ],
+)
+def test_malformed_sidecars(tmp_path, name, text, match):
+    (tmp_path / name).write_text(text)
+    with pytest.raises(ConditionsError, match=match) as err:
+        read_sidecar(tmp_path / name)
+    assert err.value.path == tmp_path / name
+
+
+def test_conditions_csv(tmp_path):
+    csv = tmp_path / "conditions.csv"
+    csv.write_text("file,speed_rpm,radial_load_n,axial_load_n,px_per_mm\na.cine,3000,500,0,\nb,1800,1000,300,12.5\n")
+    rows = read_conditions_csv(csv)
+    assert rows["a.cine"] == {"speed_rpm": 3000.0, "radial_load_n": 500.0, "axial_load_n": 0.0}
+    assert rows["b"]["px_per_mm"] == 12.5
+
+
+@pytest.mark.parametrize(
+    ("text", "match"),
+    [
+        ("file,radial_load_n\na.cine,500\n", "missing column 'speed_rpm'"),
+        ("name,speed_rpm\na.cine,500\n", "missing column 'file'"),
+        ("file,speed_rpm,radial_load\na.cine,3000,5\n", "Did you mean 'radial_load_n'"),
+        ("file,speed_rpm\na.cine,fast\n", "line 2: 'speed_rpm'"),
+        ("file,speed_rpm\na.cine,3000\na.cine,1800\n", "line 3: 'a.cine' is listed twice"),
+        ("", "cannot parse"),
+    ],
+)
+def test_malformed_csv(tmp_path, text, match):
+    csv = tmp_path / "conditions.csv"
+    csv.write_text(text)
+    with pytest.raises(ConditionsError, match=match) as err:
+        read_conditions_csv(csv)
+    assert err.value.path == csv
+
+
+def test_precedence_is_sidecar_then_csv_then_name(tmp_path):
+    video = _touch(tmp_path / "n3000_Fr500_Fa0.cine")
+    # Name only.
+    r = resolve_conditions(video)
+    assert r.conditions == OperatingConditions(3000.0, 500.0, 0.0)
+    assert r.origin["speed_rpm"] == "file name"
+    # CSV overrides the name, key by key.
+    (tmp_path / "conditions.csv").write_text("file,speed_rpm,radial_load_n\nn3000_Fr500_Fa0.cine,3100,\n")
+    r = resolve_conditions(video)
+    assert (r.conditions.speed_rpm, r.conditions.radial_load_n) == (3100.0, 500.0)
+    assert r.origin == {"speed_rpm": "conditions.csv", "radial_load_n": "file name", "axial_load_n": "file name"}
+    # The sidecar overrides both.
+    (tmp_path / "n3000_Fr500_Fa0.toml").write_text("speed_rpm = 3200\ncamera_roll_deg = 2.0\n")
+    r = resolve_conditions(video)
+    assert r.conditions.speed_rpm == 3200.0
+    assert r.conditions.camera_roll_deg == 2.0
+    assert r.conditions.radial_load_n == 500.0
+    assert r.origin["speed_rpm"] == "sidecar n3000_Fr500_Fa0.toml"
+
+
+def test_two_sidecars_are_ambiguous(tmp_path):
+    video = _touch(tmp_path / "clip.cine")
+    (tmp_path / "clip.toml").write_text("speed_rpm = 1\n")
+    (tmp_path / "clip.json").write_text('{"speed_rpm": 2}')
+    with pytest.raises(ConditionsError, match="Keep one sidecar"):
+        resolve_conditions(video)
+
+
+def test_no_source_is_a_per_file_error(tmp_path):
+    video = _touch(tmp_path / "clip.cine")
+    with pytest.raises(ConditionsError, match="no operating conditions found") as err:
+        resolve_conditions(video)
+    assert err.value.path == video
+    assert "clip.toml" in str(err.value)
+
+
+def test_invalid_values_name_the_source(tmp_path):
+    video = _touch(tmp_path / "clip.avi")
+    (tmp_path / "clip.json").write_text('{"speed_rpm": -5}')
+    with pytest.raises(ConditionsError, match=r"sidecar clip.json.*speed_rpm.*must be > 0"):
+        resolve_conditions(video)
+
+
+def test_operating_conditions_validation():
+    with pytest.raises(ParameterError, match="finite"):
+        OperatingConditions(math.nan)
+    with pytest.raises(ParameterError, match=">= 0"):
+        OperatingConditions(3000.0, radial_load_n=-1.0)
+    with pytest.raises(ParameterError, match="Did you mean 'axial_load_n'"):
+        OperatingConditions.from_mapping({"speed_rpm": 1.0, "axial_load": 3.0})
+    assert OperatingConditions(3000).speed_rad_s == pytest.approx(314.159265, rel=1e-8)
+
+
+def test_lab_folder_one_bad_file_does_not_stop_the_rest(tmp_path):
+    _touch(tmp_path / "n1800_Fr500.cine")
+    _touch(tmp_path / "mystery.avi")
+    _touch(tmp_path / "n6000_Fr500.mp4")
+    _touch(tmp_path / "notes.txt")
+    seq = tmp_path / "n3000_Fr500"
+    seq.mkdir()
+    for i in range(3):
+        _touch(seq / f"frame_{i:05d}.tif")
+    entries = {e.video.name: e for e in discover_lab(tmp_path)}
+    assert sorted(entries) == ["mystery.avi", "n1800_Fr500.cine", "n3000_Fr500", "n6000_Fr500.mp4"]
+    assert not entries["mystery.avi"].ok
+    assert isinstance(entries["mystery.avi"].error, ConditionsError)
+    assert entries["n3000_Fr500"].resolved.conditions.speed_rpm == 3000.0
+    assert entries["n6000_Fr500.mp4"].resolved.conditions.radial_load_n == 500.0
+
+
+def test_bad_csv_fails_every_video_with_its_name(tmp_path):
+    _touch(tmp_path / "n1800.cine")
+    (tmp_path / "conditions.csv").write_text("file\nn1800.cine\n")
+    (entry,) = discover_lab(tmp_path)
+    assert not entry.ok and "conditions.csv" in str(entry.error)
+
+
+def test_find_videos_refuses_a_file(tmp_path):
+    with pytest.raises(ConditionsError, match="is not a folder"):
+        find_videos(_touch(tmp_path / "x.cine"))
+    assert find_videos(tmp_path) == [tmp_path / "x.cine"]

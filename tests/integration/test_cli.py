@@ -1,0 +1,103 @@
+"""The cageless CLI end to end: in-process through main(), and once through the console script."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+
+import pytest
+
+from cageless import __version__
+from cageless.cli import main
+
+
+def test_version(capsys):
+    assert main(["--version"]) == 0
+    assert capsys.readouterr().out.strip() == f"cageless {__version__}"
+
+
+def test_info_text(capsys):
+    assert main(["info"]) == 0
+    out = capsys.readouterr().out
+    assert "wang2026" in out
+    # Hand-computed in tests/validation/test_kinematics_textbook.py: at 3000 rpm, w_c = 124.5574 rad/s.
+    assert "pure-rolling cage speed w_c  124.5574 rad/s" in out
+    assert "BPFO     277.535 Hz" in out
+
+
+def test_info_json(capsys):
+    assert main(["info", "--speed-rpm", "6000", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["software_version"] == __version__
+    assert d["speed_rpm"] == 6000.0
+    # FTF at 6000 rpm = 100 Hz * (1 - 0.2070427) / 2 = 39.64786 Hz (Harris & Kotzalas ch. 8).
+    assert d["frequencies_hz"]["ftf_hz"] == pytest.approx(39.64786, rel=1e-6)
+    assert d["derived"]["max_ball_count"] == 15
+    assert d["bearing"]["geometry"]["n_balls"] == 14
+
+
+def test_unknown_subcommand_is_a_usage_error(capsys):
+    assert main(["inof"]) == 2
+    err = capsys.readouterr().err
+    assert "unknown command 'inof'" in err and "Did you mean 'info'?" in err
+
+
+def test_no_subcommand_prints_help(capsys):
+    assert main([]) == 2
+    assert "usage: cageless" in capsys.readouterr().out
+
+
+def test_help_has_examples(capsys):
+    assert main(["info", "--help"]) == 0
+    assert "examples:" in capsys.readouterr().out
+
+
+def test_bad_option_value_is_a_usage_error(capsys):
+    assert main(["info", "--speed-rpm", "fast"]) == 2
+    assert "--speed-rpm: must be a number, got 'fast'" in capsys.readouterr().err
+    assert main(["info", "--speed-rpm", "nan"]) == 2
+    assert "--speed-rpm: must be a finite number, got 'nan'" in capsys.readouterr().err
+
+
+def test_config_file(tmp_path, capsys):
+    cfg = tmp_path / "lab.toml"
+    cfg.write_text("[bearing.geometry]\nn_balls = 13\n\n[info]\nspeed_rpm = 6000\njson = true\n")
+    assert main(["info", "--config", str(cfg)]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["speed_rpm"] == 6000
+    # BPFO = Z * FTF = 13 * 39.64786 Hz = 515.4222 Hz
+    assert d["frequencies_hz"]["bpfo_hz"] == pytest.approx(515.4222, rel=1e-6)
+    # The command line wins over the file.
+    assert main(["info", "--config", str(cfg), "--speed-rpm", "1800"]) == 0
+    assert json.loads(capsys.readouterr().out)["speed_rpm"] == 1800.0
+
+
+@pytest.mark.parametrize(
+    ("text", "match"),
+    [
+        ("[info]\nspeed_rmp = 1\n", "Did you mean 'speed_rpm'"),
+        ("[bearing.geometry]\nn_balls = 16\n", "at most 15 fit"),
+        ("[info\n", "not valid TOML"),
+    ],
+)
+def test_bad_config_is_a_usage_error(tmp_path, capsys, text, match):
+    cfg = tmp_path / "bad.toml"
+    cfg.write_text(text)
+    assert main(["info", "--config", str(cfg)]) == 2
+    assert match in capsys.readouterr().err
+
+
+def test_missing_config_file(capsys, tmp_path):
+    assert main(["info", "--config", str(tmp_path / "nope.toml")]) == 2
+    assert "no such file" in capsys.readouterr().err
+
+
+def test_console_script():
+    exe = shutil.which("cageless")
+    cmd = [exe] if exe else [sys.executable, "-m", "cageless"]
+    out = subprocess.run([*cmd, "--version"], capture_output=True, text=True, check=False)
+    assert out.returncode == 0 and out.stdout.strip() == f"cageless {__version__}"
+    bad = subprocess.run([*cmd, "frobnicate"], capture_output=True, text=True, check=False)
+    assert bad.returncode == 2 and "unknown command 'frobnicate'" in bad.stderr
