@@ -10,6 +10,7 @@ from typing import Any
 from cageless.bearing import Bearing
 from cageless.cli.common import finite_float
 from cageless.config import bearing_from_config
+from cageless.errors import CagelessError
 from cageless.kinematics import (
     centrifugal_force,
     characteristic_frequencies,
@@ -23,6 +24,8 @@ __all__ = ["register", "run", "describe_bearing"]
 _EXAMPLES = """\
 examples:
   cageless info                          paper bearing at 3000 rpm
+  cageless info clip.cine                what the reader sees in a video (frames, size, timing)
+  cageless info frames/ --fps 10000      an image-sequence folder, with its frame rate
   cageless info --speed-rpm 1800 --json  the same as JSON, at 1800 rpm
   cageless info --config lab.toml        with bearing overrides from a TOML file
 """
@@ -36,6 +39,8 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
         "kinematics and its characteristic frequencies at an inner-ring speed.",
         epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter,
     )
+    p.add_argument("video", nargs="?", help="a video file or image folder to describe instead of the bearing")
+    p.add_argument("--fps", type=finite_float, default=None, help="frame-rate override for VIDEO (frames/s)")
     p.add_argument("--speed-rpm", type=finite_float, default=3000.0, help="inner-ring speed in rpm (default 3000)")
     p.add_argument(
         "--contact-angle-deg", type=finite_float, default=0.0,
@@ -106,8 +111,48 @@ def _format_text(d: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
+def describe_video(path: str, fps: float | None = None) -> dict[str, Any]:
+    """Return what the reader sees in a video, JSON-ready."""
+    from tracking.io import open_video
+
+    with open_video(path, fps=fps) as video:
+        meta = video.metadata.to_dict()
+        meta["extra"] = {k: v for k, v in meta["extra"].items() if k != "exposure_per_frame_s"}
+        try:
+            t = video.times
+            meta["first_time_s"], meta["last_time_s"] = float(t[0]), float(t[-1])
+        except CagelessError as exc:
+            meta["notes"].append(str(exc))
+    return meta
+
+
+def _format_video(m: dict[str, Any]) -> str:
+    def fps(v: float | None) -> str:
+        return "unknown" if v is None else f"{v:.6g} fps"
+
+    lines = [
+        f"Video: {m['path']}",
+        f"  format            {m['format']} ({m['storage']})",
+        f"  frames            {m['n_frames']}",
+        f"  size              {m['width']} x {m['height']} px, {m['dtype']}, {m['bit_depth']}-bit",
+        f"  header rate       {fps(m['header_fps'])}",
+        f"  time-stamp rate   {fps(m['timestamp_fps'])}",
+        f"  time from         {m['time_source'] or 'nothing (give --fps)'}",
+        f"  duration          " + ("unknown" if m.get("last_time_s") is None else f"{m['last_time_s']:.6g} s (first to last frame)"),
+        f"  exposure          " + ("unknown" if m["exposure_s"] is None else f"{m['exposure_s'] * 1e6:.4g} us"),
+    ]
+    if m["camera"]:
+        lines.append(f"  camera            {m['camera']}")
+    lines += [f"  note: {n}" for n in m["notes"]]
+    return "\n".join(lines)
+
+
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
-    """Print the bearing description; return the exit code."""
+    """Print the bearing or video description; return the exit code."""
+    if args.video is not None:
+        meta = describe_video(args.video, args.fps)
+        print(json.dumps(meta, indent=2) if args.json else _format_video(meta))
+        return 0
     bearing = bearing_from_config(config)
     description = describe_bearing(bearing, float(args.speed_rpm), float(args.contact_angle_deg))
     if args.json:

@@ -101,3 +101,32 @@ def test_console_script():
     assert out.returncode == 0 and out.stdout.strip() == f"cageless {__version__}"
     bad = subprocess.run([*cmd, "frobnicate"], capture_output=True, text=True, check=False)
     assert bad.returncode == 2 and "unknown command 'frobnicate'" in bad.stderr
+
+
+def test_info_video_json(tmp_path, capsys):
+    import numpy as np
+
+    from tracking.io import write_cine
+
+    path = write_cine(tmp_path / "n3000.cine", np.zeros((4, 8, 8), np.uint16), fps=10000, fmt="p12",
+                      timestamps_s=[0, 1e-4, 2e-4, 4e-4])
+    assert main(["info", str(path), "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert (d["n_frames"], d["width"], d["height"], d["bit_depth"]) == (4, 8, 8, 12)
+    assert d["header_fps"] == 10000 and d["time_source"] == "timestamps"
+    # 3 intervals over 4e-4 s (one frame dropped): 7500 fps.
+    assert d["timestamp_fps"] == pytest.approx(7500, rel=1e-6)
+    assert d["last_time_s"] == pytest.approx(4e-4, abs=1e-9)
+
+
+def test_info_real_cine_text(shared_dir, capsys):
+    assert main(["info", str(shared_dir / "reference" / "cine" / "cine_781.cine")]) == 0
+    out = capsys.readouterr().out
+    assert "header rate       90000 fps" in out and "time from         timestamps" in out
+
+
+def test_info_bad_video_is_exit_1(tmp_path, capsys):
+    bad = tmp_path / "bad.cine"
+    bad.write_bytes(b"NOPE" * 20)
+    assert main(["info", str(bad)]) == 1
+    assert "bad.cine: wrong magic bytes" in capsys.readouterr().err

@@ -1,0 +1,99 @@
+"""Writer -> reader round trips are bit-exact for every format we write (cine 8/16/P10/P12, FFV1, images)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tracking.io import open_video, write_cine, write_ffv1, write_image_sequence
+from tracking.io.packing import pack10, pack12, unpack10, unpack12
+
+
+def frames(n: int, h: int, w: int, bits: int, seed: int = 0) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    dtype = np.uint8 if bits <= 8 else np.uint16
+    a = rng.integers(0, 1 << bits, size=(n, h, w), dtype=np.int64).astype(dtype)
+    a[:, 0, 0] = (1 << bits) - 1  # the extremes survive
+    a[:, -1, -1] = 0
+    return a
+
+
+@pytest.mark.parametrize(
+    ("fmt", "bits", "real_bpp"), [("8", 8, 8), ("16", 16, 16), ("16", 12, 12), ("p10", 10, 10), ("p12", 12, 12)]
+)
+def test_cine_round_trip(tmp_path, fmt, bits, real_bpp):
+    data = frames(7, 12, 20, bits)
+    # Frames 3 and 4 were dropped: the time stamps show the gap.
+    times = np.array([0, 1, 2, 5, 6, 7, 8]) * 1e-4
+    path = write_cine(tmp_path / f"x_{fmt}.cine", data, fps=10000, fmt=fmt, real_bpp=real_bpp,
+                      timestamps_s=times, exposure_s=10e-6, serial=1234)
+    with open_video(path) as video:
+        assert video.shape == data.shape
+        assert video.metadata.bit_depth == real_bpp
+        np.testing.assert_array_equal(video[0:7], data)
+        np.testing.assert_array_equal(video[5], data[5])
+        # TIME64 keeps 2**-32 s: the times come back to well under a nanosecond.
+        np.testing.assert_allclose(video.times, times, atol=1e-9, rtol=0)
+        assert video.metadata.header_fps == 10000
+        assert video.metadata.exposure_s == pytest.approx(10e-6)
+        assert "serial 1234" in video.metadata.camera
+
+
+def test_cine_streams_from_an_iterator(tmp_path):
+    data = frames(5, 8, 8, 12)
+    path = write_cine(tmp_path / "it.cine", iter(data), n_frames=5, fps=500, fmt="p12")
+    with open_video(path) as video:
+        np.testing.assert_array_equal(video[:], data)
+        np.testing.assert_allclose(video.times, np.arange(5) / 500, atol=1e-9)
+
+
+def test_cine_writer_refuses_bad_frames(tmp_path):
+    from cageless.errors import ParameterError
+
+    with pytest.raises(ParameterError, match=r"below 2\*\*12"):
+        write_cine(tmp_path / "a.cine", np.full((2, 4, 4), 4096, np.uint16), fps=10, fmt="16", real_bpp=12)
+    with pytest.raises(ParameterError, match="all frames must be"):
+        write_cine(tmp_path / "b.cine", [np.zeros((4, 4), np.uint16), np.zeros((4, 5), np.uint16)], fps=10)
+    with pytest.raises(ParameterError, match="must be one of"):
+        write_cine(tmp_path / "c.cine", np.zeros((1, 4, 4), np.uint16), fps=10, fmt="14")
+    assert not any(tmp_path.iterdir())  # nothing half-written
+
+
+@pytest.mark.parametrize("bits", [10, 12])
+def test_packing_is_the_inverse_of_unpacking(bits):
+    pixels = frames(1, 4, 24, bits, seed=3).reshape(-1)
+    pack, unpack = (pack10, unpack10) if bits == 10 else (pack12, unpack12)
+    packed = pack(pixels)
+    assert packed.size == pixels.size * bits // 8
+    np.testing.assert_array_equal(unpack(packed, pixels.size), pixels)
+    # Bit order, by hand: the 12-bit pair (0xABC, 0x123) packs to bytes AB C1 23.
+    if bits == 12:
+        assert pack12([0xABC, 0x123]).tolist() == [0xAB, 0xC1, 0x23]
+    else:  # 10-bit quad (0x3FF, 0, 0x155, 1) -> 11111111 11000000 00000101 01010100 00000001
+        assert pack10([0x3FF, 0, 0x155, 1]).tolist() == [0xFF, 0xC0, 0x05, 0x54, 0x01]
+
+
+@pytest.mark.parametrize("suffix", [".avi", ".mkv"])
+def test_ffv1_round_trip(tmp_path, suffix):
+    data = frames(6, 24, 32, 8)
+    path = write_ffv1(tmp_path / f"v{suffix}", data, fps=25)
+    with open_video(path, fps=10000) as video:
+        assert video.shape == data.shape
+        np.testing.assert_array_equal(video[:], data)
+        np.testing.assert_array_equal(video[4], data[4])  # random access, forward
+        np.testing.assert_array_equal(video[1], data[1])  # and back
+        assert video.metadata.time_source == "fps override"
+        np.testing.assert_allclose(video.times, np.arange(6) / 10000)
+
+
+@pytest.mark.parametrize(("suffix", "bits"), [(".tif", 16), (".png", 16), (".png", 8), (".tif", 8)])
+def test_image_sequence_round_trip(tmp_path, suffix, bits):
+    data = frames(4, 10, 14, bits)
+    times = np.array([0.0, 1e-4, 3e-4, 4e-4])
+    folder = write_image_sequence(tmp_path / "seq", data, times_s=times, suffix=suffix)
+    with open_video(folder) as video:
+        np.testing.assert_array_equal(video[:], data)
+        assert video.metadata.bit_depth == bits
+        np.testing.assert_array_equal(video.times, times)
+    with open_video(folder, fps=50) as video:
+        np.testing.assert_allclose(video.times, np.arange(4) / 50)

@@ -1,0 +1,145 @@
+"""Video files through OpenCV (``.avi``, ``.mp4``, ``.mkv``), and an 8-bit FFV1 writer.
+
+Frames come back as 8-bit luminance (the first channel of OpenCV's gray-as-BGR
+decode). Random access seeks by ``CAP_PROP_POS_FRAMES`` in AVI, where it is
+exact; in MKV/MP4 it moves forward by grabbing frames and re-opens the file to
+go back, which is always exact but slow, so read those sequentially
+(:meth:`~tracking.io.base.FrameSource.iter_chunks`).
+
+Containers store their frame rate as a rational that may be rounded (AVI turns
+10,000 fps into 600), so give the true rate with ``fps`` (the conditions'
+``fps`` key or ``--fps``) where it matters. 16-bit video is not supported
+through OpenCV; use ``.cine`` or 16-bit TIFF/PNG sequences.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from pathlib import Path
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from cageless.atomic import atomic_path
+from cageless.errors import ParameterError, VideoError
+from tracking.io.base import FrameSource, VideoMetadata
+
+__all__ = ["OpenCVReader", "write_ffv1"]
+
+_EXACT_SEEK = {".avi"}
+
+
+class OpenCVReader(FrameSource):
+    """Lazy reader of a video file through OpenCV's FFmpeg backend.
+
+    Parameters
+    ----------
+    path
+        The video file.
+    fps
+        Frame-rate override (frames/s).
+
+    Raises
+    ------
+    VideoError
+        If OpenCV cannot open or decode the file, or it holds no frame.
+    """
+
+    def __init__(self, path: str | Path, fps: float | None = None) -> None:
+        super().__init__(path)
+        if not self.path.is_file():
+            raise VideoError(self.path, "no such file.")
+        self._cap = self._open()
+        first = self._decode(0)
+        n = self._count_frames()
+        container_fps = float(self._cap.get(cv2.CAP_PROP_FPS)) or None
+        fourcc = int(self._cap.get(cv2.CAP_PROP_FOURCC))
+        codec = "".join(chr((fourcc >> (8 * k)) & 0xFF) for k in range(4)).strip("\0 ")
+        self.metadata = VideoMetadata(
+            path=str(self.path), format="opencv", n_frames=n, width=first.shape[1], height=first.shape[0],
+            dtype="uint8", bit_depth=8, storage=f"{codec or 'unknown codec'} video, 8-bit luminance",
+            header_fps=container_fps, extra={"codec": codec},
+        )
+        self._apply_timing(fps, None)
+        if self.metadata.time_source == "header frame rate":
+            self.metadata.time_source = "container frame rate"
+        self._cap = self._open()
+
+    def _open(self) -> cv2.VideoCapture:
+        cap = cv2.VideoCapture(str(self.path), cv2.CAP_FFMPEG)
+        if not cap.isOpened():
+            raise VideoError(self.path, "OpenCV cannot open this video (unknown container or codec, or a damaged file).",
+                             hint="Check the file plays, or convert it to FFV1 AVI or a .cine.")
+        self._next = 0
+        return cap
+
+    def _decode(self, index: int) -> np.ndarray:
+        ok, frame = self._cap.read()
+        if not ok or frame is None:
+            raise VideoError(self.path, f"cannot decode frame {index} (the file may be truncated or corrupt).")
+        self._next = index + 1
+        return frame[..., 0].copy() if frame.ndim == 3 else frame
+
+    def _count_frames(self) -> int:
+        n = self._cap.get(cv2.CAP_PROP_FRAME_COUNT)
+        if self.path.suffix.lower() in _EXACT_SEEK and 0 < n < 1e9:
+            return int(n)
+        count = 1  # one frame was decoded already; count the rest without decoding
+        while self._cap.grab():
+            count += 1
+        return count
+
+    def _read(self, index: int) -> np.ndarray:
+        if index != self._next:
+            if self.path.suffix.lower() in _EXACT_SEEK:
+                self._cap.set(cv2.CAP_PROP_POS_FRAMES, index)
+                self._next = index
+            else:
+                if index < self._next:
+                    self._cap.release()
+                    self._cap = self._open()
+                while self._next < index:
+                    if not self._cap.grab():
+                        raise VideoError(self.path, f"cannot reach frame {index}: the file ends early.")
+                    self._next += 1
+        return self._decode(index)
+
+    def close(self) -> None:
+        """Release the OpenCV capture."""
+        cap = getattr(self, "_cap", None)
+        if cap is not None:
+            cap.release()
+
+
+def write_ffv1(path: str | Path, frames: Iterable[npt.ArrayLike], fps: float) -> Path:
+    """Write 8-bit gray frames as lossless FFV1 in an AVI or MKV container, atomically.
+
+    The container may round ``fps``; record the true rate in the conditions.
+    """
+    path = Path(path)
+    if path.suffix.lower() not in (".avi", ".mkv"):
+        raise ParameterError("path", "FFV1 goes in an .avi or .mkv file", str(path))
+    writer = None
+    with atomic_path(path) as tmp:
+        tmp_named = tmp.with_suffix(path.suffix)
+        try:
+            for i, frame in enumerate(frames):
+                a = np.asarray(frame)
+                if a.ndim != 2 or a.dtype != np.uint8:
+                    raise ParameterError(f"frames[{i}]", "must be a 2-D uint8 array for 8-bit FFV1")
+                if writer is None:
+                    writer = cv2.VideoWriter(str(tmp_named), cv2.CAP_FFMPEG, cv2.VideoWriter_fourcc(*"FFV1"),
+                                             float(fps), (a.shape[1], a.shape[0]), False)
+                    if not writer.isOpened():
+                        raise VideoError(path, "OpenCV cannot write FFV1 here.")
+                writer.write(a)
+            if writer is None:
+                raise ParameterError("frames", "must hold at least one frame")
+            writer.release()
+            tmp_named.replace(tmp)
+        finally:
+            if writer is not None:
+                writer.release()
+            tmp_named.unlink(missing_ok=True)
+    return path
