@@ -14,6 +14,10 @@ from pathlib import Path
 
 __all__ = ["atomic_path", "atomic_write_text", "atomic_write_bytes"]
 
+# mkstemp creates files readable by the owner only; outputs should honour the umask like open() does.
+_UMASK = os.umask(0)
+os.umask(_UMASK)
+
 
 @contextmanager
 def atomic_path(path: str | Path) -> Iterator[Path]:
@@ -37,6 +41,7 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
     os.close(fd)
     tmp = Path(name)
+    os.chmod(tmp, 0o666 & ~_UMASK)
     try:
         yield tmp
         with open(tmp, "rb+") as fh:

@@ -21,7 +21,7 @@ from cageless.errors import CagelessError, ParameterError, UsageError
 
 __all__ = ["main", "entry_point", "build_parser", "SUBCOMMANDS"]
 
-SUBCOMMANDS: tuple[str, ...] = ("info",)
+SUBCOMMANDS: tuple[str, ...] = ("info", "sample")
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 
@@ -31,6 +31,8 @@ _EPILOG = """\
 examples:
   cageless info                       the default bearing and its kinematics at 3000 rpm
   cageless info --speed-rpm 6000 --json
+  cageless info clip.cine             what the reader sees in a video
+  cageless sample my_lab              render synthetic videos with ground truth
   cageless COMMAND --help             help and examples for one command
 
 exit codes: 0 success, 1 some inputs failed (the rest done), 2 usage error

@@ -25,11 +25,13 @@ class ArgumentParser(argparse.ArgumentParser):
     """
 
     def error(self, message: str) -> NoReturn:  # noqa: D401 - argparse API
-        m = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)", message)
+        m = re.search(r"argument (\S+): invalid choice: '([^']*)' \(choose from (.*)\)", message)
         if m:
-            choices = re.findall(r"'([^']*)'", m.group(2)) or [c.strip() for c in m.group(2).split(",")]
-            hint = suggest(m.group(1), choices) or f" Choose from: {', '.join(choices)}."
-            message = f"unknown command '{m.group(1)}'.{hint}"
+            arg, given = m.group(1), m.group(2)
+            choices = re.findall(r"'([^']*)'", m.group(3)) or [c.strip() for c in m.group(3).split(",")]
+            hint = suggest(given, choices) or f" Choose from: {', '.join(choices)}."
+            what = "unknown command" if arg == "COMMAND" else f"{arg}: invalid choice"
+            message = f"{what} '{given}'.{hint}"
         raise UsageError(f"{self.prog}: {message}\nRun '{self.prog} --help' for usage.")
 
 

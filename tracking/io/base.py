@@ -148,7 +148,10 @@ class FrameSource(abc.ABC):
 
     def __getitem__(self, key: int | slice) -> np.ndarray:
         if isinstance(key, slice):
-            idx = range(*key.indices(len(self)))
+            start, stop, step = key.indices(len(self))
+            if step == 1:
+                return self._read_range(start, max(start, stop))
+            idx = range(start, stop, step)
             out = np.empty((len(idx), *self.frame_shape), dtype=self.dtype)
             for k, i in enumerate(idx):
                 out[k] = self._read(i)
@@ -188,6 +191,16 @@ class FrameSource(abc.ABC):
     @abc.abstractmethod
     def _read(self, index: int) -> np.ndarray:
         """Return frame ``index`` (0 <= index < len) as a new 2-D array."""
+
+    def _read_range(self, start: int, stop: int) -> np.ndarray:
+        """Return frames ``start:stop`` as an array of shape (k, H, W); readers may override for speed.
+
+        The result may be a view with unusual strides (e.g. rows reversed); it is never shared.
+        """
+        out = np.empty((stop - start, *self.frame_shape), dtype=self.dtype)
+        for k, i in enumerate(range(start, stop)):
+            out[k] = self._read(i)
+        return out
 
     # -- shared helpers -------------------------------------------------------------------------
     def _apply_timing(self, fps_override: float | None, stamps: npt.NDArray[np.float64] | None) -> None:

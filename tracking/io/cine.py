@@ -14,7 +14,10 @@ P10 data from real cameras are log-encoded; this reader returns the raw 10-bit
 codes (``metadata.storage`` says so) and does not apply Vision Research's
 linearisation table.
 
-The file is memory-mapped; frames are decoded on access.
+The file is memory-mapped for random access. Runs of frames (``video[a:b]``,
+``iter_chunks``) are read with one ``readinto`` per run, like ``numpy.fromfile``:
+8/16-bit runs come back as a row-reversed strided view of that buffer (no
+second copy), packed runs are unpacked by a compiled loop.
 """
 
 from __future__ import annotations
@@ -42,7 +45,7 @@ from tracking.io.cine_layout import (
     TAG_TIME_ONLY,
     TIME64_FRACTION,
 )
-from tracking.io.packing import PACKED_BITS, unpack10, unpack12
+from tracking.io.packing import PACKED_BITS, unpack10, unpack12, unpack_frames_into
 
 __all__ = ["CineReader"]
 
@@ -240,6 +243,35 @@ class CineReader(FrameSource):
             return _UNPACK[self._packed_bits](raw, self.width * self.height).reshape(self.height, self.width)
         frame = raw.view(self._dtype).reshape(self.height, self.width)
         return np.array(frame[::-1] if self._bottom_up else frame)
+
+    def _read_range(self, start: int, stop: int) -> np.ndarray:
+        n = stop - start
+        if n <= 1:
+            return super()._read_range(start, stop)
+        starts = self._data_start[start:stop]
+        pitch = np.diff(starts)
+        item = self._dtype.itemsize
+        if not np.all(pitch == pitch[0]) or pitch[0] < self._image_size or pitch[0] % item:
+            return super()._read_range(start, stop)  # frames not evenly laid out: frame by frame
+        first, step = int(starts[0]), int(pitch[0])
+        buf = np.empty(step * (n - 1) + self._image_size, dtype=np.uint8)
+        with open(self.path, "rb", buffering=0) as fh:
+            fh.seek(first)
+            got = fh.readinto(memoryview(buf))
+        if got != buf.size:
+            raise VideoError(self.path, f"frames {start}..{stop - 1} end early (file changed while open?).",
+                             offset=first + got)
+        h, w = self.height, self.width
+        if self._packed_bits:
+            out = np.empty((n, h, w), dtype=np.uint16)
+            unpack_frames_into(buf, np.arange(n, dtype=np.int64) * step, out, self._packed_bits)
+            return out
+        if self._bottom_up:  # start at the last row of the first frame, walk rows backwards
+            return np.lib.stride_tricks.as_strided(
+                buf[(h - 1) * w * item:].view(self._dtype), shape=(n, h, w), strides=(step, -w * item, item),
+                writeable=True)
+        return np.lib.stride_tricks.as_strided(buf.view(self._dtype), shape=(n, h, w),
+                                               strides=(step, w * item, item), writeable=True)
 
     def close(self) -> None:
         """Drop the memory map (the OS unmaps it once no frame view refers to it)."""

@@ -6,9 +6,11 @@ exact; in MKV/MP4 it moves forward by grabbing frames and re-opens the file to
 go back, which is always exact but slow, so read those sequentially
 (:meth:`~tracking.io.base.FrameSource.iter_chunks`).
 
-Containers store their frame rate as a rational that may be rounded (AVI turns
-10,000 fps into 600), so give the true rate with ``fps`` (the conditions'
-``fps`` key or ``--fps``) where it matters. 16-bit video is not supported
+Containers store their frame rate as a rational that may be rounded, so give
+the true rate with ``fps`` (the conditions' ``fps`` key or ``--fps``) where it
+matters. MKV keeps 10,000 fps exactly; OpenCV's AVI muxer drops frames above
+1,000 fps, so :func:`write_ffv1` writes AVI at a container rate of at most
+1,000 fps and says so in the log. 16-bit video is not supported
 through OpenCV; use ``.cine`` or 16-bit TIFF/PNG sequences.
 """
 
@@ -16,6 +18,8 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from pathlib import Path
+
+import logging
 
 import cv2
 import numpy as np
@@ -27,7 +31,10 @@ from tracking.io.base import FrameSource, VideoMetadata
 
 __all__ = ["OpenCVReader", "write_ffv1"]
 
+log = logging.getLogger(__name__)
+
 _EXACT_SEEK = {".avi"}
+_AVI_MAX_FPS = 1000.0
 
 
 class OpenCVReader(FrameSource):
@@ -120,7 +127,12 @@ def write_ffv1(path: str | Path, frames: Iterable[npt.ArrayLike], fps: float) ->
     path = Path(path)
     if path.suffix.lower() not in (".avi", ".mkv"):
         raise ParameterError("path", "FFV1 goes in an .avi or .mkv file", str(path))
+    if path.suffix.lower() == ".avi" and fps > _AVI_MAX_FPS:
+        log.warning("%s: AVI cannot hold %g fps; the container says %g fps; give the true rate in the conditions",
+                    path, fps, _AVI_MAX_FPS)
+        fps = _AVI_MAX_FPS
     writer = None
+    count = 0
     with atomic_path(path) as tmp:
         tmp_named = tmp.with_suffix(path.suffix)
         try:
@@ -134,12 +146,26 @@ def write_ffv1(path: str | Path, frames: Iterable[npt.ArrayLike], fps: float) ->
                     if not writer.isOpened():
                         raise VideoError(path, "OpenCV cannot write FFV1 here.")
                 writer.write(a)
+                count += 1
             if writer is None:
                 raise ParameterError("frames", "must hold at least one frame")
             writer.release()
+            _verify_count(tmp_named, count, path)
             tmp_named.replace(tmp)
         finally:
             if writer is not None:
                 writer.release()
             tmp_named.unlink(missing_ok=True)
     return path
+
+
+def _verify_count(written: Path, expected: int, final: Path) -> None:
+    """Re-open a freshly written video and check that every frame made it into the container."""
+    cap = cv2.VideoCapture(str(written), cv2.CAP_FFMPEG)
+    found = 0
+    while cap.grab():
+        found += 1
+    cap.release()
+    if found != expected:
+        raise VideoError(final, f"the video writer stored {found} of {expected} frames.",
+                         hint="Use an .mkv container, or a lower container frame rate.")

@@ -11,10 +11,11 @@ Vision Research's packed formats as read by PIMS (``pims/cine.py``) and pycine
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["unpack10", "pack10", "unpack12", "pack12", "PACKED_BITS"]
+__all__ = ["unpack10", "pack10", "unpack12", "pack12", "PACKED_BITS", "unpack_frames_into"]
 
 #: biCompression code -> bits per pixel
 PACKED_BITS = {256: 10, 1024: 12}
@@ -63,3 +64,53 @@ def pack10(pixels: npt.ArrayLike) -> U8:
     out[:, 3] = ((p[:, 2] & 0x3F) << 2) | (p[:, 3] >> 8)
     out[:, 4] = p[:, 3] & 0xFF
     return out.reshape(-1)
+
+
+@numba.njit(cache=True, nogil=True, parallel=True)
+def _unpack12_into(buf, starts, out):  # pragma: no cover - compiled
+    h, w = out.shape[1], out.shape[2]
+    row_bytes = w * 3 // 2
+    for fr in numba.prange(out.shape[0] * h):  # every row of every frame, over both cores
+        f, r = fr // h, fr % h
+        b = starts[f] + r * row_bytes
+        row = out[f, r]
+        for q in range(w // 2):
+            b0, b1, b2 = np.int32(buf[b]), np.int32(buf[b + 1]), np.int32(buf[b + 2])
+            row[2 * q] = np.uint16((b0 << 4) | (b1 >> 4))
+            row[2 * q + 1] = np.uint16(((b1 & 15) << 8) | b2)
+            b += 3
+
+
+@numba.njit(cache=True, nogil=True, parallel=True)
+def _unpack10_into(buf, starts, out):  # pragma: no cover - compiled
+    h, w = out.shape[1], out.shape[2]
+    row_bytes = w * 5 // 4
+    for fr in numba.prange(out.shape[0] * h):
+        f, r = fr // h, fr % h
+        b = starts[f] + r * row_bytes
+        row = out[f, r]
+        for q in range(w // 4):
+            b0, b1, b2 = np.int32(buf[b]), np.int32(buf[b + 1]), np.int32(buf[b + 2])
+            b3, b4 = np.int32(buf[b + 3]), np.int32(buf[b + 4])
+            row[4 * q] = np.uint16((b0 << 2) | (b1 >> 6))
+            row[4 * q + 1] = np.uint16(((b1 & 63) << 4) | (b2 >> 4))
+            row[4 * q + 2] = np.uint16(((b2 & 15) << 6) | (b3 >> 2))
+            row[4 * q + 3] = np.uint16(((b3 & 3) << 8) | b4)
+            b += 5
+
+
+def unpack_frames_into(buf: U8, starts: npt.NDArray[np.int64], out: U16, bits: int) -> None:
+    """Unpack packed frames from ``buf`` (frame k's bytes start at ``starts[k]``) into ``out`` (k, H, W).
+
+    A compiled loop over rows on every core: one pass over the packed bytes, written straight into
+    ``out``. Rows must hold whole pixel groups (width a multiple of 2 for 12-bit, 4 for 10-bit);
+    otherwise the frames are unpacked whole with :func:`unpack12` / :func:`unpack10`.
+    """
+    group = 2 if bits == 12 else 4
+    if out.shape[2] % group:
+        unpack = unpack12 if bits == 12 else unpack10
+        n = out.shape[1] * out.shape[2]
+        for k, s in enumerate(starts):
+            out[k] = unpack(buf[s:s + n * bits // 8], n).reshape(out.shape[1:])
+        return
+    (_unpack12_into if bits == 12 else _unpack10_into)(buf, starts, out)
