@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from tqdm.auto import tqdm
 
 from cageless._version import __version__
 from cageless.atomic import atomic_write_text
@@ -82,6 +83,7 @@ def render_clip(
     speed_rpm: float | None = None,
     fmt: str = "cine-p12",
     workers: int = 1,
+    progress: bool = False,
 ) -> ClipResult:
     """Render ``n_frames`` camera frames (fewer if frames are dropped) to ``path`` with ground truth.
 
@@ -103,6 +105,8 @@ def render_clip(
         ``"cine-8"``, ``"cine-16"``, ``"cine-p10"``, ``"cine-p12"``, ``"ffv1"``, ``"tif"`` or ``"png"``.
     workers
         Processes rendering in parallel.
+    progress
+        Show a per-frame progress bar.
     """
     path = Path(path)
     if (law is None) == (motion_source is None):
@@ -117,7 +121,8 @@ def render_clip(
     else:
         motion = BallMotion.from_trace(motion_source, t_motion + motion_source.time[0])
     truth = renderer.truth(motion, index, times, sub)
-    frames = _frames(renderer, motion, index, times, sub, workers)
+    frames = tqdm(_frames(renderer, motion, index, times, sub, workers), total=len(times), desc=path.name,
+                  unit="frame", disable=not progress, leave=False)
     video = _write_video(path, frames, len(times), times, renderer, fmt)
     stem = path.name if fmt in ("tif", "png") else path.stem
     truth_csv = path.with_name(f"{stem}.truth.csv")

@@ -121,7 +121,7 @@ def make_lab(
         n = frames_for_revolutions(g, spec.speed_rpm, spec.camera.fps, revs)
         renderer = Renderer(g, spec.camera, spec.appearance, seed=seed + k)
         law = KinematicLaw(g, spec.speed_rpm, seed=seed + k)
-        res = render_clip(out / spec.name, renderer, n, law=law, fmt=spec.fmt, workers=workers)
+        res = render_clip(out / spec.name, renderer, n, law=law, fmt=spec.fmt, workers=workers, progress=progress)
         log.info("%s: %d frames", res["video"], res["n_frames"])
         _write_conditions(out, spec, csv_rows)
         results.append({k2: v for k2, v in res.items() if k2 != "truth"})

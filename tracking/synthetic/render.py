@@ -213,12 +213,13 @@ class Renderer:
     def visibility(self, n_frames: int) -> np.ndarray:
         """Highlight visibility (T, Z): dropouts start at ``dropout_rate`` and last ~3 frames."""
         z = self.geometry.n_balls
-        rng = np.random.default_rng([self.seed, 4])
         vis = np.ones((n_frames, z), dtype=bool)
         if self.look.dropout_rate > 0:
-            starts = rng.random((n_frames, z)) < self.look.dropout_rate
+            # Whole arrays from separate streams: the first k rows never depend on n_frames.
+            starts = np.random.default_rng([self.seed, 4]).random((n_frames, z)) < self.look.dropout_rate
+            lengths = np.random.default_rng([self.seed, 6]).geometric(1 / 3, size=(n_frames, z))
             for i, j in zip(*np.nonzero(starts), strict=True):
-                vis[i:i + 1 + rng.geometric(1 / 3), j] = False
+                vis[i:i + 1 + lengths[i, j], j] = False
         return vis
 
     def peaks(self, n_frames: int) -> np.ndarray:
