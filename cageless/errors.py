@@ -19,6 +19,7 @@ __all__ = [
     "ConditionsError",
     "TraceFormatError",
     "VideoError",
+    "TrackingError",
     "UsageError",
     "suggest",
 ]
@@ -124,6 +125,10 @@ class VideoError(_PathError):
         if offset is not None:
             message = f"{message} (at byte offset {offset})"
         super().__init__(path, message, hint)
+
+
+class TrackingError(_PathError):
+    """A video was read but could not be tracked (no bearing in view, too short, wrong ball count...)."""
 
 
 class UsageError(CagelessError):

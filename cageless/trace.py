@@ -138,6 +138,8 @@ class Trace:
         ``"complete"``, or ``"incomplete: <why>"`` for a partial result.
     provenance
         A provenance record (see :mod:`cageless.provenance`), or ``None``.
+    qc
+        Quality-control summary (video traces: detection rates, fit residual, warnings), or ``None``.
     created_utc, software_version
         Stamped by :func:`write_trace` when ``None``.
     """
@@ -161,6 +163,7 @@ class Trace:
     events: pd.DataFrame | None = None
     status: str = "complete"
     provenance: dict[str, Any] | None = None
+    qc: dict[str, Any] | None = None
     created_utc: str | None = None
     software_version: str | None = None
 
@@ -256,6 +259,8 @@ def _write_root_attrs(f: h5py.File, trace: Trace) -> None:
     a["status"] = trace.status
     if trace.provenance is not None:
         a["provenance_json"] = json.dumps(trace.provenance, sort_keys=True)
+    if trace.qc is not None:
+        a["qc_json"] = json.dumps(trace.qc, sort_keys=True)
     for name in ("speed_rpm", "radial_load_n", "axial_load_n", "ball_diameter_m", "pitch_diameter_m"):
         a[name] = np.float64(getattr(trace, name))
     a["n_balls"] = np.int64(trace.n_balls)
@@ -359,6 +364,7 @@ def _read_body(path: Path, f: h5py.File) -> Trace:
     if data["angle"].ndim == 2 and data["angle"].shape[1] != n_balls:
         raise ValueError(f"attribute n_balls = {n_balls} but angle has {data['angle'].shape[1]} columns.")
     prov = a.get("provenance_json")
+    qc = a.get("qc_json")
     return Trace(
         source=source, **data,
         speed_rpm=float(_attr(a, "speed_rpm")), radial_load_n=float(_attr(a, "radial_load_n")),
@@ -367,6 +373,7 @@ def _read_body(path: Path, f: h5py.File) -> Trace:
         config=json.loads(_attr(a, "config_json")), groups=groups, events=events,
         status=str(a.get("status", "complete")),
         provenance=None if prov is None else json.loads(prov),
+        qc=None if qc is None else json.loads(qc),
         created_utc=str(_attr(a, "created_utc")), software_version=str(_attr(a, "software_version")),
         **kwargs,
     )

@@ -45,7 +45,7 @@ def assert_same(a: Trace, b: Trace) -> None:
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
         assert getattr(a, name).dtype == getattr(b, name).dtype
     for name in ("source", "speed_rpm", "radial_load_n", "axial_load_n", "ball_diameter_m",
-                 "pitch_diameter_m", "direction", "config", "video", "simulation", "status", "provenance"):
+                 "pitch_diameter_m", "direction", "config", "video", "simulation", "status", "provenance", "qc"):
         assert getattr(a, name) == getattr(b, name), name
     assert a.groups.keys() == b.groups.keys()
     for g in a.groups:
@@ -73,7 +73,7 @@ def test_round_trip_is_lossless(tmp_path_factory, shape, data, direction):
     tr = make_trace(
         t, z, time=np.cumsum(steps), angle=data.draw(arr), speed=data.draw(arr), slip=data.draw(arr),
         valid=data.draw(hnp.arrays(np.bool_, (t, z))), direction=direction,
-        speed_rpm=data.draw(st.floats(1.0, 1e5)), provenance={"inputs": ["x"]},
+        speed_rpm=data.draw(st.floats(1.0, 1e5)), provenance={"inputs": ["x"]}, qc={"warnings": ["w"]},
     )
     path = tmp_path_factory.mktemp("rt") / "x.trace.h5"
     write_trace(path, tr)

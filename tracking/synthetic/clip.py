@@ -120,6 +120,7 @@ def render_clip(
         motion = law.sample(t_motion)
     else:
         motion = BallMotion.from_trace(motion_source, t_motion + motion_source.time[0])
+    motion = _number_balls(motion)
     truth = renderer.truth(motion, index, times, sub)
     frames = tqdm(_frames(renderer, motion, index, times, sub, workers), total=len(times), desc=path.name,
                   unit="frame", disable=not progress, leave=False)
@@ -142,6 +143,21 @@ def render_clip(
     truth_json = path.with_name(f"{stem}.truth.json")
     atomic_write_text(truth_json, json.dumps(meta, indent=1, default=float))
     return ClipResult(video=video, truth_csv=truth_csv, truth_json=truth_json, n_frames=len(times), truth=truth)
+
+
+def _number_balls(motion: BallMotion) -> BallMotion:
+    """Renumber balls as DESIGN §3 does: counter-clockwise from the ball just after the largest gap at the
+    start, ball 0's angle in [0, 2 pi) and each next ball ahead of the previous one."""
+    a0 = np.mod(motion.angle[0], 2 * np.pi)
+    ccw = np.argsort(a0)
+    gaps = np.diff(np.concatenate([a0[ccw], [a0[ccw][0] + 2 * np.pi]]))
+    order = np.roll(ccw, -((int(np.argmax(gaps)) + 1) % len(ccw)))
+    angle = motion.angle[:, order].copy()
+    angle -= 2 * np.pi * np.floor(angle[0, 0] / (2 * np.pi))
+    for j in range(1, angle.shape[1]):
+        angle[:, j] -= 2 * np.pi * np.floor((angle[0, j] - angle[0, j - 1]) / (2 * np.pi))
+    return BallMotion(times=motion.times, angle=angle, radius=motion.radius[:, order], ring_angle=motion.ring_angle,
+                      ring_offset=motion.ring_offset, direction=motion.direction)
 
 
 def _describe_law(law: KinematicLaw) -> dict[str, Any]:

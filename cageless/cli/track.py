@@ -1,0 +1,148 @@
+"""``cageless track``: videos to ``<video>.trace.h5`` files with QC."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from tqdm.auto import tqdm
+
+from cageless.bearing import Bearing
+from cageless.cli.common import finite_float
+from cageless.conditions import IMAGE_SUFFIXES, LabEntry, OperatingConditions, discover_lab, resolve_conditions
+from cageless.config import bearing_from_config
+from cageless.errors import CagelessError, UsageError
+
+__all__ = ["register", "run", "collect_inputs"]
+
+log = logging.getLogger(__name__)
+
+_EXAMPLES = """\
+examples:
+  cageless track sample_data/lab -o out            every video of a lab folder (conditions per DESIGN §5)
+  cageless track clip.cine --speed-rpm 3000 -o out one video whose conditions are nowhere else
+  cageless track lab -o out --window 31 --detector weighted --workers 2
+"""
+
+
+def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
+    """Add the ``track`` subcommand."""
+    from tracking.detect import DETECTORS
+    from tracking.kinematics import DEFAULT_WINDOW
+
+    p = subparsers.add_parser(
+        "track", parents=[parent], help="track the balls in videos and write trace files",
+        description="Track every ball in bearing videos and write <video>.trace.h5 (DESIGN §4) plus QC "
+        "(qc/<video>.qc.json and overlay PNGs). A folder is read as a lab folder; one failing video is "
+        "reported and the others still run (exit code 1).",
+        epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("inputs", nargs="+", metavar="VIDEO_OR_FOLDER", help="videos, image folders or lab folders")
+    p.add_argument("-o", "--out", default="traces", help="output folder (default ./traces)")
+    p.add_argument("--speed-rpm", type=finite_float, help="inner-ring speed for videos without conditions")
+    p.add_argument("--fps", type=finite_float, help="frame-rate override (frames/s)")
+    p.add_argument("--window", type=int, default=DEFAULT_WINDOW,
+                   help=f"Savitzky-Golay speed window in frames, odd (default {DEFAULT_WINDOW})")
+    p.add_argument("--detector", choices=DETECTORS, default="window",
+                   help="centroid method: window refinement (default), weighted, or binary mask")
+    p.add_argument("--strict", action="store_true", help="a wrong ball count is an error, not a warning")
+    p.add_argument("--workers", type=int, default=2, help="videos tracked in parallel (default 2)")
+
+
+def collect_inputs(inputs: list[str], speed_rpm: float | None) -> list[LabEntry]:
+    """Expand the command-line inputs into videos with their conditions (or their errors)."""
+    entries: list[LabEntry] = []
+    for raw in inputs:
+        p = Path(raw)
+        if not p.exists():
+            entries.append(LabEntry(video=p, error=CagelessError(f"{p}: no such file or folder.")))
+        elif p.is_dir() and not any(f.suffix.lower() in IMAGE_SUFFIXES for f in p.iterdir()):
+            found = discover_lab(p)
+            if not found:
+                entries.append(LabEntry(video=p, error=CagelessError(f"{p}: no videos found in this folder.")))
+            entries.extend(_with_speed(e, speed_rpm) for e in found)
+        else:
+            try:
+                entries.append(LabEntry(video=p, resolved=resolve_conditions(p)))
+            except CagelessError as exc:
+                entries.append(_with_speed(LabEntry(video=p, error=exc), speed_rpm))
+    return entries
+
+
+def _with_speed(entry: LabEntry, speed_rpm: float | None) -> LabEntry:
+    """Let --speed-rpm stand in where no source gave the conditions."""
+    if speed_rpm is None or entry.ok:
+        return entry
+    from cageless.conditions import ResolvedConditions
+
+    resolved = ResolvedConditions(video=entry.video, conditions=OperatingConditions(speed_rpm),
+                                  origin={"speed_rpm": "--speed-rpm"})
+    return LabEntry(video=entry.video, resolved=resolved)
+
+
+def _track_one(job: tuple[Path, OperatingConditions, Bearing, Any, Path]) -> tuple[str, dict[str, Any] | str]:
+    from tracking.pipeline import track_video
+
+    video, conditions, bearing, options, out = job
+    try:
+        res = track_video(video, conditions, bearing, options, out_dir=out, progress=False)
+    except CagelessError as exc:
+        return "failed", str(exc)
+    tr = res.trace
+    unloaded = np.sin(tr.angle) > 0
+    return "ok", {"path": str(res.path), "frames": tr.n_samples, "balls": tr.n_balls,
+                  "detected": float(np.mean(res.qc.detection_rate)), "warnings": res.qc.warnings,
+                  "peak_slip": float(np.nanmax(np.nanmean(np.where(unloaded, tr.slip, np.nan), axis=1)))}
+
+
+def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
+    """Track every input; print one summary line per video; return 1 if any failed."""
+    from tracking.detect import DetectorParams
+    from tracking.pipeline import TrackOptions
+
+    if args.window < 3 or args.window % 2 == 0:
+        raise UsageError(f"--window {args.window}: must be an odd number of frames >= 3.")
+    bearing = bearing_from_config(config)
+    options = TrackOptions(detector=replace(DetectorParams(), method=args.detector), window=args.window,
+                           strict=args.strict, fps=args.fps)
+    entries = collect_inputs(args.inputs, args.speed_rpm)
+    out = Path(args.out)
+    failed = 0
+    for e in entries:
+        if not e.ok:
+            print(f"FAILED {e.video}: {e.error}")
+            failed += 1
+    jobs = [(e.video, e.resolved.conditions, bearing, options, out) for e in entries if e.ok]
+    workers = max(1, min(args.workers, len(jobs)))
+    with tqdm(total=len(jobs), desc="videos", unit="video", disable=args.quiet) as bar:
+        results = _map(jobs, workers, bar)
+        for (video, *_), (status, info) in zip(jobs, results, strict=True):
+            if status == "ok":
+                warn = f"; QC: {'; '.join(info['warnings'])}" if info["warnings"] else ""
+                print(f"ok     {video.name}: {info['frames']} frames, {info['balls']} balls, "
+                      f"{100 * info['detected']:.1f}% detected, peak unloaded slip {100 * info['peak_slip']:.2f}% "
+                      f"-> {info['path']}{warn}")
+            else:
+                print(f"FAILED {video.name}: {info}")
+                failed += 1
+    return 1 if failed else 0
+
+
+def _map(jobs: list[Any], workers: int, bar: Any) -> list[tuple[str, Any]]:
+    if workers == 1:
+        out = []
+        for job in jobs:
+            out.append(_track_one(job))
+            bar.update(1)
+        return out
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        out = []
+        for res in pool.map(_track_one, jobs):
+            out.append(res)
+            bar.update(1)
+        return out

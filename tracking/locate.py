@@ -1,0 +1,171 @@
+"""Stage 1: find the bearing in the image and the annulus the balls travel in (DESIGN §8.2).
+
+On a background frame (the per-pixel median of a sample of frames, which
+removes the moving highlights), a global Otsu binarisation and a
+connected-component area threshold keep the bright ring faces and reject small
+metallic reflections; a circle fit to the outer contour gives a first centre.
+The radial brightness profile about that centre then shows the dark band
+between the ring lands where the balls are seen: that band, eroded by a small
+margin, is the ball annulus mask.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+from scipy import optimize
+
+from cageless.errors import TrackingError
+from tracking.io.base import FrameSource
+
+__all__ = ["BearingLocation", "background_frame", "locate_bearing", "fit_circle"]
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class BearingLocation:
+    """Where the bearing is in the image (pixels).
+
+    Attributes
+    ----------
+    centre
+        Centre (u, v) of the bearing contour.
+    outer_radius
+        Radius of the bearing's outer contour.
+    band_inner, band_outer
+        Radii of the dark band between the ring lands, where the balls are seen.
+    contour_residual
+        RMS distance of the contour points from the fitted circle.
+    """
+
+    centre: tuple[float, float]
+    outer_radius: float
+    band_inner: float
+    band_outer: float
+    contour_residual: float
+
+    def annulus_mask(self, shape: tuple[int, int], margin: float = 0.0) -> npt.NDArray[np.bool_]:
+        """Boolean mask of the band, shrunk by ``margin`` px on both sides."""
+        v, u = np.ogrid[0:shape[0], 0:shape[1]]
+        r = np.hypot(u - self.centre[0], v - self.centre[1])
+        return (r >= self.band_inner + margin) & (r <= self.band_outer - margin)
+
+    def crop(self, shape: tuple[int, int], pad: int = 2) -> tuple[slice, slice]:
+        """Rows and columns of the band's bounding box, clipped to the image."""
+        cu, cv = self.centre
+        r = self.band_outer + pad
+        return (slice(max(int(cv - r), 0), min(int(cv + r) + 1, shape[0])),
+                slice(max(int(cu - r), 0), min(int(cu + r) + 1, shape[1])))
+
+
+def background_frame(video: FrameSource, n_sample: int = 48) -> npt.NDArray[np.float32]:
+    """Per-pixel median of up to ``n_sample`` frames spread over the video."""
+    n = len(video)
+    idx = np.unique(np.linspace(0, n - 1, min(n, n_sample)).round().astype(int))
+    stack = np.stack([video[int(i)] for i in idx]).astype(np.float32)
+    return np.median(stack, axis=0)
+
+
+def fit_circle(u: npt.ArrayLike, v: npt.ArrayLike) -> tuple[float, float, float, float]:
+    """Least-squares circle through points: algebraic (Kasa) start, then geometric refinement.
+
+    Returns
+    -------
+    cx, cy, radius, rms
+        Centre, radius and the RMS of the geometric residuals (same units as the points).
+    """
+    u, v = np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64)
+    if u.size < 3:
+        raise ValueError("a circle needs at least 3 points")
+    a = np.column_stack([u, v, np.ones_like(u)])
+    sol, *_ = np.linalg.lstsq(a, u**2 + v**2, rcond=None)
+    cx, cy = sol[0] / 2, sol[1] / 2
+    r0 = np.sqrt(max(sol[2] + cx**2 + cy**2, 1e-12))
+
+    def resid(p: np.ndarray) -> np.ndarray:
+        return np.hypot(u - p[0], v - p[1]) - p[2]
+
+    res = optimize.least_squares(resid, [cx, cy, r0], method="lm")
+    cx, cy, r = res.x
+    return float(cx), float(cy), float(abs(r)), float(np.sqrt(np.mean(res.fun**2)))
+
+
+def _to_u8(img: np.ndarray) -> np.ndarray:
+    lo, hi = np.percentile(img, [0.5, 99.5])
+    if hi - lo < 1e-9:
+        return np.zeros(img.shape, np.uint8)
+    return np.clip((img - lo) * (255.0 / (hi - lo)), 0, 255).astype(np.uint8)
+
+
+def locate_bearing(background: np.ndarray, path: str | Path = "video", min_area_frac: float = 0.02) -> BearingLocation:
+    """Find the bearing contour and the ball band on a background frame.
+
+    Raises
+    ------
+    TrackingError
+        When no ring-shaped bright region is in view (no bearing, an all-dark or all-saturated video).
+    """
+    img8 = _to_u8(background.astype(np.float32))
+    if img8.max() == img8.min():
+        raise TrackingError(path, "the frames have no contrast (all dark or all saturated): no bearing in view.",
+                            "Check the exposure and the lighting.")
+    _, binary = cv2.threshold(img8, 0, 255, cv2.THRESH_BINARY + cv2.THRESH_OTSU)
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(binary, connectivity=8)
+    min_area = min_area_frac * binary.size
+    big = [k for k in range(1, n) if stats[k, cv2.CC_STAT_AREA] >= min_area]
+    if not big:
+        raise TrackingError(path, "no bright ring-shaped region found: no bearing in view.",
+                            "Check that the bearing's end face fills a good part of the frame.")
+    mask = np.isin(labels, big).astype(np.uint8)
+    contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    outer = max(contours, key=cv2.contourArea).reshape(-1, 2).astype(np.float64)
+    cx, cy, r_out, rms = fit_circle(outer[:, 0], outer[:, 1])
+    if rms > 0.05 * r_out or r_out < 20:
+        raise TrackingError(path, f"the bright region is not circular (fit residual {rms:.1f} px on radius "
+                            f"{r_out:.1f} px): no bearing in view.", "Frame the bearing's end face.")
+    band_in, band_out = _dark_band(background, (cx, cy), r_out, path)
+    log.debug("%s: bearing at (%.1f, %.1f), r = %.1f px, band %.1f..%.1f px", path, cx, cy, r_out, band_in, band_out)
+    return BearingLocation(centre=(cx, cy), outer_radius=r_out, band_inner=band_in, band_outer=band_out,
+                           contour_residual=rms)
+
+
+def _dark_band(background: np.ndarray, centre: tuple[float, float], r_out: float, path: str | Path) -> tuple[float, float]:
+    """Radii of the widest dark band between bright ring faces, from the radial median profile."""
+    h, w = background.shape
+    v, u = np.mgrid[0:h, 0:w]
+    r = np.hypot(u - centre[0], v - centre[1])
+    inside = r < r_out
+    rb = r[inside].astype(np.int64)
+    vals = background[inside].astype(np.float64)
+    n_r = int(r_out) + 1
+    order = np.argsort(rb, kind="stable")
+    rb, vals = rb[order], vals[order]
+    edges = np.searchsorted(rb, np.arange(n_r + 1))
+    prof = np.array([np.median(vals[edges[k]:edges[k + 1]]) if edges[k + 1] > edges[k] else np.nan
+                     for k in range(n_r)])
+    valid = np.isfinite(prof)
+    lo, hi = np.nanpercentile(prof, [5, 95])
+    thresh = lo + 0.5 * (hi - lo)
+    dark = valid & (prof < thresh)
+    dark[: int(0.3 * r_out)] = False  # the bore and the shaft are not the ball band
+    runs = _runs(dark)
+    bright_out = np.flatnonzero(valid & (prof >= thresh))
+    # The band is a dark run with bright ring faces on both sides.
+    candidates = [(a, b) for a, b in runs if bright_out.size and bright_out.min() < a and (bright_out > b).any()]
+    if not candidates:
+        raise TrackingError(path, "no dark ball band between two bright ring faces was found.",
+                            "Check the lighting: the ring faces must be brighter than the black balls.")
+    a, b = max(candidates, key=lambda ab: ab[1] - ab[0])
+    return float(a), float(b)
+
+
+def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
+    """Start and end (inclusive) of each run of True."""
+    d = np.diff(np.concatenate([[0], flags.astype(np.int8), [0]]))
+    return list(zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1) - 1, strict=True))

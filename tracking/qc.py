@@ -1,0 +1,142 @@
+"""Stage 6: quality control written beside the trace (DESIGN §8.7).
+
+Per video: detection rate per ball, the share of interpolated samples, the
+orbit-circle fit residual, the ball count found, and overlay images of chosen
+frames with ball numbers and the fitted circle. A warning is raised for any
+value out of bounds (:data:`QC_LIMITS`).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+import pandas as pd
+
+from cageless.atomic import atomic_path, atomic_write_text
+from cageless.trace import Trace
+from tracking.geometry import Orbit
+from tracking.io import open_video
+from tracking.locate import BearingLocation
+
+__all__ = ["QC_LIMITS", "QCReport", "build_qc", "write_qc"]
+
+log = logging.getLogger(__name__)
+
+#: Bounds beyond which QC warns.
+QC_LIMITS = {
+    "min_detection_rate": 0.90,  # per ball
+    "max_interpolated_share": 0.10,  # over all samples
+    "max_residual_fraction": 0.005,  # orbit fit residual / orbit radius
+}
+
+
+@dataclass
+class QCReport:
+    """Tracking quality of one video."""
+
+    n_balls_found: int
+    n_balls_expected: int
+    detection_rate: list[float]
+    interpolated_share: float
+    orbit_centre_px: tuple[float, float]
+    orbit_radius_px: float
+    orbit_residual_px: float
+    contour_centre_px: tuple[float, float]
+    px_per_mm: float
+    direction: int
+    ball_order: list[int] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+    overlays: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready summary."""
+        return asdict(self)
+
+    @property
+    def ok(self) -> bool:
+        """True when nothing was out of bounds."""
+        return not self.warnings
+
+
+def build_qc(table: pd.DataFrame, order: np.ndarray, valid: np.ndarray, orbit: Orbit, loc: BearingLocation,
+             direction: int, px_per_mm: float, n_expected: int, warned: list[str]) -> QCReport:
+    """Summarise the track table; out-of-bounds values become warnings (also logged)."""
+    rate = valid.mean(axis=0)
+    interp = 1.0 - float(valid.mean())
+    report = QCReport(
+        n_balls_found=int(valid.shape[1]), n_balls_expected=n_expected,
+        detection_rate=[round(float(r), 6) for r in rate], interpolated_share=round(interp, 6),
+        orbit_centre_px=orbit.centre, orbit_radius_px=orbit.radius, orbit_residual_px=orbit.residual,
+        contour_centre_px=loc.centre, px_per_mm=px_per_mm, direction=direction,
+        ball_order=[int(c) for c in order], warnings=list(warned),
+    )
+    lim = QC_LIMITS
+    low = [k for k, r in enumerate(rate) if r < lim["min_detection_rate"]]
+    if low:
+        report.warnings.append(f"detection rate below {lim['min_detection_rate']:.0%} for balls {low}")
+    if interp > lim["max_interpolated_share"]:
+        report.warnings.append(f"{interp:.1%} of samples interpolated (limit {lim['max_interpolated_share']:.0%})")
+    if orbit.residual > lim["max_residual_fraction"] * orbit.radius:
+        report.warnings.append(f"orbit fit residual {orbit.residual:.2f} px exceeds "
+                               f"{lim['max_residual_fraction']:.1%} of the radius {orbit.radius:.1f} px")
+    for w in report.warnings:
+        log.warning("%s", w)
+    return report
+
+
+def _overlay(frame: np.ndarray, rows: pd.DataFrame, orbit: Orbit, scale: int) -> np.ndarray:
+    lo, hi = np.percentile(frame, [1, 99.8])
+    img8 = np.clip((frame.astype(np.float32) - lo) * (255.0 / max(hi - lo, 1e-6)), 0, 255).astype(np.uint8)
+    img = cv2.resize(cv2.cvtColor(img8, cv2.COLOR_GRAY2BGR), None, fx=scale, fy=scale,
+                     interpolation=cv2.INTER_NEAREST)
+    shift = 4
+    f = scale * (1 << shift)
+
+    def pt(u: float, v: float) -> tuple[int, int]:
+        return int(round((u + 0.5) * f - 0.5 * (1 << shift))), int(round((v + 0.5) * f - 0.5 * (1 << shift)))
+
+    cv2.circle(img, pt(*orbit.centre), int(round(orbit.radius * f)), (0, 200, 255), 1, cv2.LINE_AA, shift)
+    for r in rows.itertuples():
+        if not np.isfinite(r.u_px):
+            continue
+        colour = (0, 255, 0) if r.detected else (0, 0, 255)
+        cv2.circle(img, pt(r.u_px, r.v_px), 6 * f // scale, colour, 1, cv2.LINE_AA, shift)
+        cv2.putText(img, str(r.ball), (int((r.u_px + 5) * scale), int((r.v_px - 5) * scale)),
+                    cv2.FONT_HERSHEY_SIMPLEX, 0.35 * max(scale, 1), colour, 1, cv2.LINE_AA)
+    return img
+
+
+def write_qc(qc_dir: Path, stem: str, video_path: Path, qc: QCReport, table: pd.DataFrame, trace: Trace,
+             n_frames: int, fps: float | None) -> list[Path]:
+    """Write ``<stem>.qc.json`` and ``n_frames`` overlay PNGs (balls numbered as in the trace)."""
+    qc_dir.mkdir(parents=True, exist_ok=True)
+    written: list[Path] = []
+    order = np.argsort(_column_of_ball(table, trace))
+    with open_video(video_path, fps=fps) as video:
+        n = len(video)
+        picks = np.unique(np.linspace(0, n - 1, max(1, n_frames)).round().astype(int))
+        scale = max(1, int(math.ceil(600 / max(video.frame_shape))))
+        for i in picks:
+            rows = table[table.frame == i].copy()
+            rows["ball"] = order[rows.ball.to_numpy()]
+            img = _overlay(video[int(i)], rows, Orbit(tuple(trace.video.centre_px), qc.orbit_radius_px, 0.0), scale)
+            target = qc_dir / f"{stem}.frame{i:06d}.png"
+            with atomic_path(target) as tmp:
+                ok, buf = cv2.imencode(".png", img)
+                tmp.write_bytes(buf.tobytes())
+            written.append(target)
+    qc.overlays = [p.name for p in written]
+    atomic_write_text(qc_dir / f"{stem}.qc.json", json.dumps(qc.to_dict(), indent=1, default=float))
+    return written
+
+
+def _column_of_ball(table: pd.DataFrame, trace: Trace) -> np.ndarray:
+    """For each trace ball, the tracker column it came from (stored in the trace's QC)."""
+    return np.asarray(trace.qc["ball_order"]) if trace.qc and "ball_order" in trace.qc else np.arange(trace.n_balls)
