@@ -6,9 +6,14 @@ saturated, flat-topped highlight is one solid blob), then connected components
 filtered by area, shape (glints are long and thin) and peak intensity.
 
 Positions are **background-subtracted, intensity-weighted centroids** in a
-circular window, re-centred on the result: each pixel weighs ``max(I - B - t, 0)``
-with B the background frame and t a threshold of a few noise standard
-deviations. The centroid of the binary mask is kept only as the ``"mask"``
+circular window, re-centred on the result: each pixel weighs ``max(I - b - t, 0)``
+with b the *local* background (the median of a 2-px ring just outside the
+window, i.e. the black ball coating around the highlight) and t a threshold of
+a few noise standard deviations. A local constant works better than the median
+background frame, which in the ball band switches between ball and gap levels
+across a window and biases the centroid (2.1-2.4 x the Cramér-Rao bound against
+1.1-1.15 x, measured on rendered video). Static defects (hot pixels) are taken
+out of the mask by :func:`static_defects`. The centroid of the binary mask is kept only as the ``"mask"``
 detector, for the accuracy-versus-time comparison.
 """
 
@@ -25,6 +30,7 @@ from cageless.errors import ParameterError
 
 __all__ = [
     "DetectorParams", "DETECTORS", "Detections", "detect_full", "centroid_windows", "noise_sigma", "spot_sigma",
+    "static_defects",
 ]
 
 #: The detector choices: binary-mask centroid, weighted centroid after full detection every frame,
@@ -90,6 +96,12 @@ class Detections:
 
     def __len__(self) -> int:
         return int(self.u.size)
+
+
+def static_defects(background: np.ndarray, sigma_noise: float, k: float = 8.0) -> np.ndarray:
+    """Pixels far brighter than their 3 x 3 median in the background frame (hot pixels, fixed glints)."""
+    bg = background.astype(np.float32)
+    return (bg - cv2.medianBlur(bg, 3)) > k * sigma_noise
 
 
 def noise_sigma(frames: np.ndarray, background: np.ndarray, mask: np.ndarray) -> float:
@@ -186,10 +198,23 @@ def _centroids(frame, background, mask, u0, v0, half, threshold, iterations):  #
             continue
         r = half[j]
         r2 = r * r
+        ro2 = (r + 2.0) * (r + 2.0)
+        ri = int(np.ceil(r + 2.0))
+        ring = np.empty((2 * ri + 1) * (2 * ri + 1))
         m = 0.0
         for _ in range(iterations):
             ui, vi = int(np.floor(u + 0.5)), int(np.floor(v + 0.5))
-            ri = int(np.ceil(r))
+            # Local background: median of the 2-px ring just outside the window (the black ball coating).
+            cnt = 0
+            for y in range(max(vi - ri, 0), min(vi + ri + 1, h)):
+                dy = y - v
+                for x in range(max(ui - ri, 0), min(ui + ri + 1, w)):
+                    dx = x - u
+                    d2 = dx * dx + dy * dy
+                    if d2 > r2 and d2 <= ro2 and mask[y, x]:
+                        ring[cnt] = frame[y, x]
+                        cnt += 1
+            local = np.median(ring[:cnt]) if cnt >= 8 else np.nan
             su = 0.0
             sv = 0.0
             m = 0.0
@@ -199,7 +224,8 @@ def _centroids(frame, background, mask, u0, v0, half, threshold, iterations):  #
                     dx = x - u
                     if dx * dx + dy * dy > r2 or not mask[y, x]:
                         continue
-                    wgt = np.float64(frame[y, x]) - background[y, x] - threshold
+                    base = local if np.isfinite(local) else background[y, x]
+                    wgt = np.float64(frame[y, x]) - base - threshold
                     if wgt > 0.0:
                         su += wgt * x
                         sv += wgt * y

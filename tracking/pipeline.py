@@ -28,7 +28,7 @@ from cageless.errors import ParameterError, TrackingError
 from cageless.kinematics import slip_rate, theoretical_cage_speed
 from cageless.provenance import Provenance
 from cageless.trace import Trace, VideoInfo, write_trace
-from tracking.detect import DetectorParams, detect_full, noise_sigma, spot_sigma
+from tracking.detect import DetectorParams, detect_full, noise_sigma, spot_sigma, static_defects
 from tracking.geometry import fit_orbit, orbital_angles
 from tracking.io import FrameSource, open_video
 from tracking.kinematics import DEFAULT_WINDOW, revolution_speed
@@ -114,6 +114,7 @@ def _setup(video: FrameSource, loc: BearingLocation, background: np.ndarray, bea
     bg = np.ascontiguousarray(background[rows, cols])
     sample = np.stack([frames(int(i)) for i in np.linspace(0, len(video) - 1, min(4, len(video))).astype(int)])
     sigma = noise_sigma(sample, bg, mask)
+    mask = mask & ~static_defects(bg, sigma)
     g = bearing.geometry
     r_mid = 0.5 * (loc.band_inner + loc.band_outer)
     ball_px = g.ball_diameter_m / (0.5 * g.pitch_diameter_m) * r_mid
@@ -160,6 +161,8 @@ def track_video(
         table["v_px"] += rows.start
         trace, qc = _finish(path, video, table, loc, conditions, bearing, options, prov,
                             [str(w.message) for w in caught])
+    for w in caught:  # recorded for QC; still shown to the caller
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     written = None
     if out_dir is not None:
         out_dir = Path(out_dir)

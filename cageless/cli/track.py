@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import multiprocessing
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import replace
 from pathlib import Path
@@ -140,7 +141,8 @@ def _map(jobs: list[Any], workers: int, bar: Any) -> list[tuple[str, Any]]:
             out.append(_track_one(job))
             bar.update(1)
         return out
-    with ProcessPoolExecutor(max_workers=workers) as pool:
+    # spawn, not fork: numba's thread pool (parallel cine unpacking) does not survive a fork.
+    with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn")) as pool:
         out = []
         for res in pool.map(_track_one, jobs):
             out.append(res)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+import multiprocessing
 from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict
@@ -69,7 +70,8 @@ def _frames(renderer: Renderer, motion: BallMotion, index: np.ndarray, times: np
                           ring_angle=motion.ring_angle[rows], ring_offset=motion.ring_offset[rows],
                           direction=motion.direction)
         jobs.append((renderer, part, index[a:b], times[a:b], sub, a))
-    with ProcessPoolExecutor(max_workers=workers) as pool:
+    # spawn, not fork: numba's thread pool does not survive a fork.
+    with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn")) as pool:
         for chunk in pool.map(_render_chunk, jobs):
             yield from chunk
 

@@ -32,7 +32,7 @@ from tracking.synthetic.motion import BallMotion
 __all__ = ["Renderer", "TRUTH_COLUMNS"]
 
 TRUTH_COLUMNS = ("frame", "time_s", "ball", "angle_rad", "radius_m", "centre_u_px", "centre_v_px",
-                 "highlight_u_px", "highlight_v_px", "highlight_visible")
+                 "highlight_u_px", "highlight_v_px", "highlight_visible", "highlight_peak")
 
 _BLUR_STEP_PX = 0.25  # one exposure sub-sample per this much motion
 
@@ -240,7 +240,11 @@ class Renderer:
                                     peaks[i], float(times[i]))
 
     def truth(self, motion: BallMotion, frame_index: np.ndarray, times: np.ndarray, subsamples: int) -> pd.DataFrame:
-        """Ground truth per frame and ball at mid-exposure (long table, ``TRUTH_COLUMNS``)."""
+        """Ground truth per frame and ball at mid-exposure (long table, ``TRUTH_COLUMNS``).
+
+        ``highlight_peak`` is the highlight's peak brightness as a fraction of full scale before
+        flicker (above 1 it saturates); 0 where the highlight is hidden.
+        """
         vis = self.visibility(len(times))
         mid = np.arange(len(times)) * subsamples + (subsamples - 1) / 2.0
         lo, hi = np.floor(mid).astype(int), np.ceil(mid).astype(int)
@@ -251,9 +255,11 @@ class Renderer:
         cx, cy = self.camera.centre_px
         r_hl = np.hypot(hu - cx, hv - cy) / self.camera.px_per_m  # highlights behind a ring land are hidden
         vis = vis & (r_hl > self.radii.inner_land) & (r_hl < self.radii.outer_land)
+        peaks = self.peaks(len(times)) * vis
         t, z = angle.shape
         return pd.DataFrame({
             "frame": np.repeat(frame_index, z), "time_s": np.repeat(times, z), "ball": np.tile(np.arange(z), t),
             "angle_rad": angle.ravel(), "radius_m": radius.ravel(), "centre_u_px": u.ravel(), "centre_v_px": v.ravel(),
             "highlight_u_px": hu.ravel(), "highlight_v_px": hv.ravel(), "highlight_visible": vis.ravel(),
+            "highlight_peak": peaks.ravel(),
         })

@@ -1,0 +1,118 @@
+"""Bad input to tracking: each case gets a clear message, and no partial trace file is left behind."""
+
+from __future__ import annotations
+
+import dataclasses
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cageless.bearing import default_bearing
+from cageless.cli import main
+from cageless.conditions import OperatingConditions
+from cageless.errors import TrackingError, VideoError
+from cageless.trace import read_trace
+from tracking.io import write_cine, write_image_sequence
+from tracking.link import BallCountWarning
+from tracking.pipeline import track_video
+from tracking.synthetic.camera import Appearance, Camera
+from tracking.synthetic.clip import render_clip
+from tracking.synthetic.motion import KinematicLaw
+from tracking.synthetic.render import Renderer
+
+B = default_bearing()
+SMALL = Camera(width=320, height=200, px_per_mm=3.125, bit_depth=8)
+COND = OperatingConditions(3000.0, 500.0)
+
+
+def _clip(path: Path, n: int = 40, geometry=None, fmt: str = "cine-8") -> Path:
+    g = geometry or B.geometry
+    return render_clip(path, Renderer(g, SMALL, Appearance(), seed=7), n, law=KinematicLaw(g, 3000, seed=7),
+                       fmt=fmt)["video"]
+
+
+def test_no_bearing_in_view(tmp_path):
+    rng = np.random.default_rng(0)
+    noise = rng.integers(0, 40, size=(30, 200, 320), dtype=np.uint8)
+    video = write_cine(tmp_path / "empty_bench.cine", noise, fps=10000, fmt="8")
+    with pytest.raises(TrackingError, match="empty_bench.cine: .*no bearing in view"):
+        track_video(video, COND, B, out_dir=tmp_path / "out", progress=False)
+    assert not list((tmp_path).rglob("*.trace.h5"))
+
+
+@pytest.mark.parametrize(("level", "name"), [(0, "dark"), (255, "saturated")])
+def test_all_dark_and_all_saturated(tmp_path, level, name):
+    video = write_cine(tmp_path / f"{name}.cine", np.full((30, 200, 320), level, np.uint8), fps=10000, fmt="8")
+    with pytest.raises(TrackingError, match=f"{name}.cine: the frames have no contrast"):
+        track_video(video, COND, B, out_dir=tmp_path / "out", progress=False)
+    assert not (tmp_path / "out").exists() or not list((tmp_path / "out").rglob("*.trace.h5"))
+
+
+def test_too_short_for_a_speed(tmp_path):
+    video = _clip(tmp_path / "short.cine", n=10)
+    with pytest.raises(TrackingError, match="short.cine: has 10 frames, fewer than the speed window of 21"):
+        track_video(video, COND, B, out_dir=tmp_path / "out", progress=False)
+
+
+def test_wrong_ball_count_warns_or_fails_under_strict(tmp_path):
+    g13 = dataclasses.replace(B.geometry, n_balls=13)
+    video = _clip(tmp_path / "thirteen.cine", n=30, geometry=g13)
+    with pytest.warns(BallCountWarning, match="shows 13 balls but the bearing has 14"):
+        res = track_video(video, COND, B, progress=False)
+    assert res.trace.n_balls == 13
+    assert any("13 balls" in w for w in res.qc.warnings)
+    from tracking.pipeline import TrackOptions
+
+    with pytest.raises(TrackingError, match="shows 13 balls but the bearing has 14.*--strict"):
+        track_video(video, COND, B, TrackOptions(strict=True), out_dir=tmp_path / "out", progress=False)
+    assert not list(tmp_path.rglob("*.trace.h5"))
+
+
+def test_frames_of_varying_size(tmp_path):
+    seq = _clip(tmp_path / "seq", n=30, fmt="png")
+    frames = sorted(seq.glob("*.png"))
+    import cv2
+
+    cv2.imwrite(str(frames[12]), np.zeros((100, 100), np.uint8))
+    with pytest.raises(VideoError, match=r"frame_000012.png: is \(100, 100\) uint8, unlike the first image"):
+        track_video(seq, dataclasses.replace(COND, fps=10000.0), B, out_dir=tmp_path / "out", progress=False)
+    assert not list(tmp_path.rglob("*.trace.h5"))
+
+
+def test_cli_folder_one_bad_video_does_not_stop_the_rest(tmp_path, capsys):
+    lab = tmp_path / "lab"
+    lab.mkdir()
+    _clip(lab / "n3000_Fr500.cine", n=30)
+    (lab / "n1800_Fr500.cine").write_bytes(b"CI" + b"\0" * 30)  # truncated header
+    (lab / "mystery.cine").write_bytes(b"\0")  # no conditions anywhere
+    out = tmp_path / "out"
+    assert main(["track", str(lab), "-o", str(out), "-q", "--workers", "1"]) == 1
+    text = capsys.readouterr().out
+    assert "ok     n3000_Fr500.cine: 30 frames, 14 balls" in text
+    assert "FAILED n1800_Fr500.cine" in text and "too short" in text
+    assert "FAILED" in text and "mystery.cine: no operating conditions found" in text
+    assert [p.name for p in out.glob("*.trace.h5")] == ["n3000_Fr500.trace.h5"]
+    tr = read_trace(out / "n3000_Fr500.trace.h5")
+    assert tr.source == "video" and tr.speed_rpm == 3000 and tr.qc["n_balls_found"] == 14
+    assert (out / "qc" / "n3000_Fr500.qc.json").is_file() and list((out / "qc").glob("n3000_Fr500.frame*.png"))
+
+
+def test_cli_sample_lab_in_parallel(tmp_path, capsys):
+    lab = Path(__file__).resolve().parents[2] / "sample_data" / "lab"
+    out = tmp_path / "out"
+    assert main(["track", str(lab), "-o", str(out), "-q", "--workers", "2"]) == 0
+    assert sorted(p.name for p in out.glob("*.trace.h5")) == [
+        "clip_3000rpm.trace.h5", "n6000_Fr500_Fa0.trace.h5", "run_1800.trace.h5"]
+    tr = read_trace(out / "run_1800.trace.h5")
+    assert tr.video.camera_roll_rad == pytest.approx(np.radians(2.0))
+    assert tr.provenance["inputs"][0]["sha256"] == tr.video.input_sha256
+
+
+def test_cli_speed_for_a_bare_video(tmp_path, capsys):
+    video = _clip(tmp_path / "bare.cine", n=30)
+    assert main(["track", str(video), "-o", str(tmp_path / "o"), "-q"]) == 1
+    assert "no operating conditions found" in capsys.readouterr().out
+    assert main(["track", str(video), "-o", str(tmp_path / "o"), "-q", "--speed-rpm", "3000"]) == 0
+    assert main(["track", str(video), "-o", str(tmp_path / "o"), "--window", "4"]) == 2
