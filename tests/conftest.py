@@ -54,3 +54,9 @@ def pytest_report_header(config: pytest.Config) -> list[str]:
         except PackageNotFoundError:
             found.append(f"{name} (not installed)")
     return ["versions: " + ", ".join(found)]
+
+
+@pytest.fixture(autouse=True)
+def _isolated_cache(tmp_path_factory, monkeypatch):
+    """Every test gets its own cageless cache folder (hash cache and the like)."""
+    monkeypatch.setenv("CAGELESS_CACHE_DIR", str(tmp_path_factory.mktemp("cache")))

@@ -185,6 +185,34 @@ def centroid_windows(frame: np.ndarray, background: np.ndarray, mask: np.ndarray
     return _centroids(frame, background, mask, u0, v0, half_arr, float(threshold), int(iterations))
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _span(c, half_sq, dy2, lo_lim, hi_lim):  # pragma: no cover - compiled
+    """Columns x with (x - c)^2 <= half_sq - dy2, clipped to [lo_lim, hi_lim)."""
+    rem = half_sq - dy2
+    if rem < 0.0:
+        return 0, -1
+    hw = np.sqrt(rem)
+    return max(int(np.ceil(c - hw)), lo_lim), min(int(np.floor(c + hw)), hi_lim - 1)
+
+
+@numba.njit(cache=True, nogil=True)
+def _local_background(frame, mask, u, v, r, ring):  # pragma: no cover - compiled
+    """Median of the masked pixels with r < distance <= r + 2 from (u, v); NaN if fewer than 8."""
+    h, w = frame.shape
+    ro = r + 2.0
+    cnt = 0
+    for y in range(max(int(np.floor(v - ro)), 0), min(int(np.ceil(v + ro)) + 1, h)):
+        dy2 = (y - v) * (y - v)
+        x0, x1 = _span(u, ro * ro, dy2, 0, w)
+        i0, i1 = _span(u, r * r, dy2, 0, w)
+        for x in range(x0, x1 + 1):
+            if (i0 <= x <= i1 and (x - u) * (x - u) + dy2 <= r * r) or not mask[y, x]:
+                continue
+            ring[cnt] = frame[y, x]
+            cnt += 1
+    return np.median(ring[:cnt]) if cnt >= 8 else np.nan
+
+
 @numba.njit(cache=True, nogil=True)
 def _centroids(frame, background, mask, u0, v0, half, threshold, iterations):  # pragma: no cover - compiled
     n = u0.shape[0]
@@ -197,32 +225,19 @@ def _centroids(frame, background, mask, u0, v0, half, threshold, iterations):  #
         if not (np.isfinite(u) and np.isfinite(v)):
             continue
         r = half[j]
-        r2 = r * r
-        ro2 = (r + 2.0) * (r + 2.0)
-        ri = int(np.ceil(r + 2.0))
-        ring = np.empty((2 * ri + 1) * (2 * ri + 1))
+        ring = np.empty(int(4 * np.pi * (r + 3.0)) + 64)
+        # Local background: the black ball coating just outside the window (measured once).
+        local = _local_background(frame, mask, u, v, r, ring)
         m = 0.0
         for _ in range(iterations):
-            ui, vi = int(np.floor(u + 0.5)), int(np.floor(v + 0.5))
-            # Local background: median of the 2-px ring just outside the window (the black ball coating).
-            cnt = 0
-            for y in range(max(vi - ri, 0), min(vi + ri + 1, h)):
-                dy = y - v
-                for x in range(max(ui - ri, 0), min(ui + ri + 1, w)):
-                    dx = x - u
-                    d2 = dx * dx + dy * dy
-                    if d2 > r2 and d2 <= ro2 and mask[y, x]:
-                        ring[cnt] = frame[y, x]
-                        cnt += 1
-            local = np.median(ring[:cnt]) if cnt >= 8 else np.nan
             su = 0.0
             sv = 0.0
             m = 0.0
-            for y in range(max(vi - ri, 0), min(vi + ri + 1, h)):
-                dy = y - v
-                for x in range(max(ui - ri, 0), min(ui + ri + 1, w)):
-                    dx = x - u
-                    if dx * dx + dy * dy > r2 or not mask[y, x]:
+            for y in range(max(int(np.floor(v - r)), 0), min(int(np.ceil(v + r)) + 1, h)):
+                dy2 = (y - v) * (y - v)
+                x0, x1 = _span(u, r * r, dy2, 0, w)
+                for x in range(x0, x1 + 1):
+                    if not mask[y, x]:
                         continue
                     base = local if np.isfinite(local) else background[y, x]
                     wgt = np.float64(frame[y, x]) - base - threshold

@@ -36,8 +36,10 @@ log = logging.getLogger(__name__)
 
 TRACK_COLUMNS = ("frame", "time_s", "ball", "u_px", "v_px", "mass", "detected")
 
-#: Consecutive misses after which a frame is searched in full.
-_REDETECT_AFTER = 3
+#: Consecutive misses after which a ball is looked for in a doubled window, and after which the
+#: whole frame is searched (a highlight dropout lasts a few frames; the prediction stays good).
+_WIDEN_AFTER = 3
+_REDETECT_AFTER = 12
 #: Frames scanned for a start frame with all balls in view.
 _START_SCAN = 64
 
@@ -153,8 +155,9 @@ def _step(frame: np.ndarray, t: float, st: _State, s: TrackSetup, centre: tuple[
     half = s.params.window_sigma * s.highlight_sigma
     if s.params.method == "window":
         # Until the speed is known, widen the window by the largest plausible motion.
-        # Until the speed is known, find the highlight in a wider window, then measure it in the normal one.
-        grow = np.where(st.omega == 0.0, 2.0, 1.0)
+        # Until the speed is known, or after a few misses, find the highlight in a wider window first,
+        # then measure it in the normal one.
+        grow = np.where((st.omega == 0.0) | (st.misses >= _WIDEN_AFTER), 2.0, 1.0)
         thr = s.params.weight_sigma * s.sigma_noise
         if np.any(grow > 1.0):
             fu, fv, _ = centroid_windows(frame, s.background, s.mask, pu, pv, half * grow, thr, 1)

@@ -64,12 +64,12 @@ class BearingLocation:
                 slice(max(int(cu - r), 0), min(int(cu + r) + 1, shape[1])))
 
 
-def background_frame(video: FrameSource, n_sample: int = 48) -> npt.NDArray[np.float32]:
-    """Per-pixel median of up to ``n_sample`` frames spread over the video."""
+def background_frame(video: FrameSource, n_sample: int = 25) -> npt.NDArray[np.float32]:
+    """Per-pixel median of up to ``n_sample`` frames spread over the video (removes the moving highlights)."""
     n = len(video)
     idx = np.unique(np.linspace(0, n - 1, min(n, n_sample)).round().astype(int))
-    stack = np.stack([video[int(i)] for i in idx]).astype(np.float32)
-    return np.median(stack, axis=0)
+    stack = np.stack([video[int(i)] for i in idx])
+    return np.median(stack, axis=0).astype(np.float32)
 
 
 def fit_circle(u: npt.ArrayLike, v: npt.ArrayLike) -> tuple[float, float, float, float]:

@@ -14,6 +14,7 @@ import logging
 import math
 import warnings
 from collections import OrderedDict
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -30,7 +31,7 @@ from cageless.provenance import Provenance
 from cageless.trace import Trace, VideoInfo, write_trace
 from tracking.detect import DetectorParams, detect_full, noise_sigma, spot_sigma, static_defects
 from tracking.geometry import fit_orbit, orbital_angles
-from tracking.io import FrameSource, open_video
+from tracking.io import CineReader, FrameSource, open_video
 from tracking.kinematics import DEFAULT_WINDOW, revolution_speed
 from tracking.link import BallCountWarning, TrackSetup, track_frames
 from tracking.locate import BearingLocation, background_frame, locate_bearing
@@ -39,6 +40,12 @@ from tracking.qc import QCReport, build_qc, write_qc
 __all__ = ["TrackOptions", "TrackResult", "track_video"]
 
 log = logging.getLogger(__name__)
+
+#: Shortest segment worth a thread, and the frames two segments share to match identities.
+_MIN_SEGMENT = 1024
+_OVERLAP = 8
+#: Frames served from a memory map between drops of its touched pages.
+_DROP_EVERY = 256
 
 
 @dataclass(frozen=True)
@@ -56,20 +63,23 @@ class TrackOptions:
     strict
         Make a ball-count mismatch an error instead of a warning.
     chunk
-        Frames read per chunk.
+        Frames read per chunk (two chunks are cached: 64 full-size 16-bit frames are 131 MB).
     fps
         Frame-rate override (frames/s); default the conditions' ``fps``, then the file's timing.
     qc_frames
         How many overlay images to write.
+    threads
+        Segments tracked in parallel threads for long videos (each at least 1024 frames).
     """
 
     detector: DetectorParams = field(default_factory=DetectorParams)
     window: int = DEFAULT_WINDOW
     polyorder: int = 2
     strict: bool = False
-    chunk: int = 128
+    chunk: int = 64
     fps: float | None = None
     qc_frames: int = 3
+    threads: int = 2
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready settings."""
@@ -87,19 +97,30 @@ class TrackResult:
 
 
 class _CroppedFrames:
-    """Random access to cropped frames, reading whole chunks and keeping the last two."""
+    """Random access to cropped frames ``offset + i``: zero-copy views of a memory-mapped cine, or whole
+    chunks read and the last two kept."""
 
-    def __init__(self, video: FrameSource, rows: slice, cols: slice, chunk: int) -> None:
-        self.video, self.rows, self.cols, self.chunk = video, rows, cols, chunk
+    def __init__(self, video: FrameSource, rows: slice, cols: slice, chunk: int, offset: int = 0,
+                 stop: int | None = None) -> None:
+        self.video, self.rows, self.cols, self.chunk, self.offset = video, rows, cols, chunk, offset
+        self.stop = len(video) if stop is None else stop
         self._cache: OrderedDict[int, np.ndarray] = OrderedDict()
+        # Memory-mapped 8/16-bit cine: hand out views; the window kernel touches only the pages it needs.
+        self.zero_copy = isinstance(video, CineReader) and not video._packed_bits
+        self._served = 0
 
     def __call__(self, i: int) -> np.ndarray:
+        if self.zero_copy:
+            self._served += 1
+            if self._served % _DROP_EVERY == 0:
+                self.video.drop_pages()  # type: ignore[attr-defined]
+            return self.video.frame_view(self.offset + i)[self.rows, self.cols]
         k = i // self.chunk
         block = self._cache.get(k)
         if block is None:
-            a = k * self.chunk
-            raw = self.video[a:min(a + self.chunk, len(self.video))]
-            block = np.ascontiguousarray(raw[:, self.rows, self.cols])
+            a = self.offset + k * self.chunk
+            raw = self.video[a:min(a + self.chunk, self.stop)]
+            block = raw[:, self.rows, self.cols]  # a view: the window kernel reads any strides
             self._cache[k] = block
             if len(self._cache) > 2:
                 self._cache.popitem(last=False)
@@ -112,7 +133,8 @@ def _setup(video: FrameSource, loc: BearingLocation, background: np.ndarray, bea
     margin = max(1.5, 0.04 * (loc.band_outer - loc.band_inner))
     mask = loc.annulus_mask(video.frame_shape, margin)[rows, cols]
     bg = np.ascontiguousarray(background[rows, cols])
-    sample = np.stack([frames(int(i)) for i in np.linspace(0, len(video) - 1, min(4, len(video))).astype(int)])
+    picks = np.linspace(0, len(video) - 1, min(4, len(video))).astype(int)
+    sample = np.stack([video[int(i)][rows, cols] for i in picks])
     sigma = noise_sigma(sample, bg, mask)
     mask = mask & ~static_defects(bg, sigma)
     g = bearing.geometry
@@ -143,7 +165,7 @@ def track_video(
     path = Path(path)
     fps = options.fps or conditions.fps
     prov = Provenance.start(config={"tracking": options.to_dict(), "conditions": conditions.to_dict(),
-                                    **(config or {})}, inputs=[path])
+                                    **(config or {})}, inputs=[path], background=True)
     with warnings.catch_warnings(record=True) as caught, open_video(path, fps=fps) as video:
         warnings.simplefilter("always", BallCountWarning)
         times = video.times
@@ -156,7 +178,7 @@ def track_video(
         frames = _CroppedFrames(video, rows, cols, options.chunk)
         setup = _setup(video, loc, background, bearing, options, frames)
         with tqdm(total=len(video), desc=path.name, unit="frame", disable=not progress, leave=False) as bar:
-            table, _ = track_frames(frames, times, setup, str(path), options.strict, bar.update)
+            table = _track_all(path, fps, video, frames, times, setup, options, bar.update)
         table["u_px"] += cols.start
         table["v_px"] += rows.start
         trace, qc = _finish(path, video, table, loc, conditions, bearing, options, prov,
@@ -169,6 +191,53 @@ def track_video(
         written = write_trace(out_dir / f"{_stem(path)}.trace.h5", trace)
         write_qc(out_dir / "qc", _stem(path), path, qc, table, trace, options.qc_frames, fps)
     return TrackResult(trace=trace, table=table, qc=qc, path=written)
+
+
+def _track_all(path: Path, fps: float | None, video: FrameSource, frames: _CroppedFrames, times: np.ndarray,
+               setup: TrackSetup, options: TrackOptions, update: Any) -> pd.DataFrame:
+    """Track every frame: in one pass, or in overlapping segments on ``options.threads`` threads."""
+    n = len(times)
+    k = max(1, min(options.threads, n // _MIN_SEGMENT))
+    if k == 1:
+        return track_frames(frames, times, setup, str(path), options.strict, update)[0]
+    bounds = np.linspace(0, n, k + 1).astype(int)
+    spans = [(int(a), int(min(b + _OVERLAP, n))) for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+
+    def one(span: tuple[int, int]) -> pd.DataFrame:
+        a, b = span
+        with open_video(path, fps=fps) as own:
+            seg = _CroppedFrames(own, frames.rows, frames.cols, options.chunk, offset=a, stop=b)
+            return track_frames(seg, times[a:b], setup, str(path), options.strict, update)[0]
+
+    with ThreadPoolExecutor(max_workers=k) as pool:
+        parts = list(pool.map(one, spans))
+    return _stitch(parts, spans, times)
+
+
+def _stitch(parts: list[pd.DataFrame], spans: list[tuple[int, int]], times: np.ndarray) -> pd.DataFrame:
+    """Join segment tables, renaming each segment's balls to the first segment's by position on the overlap."""
+    z = int(parts[0].ball.max()) + 1
+    grids = []
+    for part in parts:
+        if int(part.ball.max()) + 1 != z:
+            raise TrackingError("video", "segments saw different ball counts; track with threads=1.")
+        grids.append({c: part[c].to_numpy().reshape(-1, z) for c in ("u_px", "v_px", "mass")})
+    out = {c: grids[0][c] for c in ("u_px", "v_px", "mass")}
+    for (a, _), g in zip(spans[1:], grids[1:], strict=True):
+        prev_u, prev_v = out["u_px"][a:], out["v_px"][a:]
+        d = np.nanmedian(np.hypot(prev_u[:, :, None] - g["u_px"][: len(prev_u), None, :],
+                                  prev_v[:, :, None] - g["v_px"][: len(prev_v), None, :]), axis=0)
+        mapping = np.argmin(np.nan_to_num(d, nan=np.inf), axis=1)  # previous ball -> this segment's column
+        if len(set(mapping.tolist())) != z:
+            raise TrackingError("video", "could not match ball identities between segments; track with threads=1.")
+        for c in out:
+            out[c] = np.concatenate([out[c][:a], g[c][:, mapping]])
+    n = len(times)
+    return pd.DataFrame({
+        "frame": np.repeat(np.arange(n), z), "time_s": np.repeat(times, z), "ball": np.tile(np.arange(z), n),
+        "u_px": out["u_px"].ravel(), "v_px": out["v_px"].ravel(), "mass": out["mass"].ravel(),
+        "detected": np.isfinite(out["u_px"]).ravel(),
+    })
 
 
 def _stem(path: Path) -> str:
@@ -199,8 +268,8 @@ def _finish(path: Path, video: FrameSource, table: pd.DataFrame, loc: BearingLoc
         config={"tracking": options.to_dict(), "conditions": conditions.to_dict(), "bearing": bearing.to_dict(),
                 "video": meta.to_dict() | {"extra": {}}},
         video=VideoInfo(fps=float(fps), px_per_mm=float(px_per_mm), centre_px=orbit.centre,
-                        camera_roll_rad=roll, input_file=path.name, input_sha256=prov.inputs[0].sha256),
-        provenance=prov.finish().to_dict(),
+                        camera_roll_rad=roll, input_file=path.name, input_sha256=prov.finish().inputs[0].sha256),
+        provenance=prov.to_dict(),
         qc=qc.to_dict(),
     )
     return trace, qc

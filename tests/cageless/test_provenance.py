@@ -54,3 +54,16 @@ def test_atomic_write_text(tmp_path):
         raise KeyError("crash")
     assert target.read_text() == "hello"
     assert [p.name for p in target.parent.iterdir()] == ["out.txt"]
+
+
+def test_hash_cache_follows_the_file(tmp_path):
+    from cageless.provenance import cache_dir
+
+    p = tmp_path / "v.bin"
+    p.write_bytes(b"abc")
+    assert sha256_file(p) == SHA256_ABC
+    assert len(list((cache_dir() / "sha256").iterdir())) == 1
+    assert sha256_file(p) == SHA256_ABC  # from the cache
+    p.write_bytes(b"abcd")  # new size and mtime: a new key, a fresh hash
+    assert sha256_file(p) == "88d4266fd4e6338d13b845fcf289579d209c897823b9217da3e161936f031589"
+    assert sha256_file(p, cache=False) == sha256_file(p)

@@ -174,6 +174,13 @@ class FrameSource(abc.ABC):
         for a in range(start, stop, chunk_size):
             yield a, self[a:min(a + chunk_size, stop)]
 
+    def frame_view(self, index: int) -> np.ndarray:
+        """Frame ``index`` without copying where the format allows (memory-mapped cine); else a copy.
+
+        A view is read-only and valid while the source is open.
+        """
+        return self[index]
+
     def close(self) -> None:  # noqa: B027 - optional hook
         """Release the file handle (readers that hold one override this)."""
 

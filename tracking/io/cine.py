@@ -22,6 +22,7 @@ second copy), packed runs are unpacked by a compiled loop.
 
 from __future__ import annotations
 
+import mmap
 import struct
 from datetime import UTC, datetime
 from pathlib import Path
@@ -243,6 +244,24 @@ class CineReader(FrameSource):
             return _UNPACK[self._packed_bits](raw, self.width * self.height).reshape(self.height, self.width)
         frame = raw.view(self._dtype).reshape(self.height, self.width)
         return np.array(frame[::-1] if self._bottom_up else frame)
+
+    def frame_view(self, index: int) -> np.ndarray:
+        """A read-only view of frame ``index`` into the memory map (8/16-bit frames); a copy for packed ones."""
+        n = len(self)
+        if not -n <= index < n:
+            raise IndexError(f"frame {index} out of range for {n} frames of {self.path}")
+        if self._packed_bits:
+            return self._read(index % n)
+        start = int(self._data_start[index % n])
+        frame = self._mm[start:start + self._image_size].view(self._dtype).reshape(self.height, self.width)
+        return frame[::-1] if self._bottom_up else frame
+
+    def drop_pages(self) -> None:
+        """Unmap the file pages touched so far (they stay in the page cache); keeps memory bounded
+        while frame views stream through a long video."""
+        mm = getattr(self._mm, "_mmap", None)
+        if mm is not None and hasattr(mm, "madvise"):
+            mm.madvise(mmap.MADV_DONTNEED)
 
     def _read_range(self, start: int, stop: int) -> np.ndarray:
         n = stop - start

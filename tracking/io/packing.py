@@ -11,11 +11,16 @@ Vision Research's packed formats as read by PIMS (``pims/cine.py``) and pycine
 
 from __future__ import annotations
 
+import threading
+
 import numba
 import numpy as np
 import numpy.typing as npt
 
 __all__ = ["unpack10", "pack10", "unpack12", "pack12", "PACKED_BITS", "unpack_frames_into"]
+
+#: numba's default (workqueue) threading layer must not run two parallel kernels at once.
+_PARALLEL_LOCK = threading.Lock()
 
 #: biCompression code -> bits per pixel
 PACKED_BITS = {256: 10, 1024: 12}
@@ -113,4 +118,5 @@ def unpack_frames_into(buf: U8, starts: npt.NDArray[np.int64], out: U16, bits: i
         for k, s in enumerate(starts):
             out[k] = unpack(buf[s:s + n * bits // 8], n).reshape(out.shape[1:])
         return
-    (_unpack12_into if bits == 12 else _unpack10_into)(buf, starts, out)
+    with _PARALLEL_LOCK:
+        (_unpack12_into if bits == 12 else _unpack10_into)(buf, starts, out)
