@@ -1,8 +1,10 @@
 """Stage 6: quality control written beside the trace (DESIGN §8.7).
 
 Per video: detection rate per ball, the share of interpolated samples, the
-orbit-circle fit residual, the ball count found, and overlay images of chosen
-frames with ball numbers and the fitted circle. A warning is raised for any
+orbit-circle fit residual, the ball count found, overlay images of chosen
+frames with ball numbers and the fitted circle, and the slip profile against
+orbital angle (mean, spread and count per 1 deg bin over all balls and
+revolutions, ``<stem>.slip_profile.csv``). A warning is raised for any
 value out of bounds (:data:`QC_LIMITS`).
 """
 
@@ -20,6 +22,7 @@ import numpy as np
 import pandas as pd
 
 from cageless.atomic import atomic_path, atomic_write_text
+from cageless.profiles import angle_profile
 from cageless.trace import Trace
 from tracking.geometry import Orbit
 from tracking.io import open_video
@@ -134,6 +137,8 @@ def write_qc(qc_dir: Path, stem: str, video_path: Path, qc: QCReport, table: pd.
             written.append(target)
     qc.overlays = [p.name for p in written]
     atomic_write_text(qc_dir / f"{stem}.qc.json", json.dumps(qc.to_dict(), indent=1, default=float))
+    profile = angle_profile(trace.angle, trace.slip, 1.0, trace.valid)
+    atomic_write_text(qc_dir / f"{stem}.slip_profile.csv", profile.to_csv(index=False, float_format="%.6g"))
     return written
 
 

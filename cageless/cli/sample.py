@@ -13,7 +13,7 @@ __all__ = ["register", "run"]
 _EXAMPLES = """\
 examples:
   cageless sample my_lab                         the small three-condition sample (as in sample_data/lab)
-  cageless sample big --preset full --workers 2  full-size 1280x800, 10 kfps packed 12-bit cines
+  cageless sample big --preset full --workers 2  full-size 1280x800, 10 kfps 12-bit cines
   cageless sample my_lab --revolutions 1 --seed 7
 """
 

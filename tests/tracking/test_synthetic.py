@@ -186,4 +186,4 @@ def test_full_preset_renders_the_papers_camera(tmp_path):
     results = make_lab(tmp_path, preset="full", revolutions=0.005, progress=False)
     with open_video(results[0]["video"]) as video:
         assert video.frame_shape == (800, 1280) and video.metadata.bit_depth == 12
-        assert video.metadata.storage.startswith("packed 12-bit")
+        assert video.metadata.storage == "16-bit words"

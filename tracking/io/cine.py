@@ -256,12 +256,16 @@ class CineReader(FrameSource):
         frame = self._mm[start:start + self._image_size].view(self._dtype).reshape(self.height, self.width)
         return frame[::-1] if self._bottom_up else frame
 
-    def drop_pages(self) -> None:
-        """Unmap the file pages touched so far (they stay in the page cache); keeps memory bounded
-        while frame views stream through a long video."""
+    def drop_pages(self, first: int, last: int) -> None:
+        """Unmap the file pages of frames ``first..last`` (they stay in the page cache), keeping the
+        resident memory bounded while frame views stream through a long video."""
         mm = getattr(self._mm, "_mmap", None)
-        if mm is not None and hasattr(mm, "madvise"):
-            mm.madvise(mmap.MADV_DONTNEED)
+        if mm is None or not hasattr(mm, "madvise") or len(self) == 0:
+            return
+        lo = int(self._data_start[max(min(first, last), 0)])
+        hi = int(self._data_start[min(max(first, last), len(self) - 1)]) + self._image_size
+        lo -= lo % mmap.PAGESIZE
+        mm.madvise(mmap.MADV_DONTNEED, lo, min(hi, self._size) - lo)
 
     def _read_range(self, start: int, stop: int) -> np.ndarray:
         n = stop - start

@@ -19,7 +19,8 @@ Two presets:
 
 ``full``
     Full-size footage for benchmarks: 1280 x 800 px at 12.5 px/mm (the paper's
-    camera), 10,000 fps, packed 12-bit cine, the same three conditions.
+    camera), 10,000 fps, 12-bit data in 16-bit cine words (how Phantom Camera
+    Control saves by default), the same three conditions.
 """
 
 from __future__ import annotations
@@ -71,11 +72,11 @@ PRESETS: dict[str, list[ClipSpec]] = {
                  Appearance(dropped_frame_rate=0.02, highlight_peak=1.05)),
     ],
     "full": [
-        ClipSpec("n1800_Fr500_Fa0.cine", 1800, "cine-p12", "name", replace(_FULL, roll_deg=1.0),
+        ClipSpec("n1800_Fr500_Fa0.cine", 1800, "cine-16", "name", replace(_FULL, roll_deg=1.0),
                  Appearance(dropout_rate=0.01, n_hot_pixels=40)),
-        ClipSpec("n3000_Fr500_Fa0.cine", 3000, "cine-p12", "name", replace(_FULL, centre_offset_px=(25.0, -12.0)),
+        ClipSpec("n3000_Fr500_Fa0.cine", 3000, "cine-16", "name", replace(_FULL, centre_offset_px=(25.0, -12.0)),
                  Appearance()),
-        ClipSpec("n6000_Fr500_Fa0.cine", 6000, "cine-p12", "name", _FULL, Appearance(dropped_frame_rate=0.01)),
+        ClipSpec("n6000_Fr500_Fa0.cine", 6000, "cine-16", "name", _FULL, Appearance(dropped_frame_rate=0.01)),
     ],
 }
 

@@ -1,0 +1,46 @@
+"""``cageless bench``: what accuracy costs in time (prints tables; not tests)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any
+
+__all__ = ["register", "run"]
+
+_EXAMPLES = """\
+examples:
+  cageless bench tracking                       render 2400 full-size frames once, then measure
+  cageless bench tracking --frames 600 --json bench.json
+"""
+
+
+def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
+    """Add the ``bench`` subcommand."""
+    p = subparsers.add_parser(
+        "bench", parents=[parent], help="accuracy-versus-time studies (tables)",
+        description="Measure what accuracy costs in time. 'tracking': end-to-end frames/s on full-size "
+        "footage, detector and smoothing-window trade-offs, trackpy on the same frames, peak memory.",
+        epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("study", choices=("tracking",), help="which study to run")
+    p.add_argument("--dir", default="bench_footage", help="where rendered footage is kept (default ./bench_footage)")
+    p.add_argument("--frames", type=int, default=2400, help="frames of full-size footage (default 2400, 4.9 GB)")
+    p.add_argument("--repeats", type=int, default=3, help="timing repeats, best taken (default 3)")
+    p.add_argument("--json", help="also write the results as JSON")
+
+
+def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
+    """Run the study and print its tables."""
+    from tracking.bench import format_tables, run_benchmark
+
+    folder = Path(args.dir)
+    folder.mkdir(parents=True, exist_ok=True)
+    result = run_benchmark(folder, args.frames, args.repeats)
+    print(format_tables(result))
+    if args.json:
+        from cageless.atomic import atomic_write_text
+
+        atomic_write_text(args.json, json.dumps(result, indent=1))
+    return 0
