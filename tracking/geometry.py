@@ -18,6 +18,7 @@ import numpy as np
 import numpy.typing as npt
 import pandas as pd
 
+from cageless.balls import ball_order, normalise_unwrapped
 from tracking.locate import fit_circle
 
 __all__ = ["Orbit", "fit_orbit", "orbital_angles"]
@@ -99,19 +100,5 @@ def orbital_angles(table: pd.DataFrame, orbit: Orbit, roll_rad: float = 0.0
     direction = -1 if travel < 0 else 1
     if direction == -1:
         angle = np.pi - angle
-    order = _ball_order(angle[0])
-    angle, ok = angle[:, order], ok[:, order]
-    # Ball 0 starts in [0, 2 pi); each next ball starts ahead of the previous one.
-    angle -= 2 * np.pi * np.floor(angle[0, 0] / (2 * np.pi))
-    for j in range(1, angle.shape[1]):
-        angle[:, j] -= 2 * np.pi * np.floor((angle[0, j] - angle[0, j - 1]) / (2 * np.pi))
-    return angle, ok, direction, order
-
-
-def _ball_order(first: np.ndarray) -> np.ndarray:
-    """Columns in counter-clockwise order, starting with the ball just after the largest gap (DESIGN §3)."""
-    a = np.mod(first, 2 * np.pi)
-    ccw = np.argsort(a)
-    gaps = np.diff(np.concatenate([a[ccw], [a[ccw][0] + 2 * np.pi]]))
-    start = (int(np.argmax(gaps)) + 1) % len(ccw)
-    return np.roll(ccw, -start)
+    order = ball_order(angle[0])
+    return normalise_unwrapped(angle[:, order]), ok[:, order], direction, order

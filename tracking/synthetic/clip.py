@@ -23,6 +23,7 @@ from tqdm.auto import tqdm
 
 from cageless._version import __version__
 from cageless.atomic import atomic_write_text
+from cageless.balls import ball_order, normalise_unwrapped
 from cageless.errors import ParameterError
 from cageless.kinematics import theoretical_cage_speed
 from cageless.units import rpm_to_rad_s
@@ -150,14 +151,8 @@ def render_clip(
 def _number_balls(motion: BallMotion) -> BallMotion:
     """Renumber balls as DESIGN §3 does: counter-clockwise from the ball just after the largest gap at the
     start, ball 0's angle in [0, 2 pi) and each next ball ahead of the previous one."""
-    a0 = np.mod(motion.angle[0], 2 * np.pi)
-    ccw = np.argsort(a0)
-    gaps = np.diff(np.concatenate([a0[ccw], [a0[ccw][0] + 2 * np.pi]]))
-    order = np.roll(ccw, -((int(np.argmax(gaps)) + 1) % len(ccw)))
-    angle = motion.angle[:, order].copy()
-    angle -= 2 * np.pi * np.floor(angle[0, 0] / (2 * np.pi))
-    for j in range(1, angle.shape[1]):
-        angle[:, j] -= 2 * np.pi * np.floor((angle[0, j] - angle[0, j - 1]) / (2 * np.pi))
+    order = ball_order(motion.angle[0])
+    angle = normalise_unwrapped(motion.angle[:, order])
     return BallMotion(times=motion.times, angle=angle, radius=motion.radius[:, order], ring_angle=motion.ring_angle,
                       ring_offset=motion.ring_offset, direction=motion.direction)
 
