@@ -1,0 +1,189 @@
+"""The validated table of effects, and how a scene chooses among them (DESIGN §6).
+
+Every effect is one row of :data:`EFFECTS`: a name, the physics, and the rule
+that switches it on for a scene, with the reason in words. :func:`choose_model`
+applies the rules, then the user's overrides:
+
+* a misspelled effect or level gets a suggestion;
+* switching on an effect the scene has nothing to compute for (a lubricant
+  effect in a dry scene) is always an error;
+* any other override that contradicts the scene (planar under axial load,
+  gravity on at g = 0, race contact off) is an error unless ``force`` is given,
+  and the choice then records that it was forced.
+
+An effect that is off is never evaluated: the right-hand side is assembled from
+the effects that are on (see the simulator issue's numerics).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Mapping
+from dataclasses import asdict, dataclass
+
+from cageless.errors import UsageError, suggest
+from simulation.scene import Scene
+
+__all__ = [
+    "EffectSpec", "EffectChoice", "ModelChoice", "EFFECTS", "LEVELS", "choose_model", "parse_effect_overrides",
+    "describe_table",
+]
+
+LEVELS = ("planar", "spatial")
+
+
+@dataclass(frozen=True)
+class EffectSpec:
+    """One row of the effects table."""
+
+    name: str
+    physics: str
+    rule: Callable[[Scene], tuple[bool, str]]
+    needs_lubricant: bool = False
+
+
+def _always(what: str) -> Callable[[Scene], tuple[bool, str]]:
+    return lambda s: (True, what)
+
+
+def _lubricated(s: Scene) -> tuple[bool, str]:
+    return (True, "the scene is lubricated") if s.lubricated else (False, "dry scene: no lubricant")
+
+
+def _gravity(s: Scene) -> tuple[bool, str]:
+    return (True, f"g = {s.gravity_m_s2:g} m/s^2") if s.gravity_m_s2 > 0 else (False, "g = 0")
+
+
+def _drag(s: Scene) -> tuple[bool, str]:
+    rho = s.oil_air_density_kg_m3
+    return (True, f"oil-air mixture of {rho:g} kg/m^3") if rho is not None else (False, "no oil-air mixture given")
+
+
+EFFECTS: tuple[EffectSpec, ...] = (
+    EffectSpec("race_contact", "Hertz point contact Q = K delta^1.5 between ball and inner/outer groove",
+               _always("balls always touch the races")),
+    EffectSpec("lubricant_damping", "normal damping C_ho d(delta)/dt at race contacts, never tensile", _lubricated,
+               needs_lubricant=True),
+    EffectSpec("race_traction", "traction mu(slip) at race contacts (dry: Coulomb-Stribeck)",
+               _always("traction drives the balls")),
+    EffectSpec("ehl_film", "Hamrock-Dowson central and minimum film at race contacts", _lubricated,
+               needs_lubricant=True),
+    EffectSpec("ball_ball_contact", "Hertz contact between neighbours with hysteresis damping (restitution R) "
+               "and friction from the surface sliding speed", _always("no cage: neighbours meet")),
+    EffectSpec("ball_ball_film", "squeeze film between neighbouring balls", _lubricated, needs_lubricant=True),
+    EffectSpec("gravity", "m g on balls and ring", _gravity),
+    EffectSpec("drag", "1/2 C_D rho A V^2 on the orbit and a churning moment on the spin", _drag),
+)
+_BY_NAME = {e.name: e for e in EFFECTS}
+
+
+@dataclass(frozen=True)
+class EffectChoice:
+    """Whether one effect is on, and why."""
+
+    name: str
+    on: bool
+    reason: str
+    forced: bool = False
+
+
+@dataclass(frozen=True)
+class ModelChoice:
+    """The model level and the effects a scene uses, each with its reason."""
+
+    level: str
+    level_reason: str
+    effects: tuple[EffectChoice, ...]
+
+    @property
+    def active(self) -> tuple[str, ...]:
+        """Names of the effects that are on."""
+        return tuple(e.name for e in self.effects if e.on)
+
+    def to_json(self) -> str:
+        """The choice as JSON (stored as ``effects_json`` in simulation traces)."""
+        return json.dumps({"level": self.level, "level_reason": self.level_reason,
+                           "effects": [asdict(e) for e in self.effects]}, sort_keys=True)
+
+    def explain(self) -> str:
+        """Human-readable lines: the level and each effect with its reason."""
+        lines = [f"level: {self.level} ({self.level_reason})"]
+        for e in self.effects:
+            tag = "on " if e.on else "off"
+            lines.append(f"  {tag} {e.name:<18} {e.reason}{' [forced]' if e.forced else ''}")
+        return "\n".join(lines)
+
+
+def _scene_level(s: Scene) -> tuple[str, str]:
+    why = []
+    if s.conditions.axial_load_n > 0:
+        why.append(f"axial load {s.conditions.axial_load_n:g} N")
+    if s.misalignment_rad > 0:
+        why.append(f"misalignment {s.misalignment_rad:g} rad")
+    if s.moment_load_nm > 0:
+        why.append(f"moment load {s.moment_load_nm:g} N m")
+    if s.orientation == "vertical" and s.gravity_m_s2 > 0:
+        why.append("gravity along the shaft (vertical shaft)")
+    if why:
+        return "spatial", "needed for " + ", ".join(why)
+    return "planar", "pure radial load on an aligned bearing: ball centres stay in the mid-plane"
+
+
+def choose_model(scene: Scene, level: str | None = None, effects: Mapping[str, bool] | None = None,
+                 force: bool = False) -> ModelChoice:
+    """Decide the model level and effects for ``scene``, then apply the user's overrides.
+
+    Raises
+    ------
+    UsageError
+        For an unknown level or effect (with a suggestion), an effect that needs a lubricant in a dry
+        scene, or an override that contradicts the scene without ``force``.
+    """
+    auto_level, level_reason = _scene_level(scene)
+    chosen_level = auto_level
+    if level is not None:
+        if level not in LEVELS:
+            raise UsageError(f"--level {level}: unknown level." + (suggest(level, LEVELS) or f" Use {LEVELS}."))
+        if level != auto_level:
+            if level == "planar" and not force:
+                raise UsageError(f"--level planar contradicts the scene: the spatial level is {level_reason}. "
+                                 "Add --force to run the planar model anyway.")
+            level_reason = f"forced by the user (the scene alone gives {auto_level}: {level_reason})"
+        chosen_level = level
+    choices = []
+    overrides = dict(effects or {})
+    for name in overrides:
+        if name not in _BY_NAME:
+            raise UsageError(f"--effect {name}: unknown effect." + (suggest(name, _BY_NAME) or
+                             f" Effects: {', '.join(_BY_NAME)}."))
+    for spec in EFFECTS:
+        on, reason = spec.rule(scene)
+        if spec.name in overrides and overrides[spec.name] != on:
+            want = overrides[spec.name]
+            if want and spec.needs_lubricant and not scene.lubricated:
+                raise UsageError(f"--effect {spec.name}=on needs a lubricant, and the bearing is dry.")
+            if not force:
+                raise UsageError(f"--effect {spec.name}={'on' if want else 'off'} contradicts the scene "
+                                 f"({reason}). Add --force to override.")
+            choices.append(EffectChoice(spec.name, want, f"forced {'on' if want else 'off'} by the user "
+                                        f"(the scene alone: {reason})", forced=True))
+        else:
+            choices.append(EffectChoice(spec.name, on, reason))
+    return ModelChoice(level=chosen_level, level_reason=level_reason, effects=tuple(choices))
+
+
+def parse_effect_overrides(items: list[str]) -> dict[str, bool]:
+    """Parse ``NAME=on|off`` strings from the command line."""
+    out: dict[str, bool] = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        if not sep or value.lower() not in ("on", "off"):
+            raise UsageError(f"--effect {item}: write NAME=on or NAME=off.")
+        out[name.strip()] = value.lower() == "on"
+    return out
+
+
+def describe_table() -> list[dict[str, str]]:
+    """The effects table as rows (name, physics), for docs and reports."""
+    return [{"name": e.name, "physics": e.physics} for e in EFFECTS]
+

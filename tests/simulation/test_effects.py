@@ -1,0 +1,86 @@
+"""The effects table: what each scene switches on, the reasons, and overrides (DESIGN §6)."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import pytest
+
+from cageless.bearing import default_bearing
+from cageless.cli import main
+from cageless.conditions import OperatingConditions
+from cageless.errors import ParameterError, UsageError
+from simulation.effects import EFFECTS, choose_model
+from simulation.scene import Scene
+
+
+def scene(**kw):
+    cond = kw.pop("conditions", OperatingConditions(3000.0, 500.0))
+    return Scene(conditions=cond, **kw)
+
+
+def test_radial_lubricated_scene():
+    c = choose_model(scene())
+    assert c.level == "planar"
+    assert c.active == ("race_contact", "lubricant_damping", "race_traction", "ehl_film", "ball_ball_contact",
+                        "ball_ball_film", "gravity")
+    assert {e.name: e.reason for e in c.effects}["drag"] == "no oil-air mixture given"
+
+
+def test_scene_rules():
+    dry = scene(bearing=dataclasses.replace(default_bearing(), lubricant=None), gravity_m_s2=0.0,
+                oil_air_density_kg_m3=4.0)
+    c = choose_model(dry)
+    assert set(c.active) == {"race_contact", "race_traction", "ball_ball_contact", "drag"}
+    axial = choose_model(scene(conditions=OperatingConditions(3000.0, 500.0, 300.0)))
+    assert axial.level == "spatial" and "axial load 300 N" in axial.level_reason
+    assert choose_model(scene(misalignment_rad=1e-3)).level == "spatial"
+    assert choose_model(scene(orientation="vertical")).level == "spatial"
+
+
+def test_overrides():
+    with pytest.raises(UsageError, match="Did you mean 'gravity'"):
+        choose_model(scene(), effects={"gravty": False})
+    with pytest.raises(UsageError, match="contradicts the scene.*--force"):
+        choose_model(scene(), effects={"gravity": False})
+    c = choose_model(scene(), effects={"gravity": False}, force=True)
+    assert not dict((e.name, e.on) for e in c.effects)["gravity"]
+    assert [e.forced for e in c.effects if e.name == "gravity"] == [True]
+    with pytest.raises(UsageError, match="needs a lubricant"):
+        choose_model(scene(bearing=dataclasses.replace(default_bearing(), lubricant=None)),
+                     effects={"ehl_film": True}, force=True)
+    axial = scene(conditions=OperatingConditions(3000.0, 0.0, 300.0))
+    with pytest.raises(UsageError, match="--level planar contradicts the scene"):
+        choose_model(axial, level="planar")
+    assert choose_model(axial, level="planar", force=True).level == "planar"
+    assert choose_model(scene(), level="spatial").level == "spatial"  # more general: allowed
+    with pytest.raises(UsageError, match="Did you mean 'planar'"):
+        choose_model(scene(), level="planr")
+
+
+def test_impossible_scenes_fail_before_anything_runs():
+    with pytest.raises(ParameterError, match="speed_rpm"):
+        OperatingConditions(0.0)
+    with pytest.raises(ParameterError, match="scene.duration_s"):
+        scene(duration_s=float("nan"))
+    with pytest.raises(ParameterError, match="scene.gravity_m_s2"):
+        scene(gravity_m_s2=-1.0)
+
+
+def test_every_effect_has_a_rule_and_physics():
+    assert len({e.name for e in EFFECTS}) == len(EFFECTS) == 8
+    for e in EFFECTS:
+        on, reason = e.rule(scene())
+        assert isinstance(on, bool) and reason and e.physics
+
+
+def test_simulate_explain_cli(capsys):
+    assert main(["simulate", "--speed-rpm", "3000", "--radial-load-n", "500", "--axial-load-n", "400",
+                 "--explain", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["level"] == "spatial" and len(d["effects"]) == 8
+    assert main(["simulate", "--speed-rpm", "3000", "--effect", "drag=maybe", "--explain"]) == 2
+    assert "write NAME=on or NAME=off" in capsys.readouterr().err
+    assert main(["simulate", "--speed-rpm", "3000"]) == 2
+    assert "--explain" in capsys.readouterr().err
