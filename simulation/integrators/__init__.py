@@ -1,0 +1,1 @@
+"""Compiled integrators (see :mod:`simulation.solve` for the public entry point)."""

@@ -1,0 +1,1 @@
+"""Dynamical models assembled from the force laws of :mod:`simulation.forces`."""

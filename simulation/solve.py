@@ -1,0 +1,136 @@
+"""One entry point over a registry of integrators, like ``scipy.integrate.solve_ivp``.
+
+:func:`solve` runs a :class:`Problem` with the method named in :data:`METHODS`:
+
+* ``"dp5"``: Dormand-Prince 5(4) with its whole loop compiled (the default);
+* ``"RK45"``, ``"DOP853"``, ``"LSODA"``, ``"BDF"``, ``"Radau"``: ``scipy.integrate.solve_ivp``
+  on the same compiled right-hand side, as references (``post_step`` is not called by these).
+
+It returns a :class:`Solution` carrying the status, a message, and the solver
+statistics; a failure is a result with ``success = False``, never an exception.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+from scipy.integrate import solve_ivp
+
+from cageless.errors import ParameterError, suggest
+from simulation.integrators.dp5 import STATUS_OK, dp5_integrate
+
+__all__ = ["Problem", "Solution", "METHODS", "solve"]
+
+FloatArray = npt.NDArray[np.float64]
+_MESSAGES = {0: "reached the end", 1: "too many steps", 2: "step size underflow", 3: "the state became non-finite"}
+
+
+@dataclass(frozen=True)
+class Problem:
+    """An initial-value problem with a compiled right-hand side ``rhs(t, y, p, aux, dydt)``."""
+
+    rhs: Any
+    post_step: Any
+    params: FloatArray
+    aux: FloatArray
+    y0: FloatArray
+    t0: float
+    atol: FloatArray
+    name: str = "problem"
+
+
+@dataclass
+class Solution:
+    """What a solve returned: samples, status and statistics."""
+
+    t: FloatArray
+    y: FloatArray
+    status: int
+    message: str
+    method: str
+    n_steps: int = 0
+    n_rejected: int = 0
+    n_rhs: int = 0
+    wall_s: float = 0.0
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def success(self) -> bool:
+        """True when the integration reached the last requested time."""
+        return self.status == STATUS_OK
+
+
+def _solve_dp5(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float, first_step: float | None,
+               max_steps: int) -> Solution:
+    out = np.full((len(t_eval), len(pr.y0)), np.nan)
+    stats = np.zeros(4)
+    aux = pr.aux.copy()
+    h0 = first_step or min(max_step, 1e-3 * max(t_eval[-1] - pr.t0, 1e-12))
+    t0 = time.perf_counter()
+    status = dp5_integrate(pr.rhs, pr.post_step, pr.params, aux, pr.y0.astype(np.float64), float(pr.t0), t_eval,
+                           float(rtol), pr.atol.astype(np.float64), float(h0), float(max_step), int(max_steps), out,
+                           stats)
+    return Solution(t=t_eval, y=out, status=int(status), message=_MESSAGES[int(status)], method="dp5",
+                    n_steps=int(stats[0]), n_rejected=int(stats[1]), n_rhs=int(stats[2]),
+                    wall_s=time.perf_counter() - t0, extra={"aux": aux, "last_h": float(stats[3])})
+
+
+def _scipy(method: str) -> Callable[..., Solution]:
+    def run(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float, first_step: float | None,
+            max_steps: int) -> Solution:
+        aux = pr.aux.copy()
+        buf = np.empty(len(pr.y0))
+        count = [0]
+
+        def fun(t: float, y: FloatArray) -> FloatArray:
+            count[0] += 1
+            pr.rhs(t, y, pr.params, aux, buf)
+            return buf.copy()
+
+        t0 = time.perf_counter()
+        kw: dict[str, Any] = {"max_step": max_step}
+        if first_step:
+            kw["first_step"] = first_step
+        res = solve_ivp(fun, (pr.t0, float(t_eval[-1])), pr.y0, method=method, t_eval=t_eval, rtol=rtol,
+                        atol=pr.atol, **kw)
+        y = np.full((len(t_eval), len(pr.y0)), np.nan)
+        y[: res.y.shape[1]] = res.y.T
+        return Solution(t=t_eval, y=y, status=0 if res.success else 3, message=res.message, method=method,
+                        n_steps=int(len(res.t)), n_rhs=count[0], wall_s=time.perf_counter() - t0)
+
+    return run
+
+
+METHODS: dict[str, Callable[..., Solution]] = {
+    "dp5": _solve_dp5,
+    **{m: _scipy(m) for m in ("RK45", "DOP853", "LSODA", "BDF", "Radau")},
+}
+
+
+def solve(problem: Problem, t_eval: npt.ArrayLike, method: str = "dp5", rtol: float = 1e-6,
+          max_step: float = np.inf, first_step: float | None = None, max_steps: int = 50_000_000) -> Solution:
+    """Integrate ``problem`` and sample it at ``t_eval``.
+
+    Raises
+    ------
+    ParameterError
+        For an unknown method (with a suggestion) or bad tolerances or times, before anything runs.
+    """
+    if method not in METHODS:
+        raise ParameterError("method", "is not a solver" + (suggest(method, METHODS) or f"; use one of {list(METHODS)}"),
+                             method)
+    if not (0 < rtol < 1):
+        raise ParameterError("rtol", "must lie in (0, 1)", rtol)
+    if not (max_step > 0):
+        raise ParameterError("max_step", "must be > 0", max_step)
+    t = np.asarray(t_eval, dtype=np.float64)
+    if t.ndim != 1 or len(t) == 0 or t[0] < problem.t0 or np.any(np.diff(t) <= 0):
+        raise ParameterError("t_eval", f"must be increasing times >= t0 = {problem.t0}")
+    if problem.atol.shape != problem.y0.shape or np.any(problem.atol <= 0):
+        raise ParameterError("atol", "must be positive, one per state")
+    return METHODS[method](problem, t, rtol, float(max_step), first_step, int(max_steps))
