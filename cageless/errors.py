@@ -20,6 +20,7 @@ __all__ = [
     "TraceFormatError",
     "VideoError",
     "TrackingError",
+    "SolverError",
     "UsageError",
     "suggest",
 ]
@@ -129,6 +130,10 @@ class VideoError(_PathError):
 
 class TrackingError(_PathError):
     """A video was read but could not be tracked (no bearing in view, too short, wrong ball count...)."""
+
+
+class SolverError(CagelessError):
+    """A numerical solve failed (no convergence, non-finite state)."""
 
 
 class UsageError(CagelessError):
