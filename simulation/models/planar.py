@@ -1,18 +1,21 @@
 """The planar cageless-bearing model (DESIGN §6, pure radial load on an aligned bearing).
 
-States (n = 5 Z + 4): per ball j the orbital radius r_j, angle theta_j, their
+States (n = 5 Z + 5): per ball j the orbital radius r_j, angle theta_j, their
 rates, and the spin omega_j about the shaft axis; then the inner-ring centre
-(y, z) and its velocity. The ring's rotation is prescribed.
+(y, z) and its velocity; last, the energy dissipated so far (J), so the energy
+balance can be checked. The ring's rotation is prescribed.
 
-In this release the model carries the conservative effects and ball-ball
-damping: Hertz race contacts (ball to outer groove: delta = r + D/2 - d_o/2;
+In this release the model carries the conservative effects, ball-ball damping
+and lubricant damping at the race contacts (C_ho d(delta)/dt, the total normal
+force never tensile; default C_ho = 5000 N s/m, the middle of the 2500-7500 N s/m
+range of the paper's sensitivity study, Wang et al. 2026 §4): Hertz race contacts (ball to outer groove: delta = r + D/2 - d_o/2;
 ball to the displaced inner groove: delta = d_i/2 + D/2 - |P - C|), Hertz
 ball-ball contact with restitution-calibrated damping
 (:func:`simulation.forces.hertz_damped`), gravity on balls and ring, and the
 radial load on the ring (toward -z). The centrifugal force is not an effect: it
 comes out of the polar equations, r'' = F_r / m + r theta'^2. Race traction,
-lubricant damping, films and drag are the next slice (their parameter set must
-be cited first); the effect flags already gate every term.
+films and drag are the next slice (their parameter set must be cited first); the
+effect flags already gate every term.
 """
 
 from __future__ import annotations
@@ -29,12 +32,15 @@ from simulation.forces import damping_factor, hertz_damped
 from simulation.hertz import ball_ball_contact, compliance, hertz_contact, race_curvatures
 from simulation.solve import Problem
 
-__all__ = ["PlanarLayout", "planar_problem", "planar_energy"]
+__all__ = ["PlanarLayout", "planar_problem", "planar_energy", "packed_start", "DEFAULT_CHO_N_S_M"]
 
 # Parameter vector layout.
 P_Z, P_D, P_M, P_I, P_MR, P_DI, P_DO, P_KI, P_KO, P_KB, P_CHI, P_G, P_FR, P_WI = range(14)
-P_F_RACE, P_F_BB, P_F_GRAV = 14, 15, 16
-N_PARAMS = 17
+P_F_RACE, P_F_BB, P_F_GRAV, P_F_LUB, P_CHO = 14, 15, 16, 17, 18
+N_PARAMS = 19
+
+#: Lubricant damping coefficient at the race contacts (N s/m): the middle of the paper's 2500-7500 range.
+DEFAULT_CHO_N_S_M = 5000.0
 
 
 @dataclass(frozen=True)
@@ -45,14 +51,15 @@ class PlanarLayout:
 
     @property
     def size(self) -> int:
-        """Number of states, 5 Z + 4."""
-        return 5 * self.n_balls + 4
+        """Number of states, 5 Z + 5."""
+        return 5 * self.n_balls + 5
 
     def slices(self) -> dict[str, slice]:
         """Named slices: r, theta, r_dot, theta_dot, spin, ring (y, z, y', z')."""
         z = self.n_balls
         return {"r": slice(0, z), "theta": slice(z, 2 * z), "r_dot": slice(2 * z, 3 * z),
-                "theta_dot": slice(3 * z, 4 * z), "spin": slice(4 * z, 5 * z), "ring": slice(5 * z, 5 * z + 4)}
+                "theta_dot": slice(3 * z, 4 * z), "spin": slice(4 * z, 5 * z), "ring": slice(5 * z, 5 * z + 4),
+                "dissipated": slice(5 * z + 4, 5 * z + 5)}
 
 
 @numba.njit(cache=True)
@@ -62,7 +69,9 @@ def _rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     ri_race, ro_race = 0.5 * p[P_DI], 0.5 * p[P_DO]
     k_i, k_o, k_b, chi, g, f_r = p[P_KI], p[P_KO], p[P_KB], p[P_CHI], p[P_G], p[P_FR]
     race_on, bb_on, grav_on = p[P_F_RACE] > 0.5, p[P_F_BB] > 0.5, p[P_F_GRAV] > 0.5
+    lub_on, c_ho = p[P_F_LUB] > 0.5, p[P_CHO]
     cy, cz, cvy, cvz = y[5 * z], y[5 * z + 1], y[5 * z + 2], y[5 * z + 3]
+    power = 0.0  # dissipated power (W)
     fy_ring = 0.0
     fz_ring = -f_r - (m_ring * g if grav_on else 0.0)
     for j in range(z):
@@ -78,20 +87,33 @@ def _rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
         fy = 0.0
         fz = -m * g if grav_on else 0.0
         if race_on:
+            rd, thd = y[2 * z + j], y[3 * z + j]
             d_o = r + 0.5 * d - ro_race
             if d_o > 0.0:
                 q = k_o * d_o**1.5
+                if lub_on:
+                    q_d = max(q + c_ho * rd, 0.0)  # d(delta_o)/dt = r'; never tensile
+                    power += (q_d - q) * rd
+                    q = q_d
                 fy -= q * c
                 fz -= q * s
             sx, sz = px - cy, pz - cz
             ln = np.sqrt(sx * sx + sz * sz)
             d_i = ri_race + 0.5 * d - ln
             if d_i > 0.0:
+                nx, nz = sx / ln, sz / ln
                 q = k_i * d_i**1.5
-                fy += q * sx / ln
-                fz += q * sz / ln
-                fy_ring -= q * sx / ln
-                fz_ring -= q * sz / ln
+                if lub_on:
+                    vx = rd * c - r * thd * s - cvy
+                    vz = rd * s + r * thd * c - cvz
+                    ddot = -(vx * nx + vz * nz)
+                    q_d = max(q + c_ho * ddot, 0.0)
+                    power += (q_d - q) * ddot
+                    q = q_d
+                fy += q * nx
+                fz += q * nz
+                fy_ring -= q * nx
+                fz_ring -= q * nz
         dydt[2 * z + j] += fy
         dydt[3 * z + j] += fz
     if bb_on:
@@ -114,6 +136,7 @@ def _rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
             if aux[j] <= 0.0:
                 aux[j] = max(delta_dot, 1e-9)
             f = hertz_damped(delta, delta_dot, aux[j], k_b, chi)
+            power += (f - k_b * delta**1.5) * delta_dot
             dydt[2 * z + j] -= f * nx
             dydt[3 * z + j] -= f * nz
             dydt[2 * z + k] += f * nx
@@ -132,6 +155,7 @@ def _rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     dydt[5 * z + 1] = cvz
     dydt[5 * z + 2] = fy_ring / m_ring
     dydt[5 * z + 3] = fz_ring / m_ring
+    dydt[5 * z + 4] = power
 
 
 @numba.njit(cache=True)
@@ -140,7 +164,7 @@ def _post(t, y, p, aux):  # pragma: no cover - compiled
 
 
 def _params(bearing: Bearing, radial_load_n: float, restitution: float, gravity_m_s2: float, inner_speed: float,
-            effects: dict[str, bool]) -> npt.NDArray[np.float64]:
+            effects: dict[str, bool], cho_n_s_m: float) -> npt.NDArray[np.float64]:
     g, mat, masses = bearing.geometry, bearing.material, bearing.masses
     eta = compliance(mat)
     rc = race_curvatures(g)
@@ -157,13 +181,15 @@ def _params(bearing: Bearing, radial_load_n: float, restitution: float, gravity_
     p[P_F_RACE] = float(effects.get("race_contact", True))
     p[P_F_BB] = float(effects.get("ball_ball_contact", True))
     p[P_F_GRAV] = float(effects.get("gravity", True))
+    p[P_F_LUB] = float(effects.get("lubricant_damping", bearing.lubricant is not None))
+    p[P_CHO] = cho_n_s_m
     return p
 
 
 def planar_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLike, ring0: tuple[float, float],
                    radial_load_n: float, restitution: float = 0.8, gravity_m_s2: float = 9.81,
                    inner_speed_rad_s: float = 0.0, effects: dict[str, bool] | None = None,
-                   atol_scale: float = 1.0) -> Problem:
+                   atol_scale: float = 1.0, cho_n_s_m: float = DEFAULT_CHO_N_S_M) -> Problem:
     """The planar model from a given state (balls at rest), as a :class:`~simulation.solve.Problem`.
 
     The absolute tolerances (0.1 nm on positions, 0.1 um/s on speeds) are multiplied by ``atol_scale``;
@@ -183,8 +209,9 @@ def planar_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLi
     atol[sl["theta_dot"]] = 1e-7 / (0.5 * g.pitch_diameter_m)
     atol[sl["spin"]] = 1e-6
     atol[sl["ring"]] = [1e-10, 1e-10, 1e-7, 1e-7]
+    atol[sl["dissipated"]] = 1e-9
     atol *= atol_scale
-    p = _params(bearing, radial_load_n, restitution, gravity_m_s2, inner_speed_rad_s, effects or {})
+    p = _params(bearing, radial_load_n, restitution, gravity_m_s2, inner_speed_rad_s, effects or {}, cho_n_s_m)
     return Problem(rhs=_rhs, post_step=_post, params=p, aux=np.zeros(g.n_balls), y0=y0, t0=0.0, atol=atol,
                    name="planar cageless bearing")
 
@@ -192,7 +219,8 @@ def planar_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLi
 def planar_energy(problem: Problem, y: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     """Total mechanical energy (J) along samples y (T, n): kinetic + Hertz + gravity + load potential.
 
-    Conserved when every active force is conservative (damping and traction off).
+    Conserved when every active force is conservative; with damping on, this plus the dissipated
+    energy (the last state) is conserved.
     """
     p = problem.params
     z = int(p[P_Z])
