@@ -19,7 +19,6 @@ data in 16-bit cine words, read from the page cache) it measures:
 
 from __future__ import annotations
 
-import json
 import math
 import subprocess
 import sys
@@ -220,19 +219,3 @@ def format_tables(r: dict[str, Any]) -> str:
         lines.append(f"  {s['window']:>6}{s['speed_rms_pct_vs_instantaneous']:>24.3f}{s['noise_pct']:>28.4f}"
                      f"{s['ms_per_1000_frames']:>16.2f}")
     return "\n".join(lines)
-
-
-def main(argv: list[str] | None = None) -> None:  # pragma: no cover - script entry
-    import argparse
-
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--dir", type=Path, default=Path("bench_footage"))
-    ap.add_argument("--frames", type=int, default=2400)
-    ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--json", type=Path)
-    args = ap.parse_args(argv)
-    args.dir.mkdir(parents=True, exist_ok=True)
-    result = run_benchmark(args.dir, args.frames, args.repeats)
-    print(format_tables(result))
-    if args.json:
-        args.json.write_text(json.dumps(result, indent=1))

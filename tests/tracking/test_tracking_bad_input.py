@@ -116,3 +116,13 @@ def test_cli_speed_for_a_bare_video(tmp_path, capsys):
     assert "no operating conditions found" in capsys.readouterr().out
     assert main(["track", str(video), "-o", str(tmp_path / "o"), "-q", "--speed-rpm", "3000"]) == 0
     assert main(["track", str(video), "-o", str(tmp_path / "o"), "--window", "4"]) == 2
+
+
+def test_tracking_is_deterministic(tmp_path):
+    """The same video and settings give the same trace (timestamps aside)."""
+    video = _clip(tmp_path / "det.cine", n=30)
+    a = track_video(video, COND, B, progress=False).trace
+    b = track_video(video, COND, B, progress=False).trace
+    for name in ("time", "angle", "speed", "slip", "valid"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+    assert a.video == b.video and a.config == b.config
