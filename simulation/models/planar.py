@@ -13,7 +13,11 @@ ball to the displaced inner groove: delta = d_i/2 + D/2 - |P - C|), Hertz
 ball-ball contact with restitution-calibrated damping
 (:func:`simulation.forces.hertz_damped`), gravity on balls and ring, and the
 radial load on the ring (toward -z). The centrifugal force is not an effect: it
-comes out of the polar equations, r'' = F_r / m + r theta'^2. Race traction,
+comes out of the polar equations, r'' = F_r / m + r theta'^2. Every ball-ball
+contact episode is logged after each accepted step (:func:`contact_events`):
+its onset, pair, orbital angle at the peak, peak force and duration, classed as
+rubbing when it lasts more than :data:`RUBBING_FACTOR` Hertz impact durations at
+its approach speed, else as an impact. Race traction,
 films and drag are the next slice (their parameter set must be cited first); the
 effect flags already gate every term.
 """
@@ -26,13 +30,17 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 import numpy.typing as npt
+import pandas as pd
 
 from cageless.bearing import Bearing
 from simulation.forces import damping_factor, hertz_damped
 from simulation.hertz import ball_ball_contact, compliance, hertz_contact, race_curvatures
 from simulation.solve import Problem
 
-__all__ = ["PlanarLayout", "planar_problem", "planar_energy", "packed_start", "DEFAULT_CHO_N_S_M"]
+__all__ = [
+    "PlanarLayout", "planar_problem", "planar_energy", "packed_start", "contact_events", "DEFAULT_CHO_N_S_M",
+    "RUBBING_FACTOR",
+]
 
 # Parameter vector layout.
 P_Z, P_D, P_M, P_I, P_MR, P_DI, P_DO, P_KI, P_KO, P_KB, P_CHI, P_G, P_FR, P_WI = range(14)
@@ -158,9 +166,63 @@ def _rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     dydt[5 * z + 4] = power
 
 
+# Auxiliary array layout: per pair j (between ball j and j+1):
+#   aux[j]           approach speed recorded at contact onset (used by the damping term)
+#   aux[Z + 4j + 0]  onset time (NaN when apart)
+#   aux[Z + 4j + 1]  peak force so far
+#   aux[Z + 4j + 2]  orbital angle of the pair's midpoint at the peak
+#   aux[Z + 4j + 3]  approach speed at onset (kept for classification)
+# then the event count and EVENT_FIELDS values per logged episode.
+EVENT_FIELDS = 6  # time, pair, angle, peak_force, duration, kind (0 impact, 1 rubbing)
+#: An episode longer than this many Hertz impact durations (at its approach speed) is rubbing.
+RUBBING_FACTOR = 3.0
+
+
+def aux_size(n_balls: int, capacity: int) -> int:
+    """Length of the auxiliary array for ``capacity`` logged contact episodes."""
+    return 5 * n_balls + 1 + EVENT_FIELDS * capacity
+
+
 @numba.njit(cache=True)
 def _post(t, y, p, aux):  # pragma: no cover - compiled
-    pass
+    z = int(p[P_Z])
+    if p[P_F_BB] < 0.5:
+        return
+    d, k_b, chi, m = p[P_D], p[P_KB], p[P_CHI], p[P_M]
+    base = 5 * z + 1
+    cap = (aux.shape[0] - base) // EVENT_FIELDS
+    for j in range(z):
+        k = j + 1 if j + 1 < z else 0
+        rj, tj, rk, tk = y[j], y[z + j], y[k], y[z + k]
+        dx = rk * np.cos(tk) - rj * np.cos(tj)
+        dz = rk * np.sin(tk) - rj * np.sin(tj)
+        delta = d - np.sqrt(dx * dx + dz * dz)
+        slot = z + 4 * j
+        if delta > 0.0:
+            f = k_b * delta**1.5
+            if np.isnan(aux[slot]):
+                aux[slot] = t
+                aux[slot + 1] = 0.0
+                aux[slot + 3] = aux[j]
+            if f > aux[slot + 1]:
+                aux[slot + 1] = f
+                aux[slot + 2] = 0.5 * (tj + tk + (2.0 * np.pi if k == 0 else 0.0))
+        elif not np.isnan(aux[slot]):
+            n = int(aux[base - 1])
+            if n < cap:
+                e = base + EVENT_FIELDS * n
+                duration = t - aux[slot]
+                v = max(aux[slot + 3], 1e-9)
+                dmax = (5.0 * (0.5 * m) * v * v / (4.0 * k_b)) ** 0.4
+                t_hertz = 2.943 * dmax / v
+                aux[e] = aux[slot]
+                aux[e + 1] = j
+                aux[e + 2] = aux[slot + 2] % (2.0 * np.pi)
+                aux[e + 3] = aux[slot + 1]
+                aux[e + 4] = duration
+                aux[e + 5] = 1.0 if duration > RUBBING_FACTOR * t_hertz else 0.0
+            aux[base - 1] = n + 1
+            aux[slot] = np.nan
 
 
 def _params(bearing: Bearing, radial_load_n: float, restitution: float, gravity_m_s2: float, inner_speed: float,
@@ -189,7 +251,8 @@ def _params(bearing: Bearing, radial_load_n: float, restitution: float, gravity_
 def planar_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLike, ring0: tuple[float, float],
                    radial_load_n: float, restitution: float = 0.8, gravity_m_s2: float = 9.81,
                    inner_speed_rad_s: float = 0.0, effects: dict[str, bool] | None = None,
-                   atol_scale: float = 1.0, cho_n_s_m: float = DEFAULT_CHO_N_S_M) -> Problem:
+                   atol_scale: float = 1.0, cho_n_s_m: float = DEFAULT_CHO_N_S_M,
+                   theta_dot0: npt.ArrayLike | None = None, event_capacity: int = 10_000) -> Problem:
     """The planar model from a given state (balls at rest), as a :class:`~simulation.solve.Problem`.
 
     The absolute tolerances (0.1 nm on positions, 0.1 um/s on speeds) are multiplied by ``atol_scale``;
@@ -202,6 +265,8 @@ def planar_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLi
     y0[sl["theta"]] = theta0
     y0[sl["r"]] = radius0
     y0[5 * g.n_balls:5 * g.n_balls + 2] = ring0
+    if theta_dot0 is not None:
+        y0[sl["theta_dot"]] = theta_dot0
     atol = np.empty(lay.size)
     atol[sl["r"]] = 1e-10
     atol[sl["theta"]] = 1e-10 / (0.5 * g.pitch_diameter_m)
@@ -212,8 +277,45 @@ def planar_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLi
     atol[sl["dissipated"]] = 1e-9
     atol *= atol_scale
     p = _params(bearing, radial_load_n, restitution, gravity_m_s2, inner_speed_rad_s, effects or {}, cho_n_s_m)
-    return Problem(rhs=_rhs, post_step=_post, params=p, aux=np.zeros(g.n_balls), y0=y0, t0=0.0, atol=atol,
+    aux = np.zeros(aux_size(g.n_balls, event_capacity))
+    aux[g.n_balls:5 * g.n_balls] = np.nan  # no contact episode open
+    aux[g.n_balls + 1:5 * g.n_balls:4] = 0.0
+    aux[g.n_balls + 2:5 * g.n_balls:4] = 0.0
+    aux[g.n_balls + 3:5 * g.n_balls:4] = 0.0
+    return Problem(rhs=_rhs, post_step=_post, params=p, aux=aux, y0=y0, t0=0.0, atol=atol,
                    name="planar cageless bearing")
+
+
+def contact_events(problem: Problem, aux: npt.NDArray[np.float64], t_end: float) -> pd.DataFrame:
+    """The ball-ball contact episodes as the trace's event table (DESIGN §4, ``EVENT_COLUMNS``).
+
+    Episodes still open at ``t_end`` are closed there (their duration is a lower bound). If more
+    episodes happened than the capacity, the table holds the first ones and ``attrs["dropped"]``
+    counts the rest.
+    """
+    p = problem.params
+    z = int(p[P_Z])
+    base = 5 * z + 1
+    n = int(aux[base - 1])
+    cap = (aux.shape[0] - base) // EVENT_FIELDS
+    rows = aux[base:base + EVENT_FIELDS * min(n, cap)].reshape(-1, EVENT_FIELDS)
+    still_open = []
+    for j in range(z):
+        slot = z + 4 * j
+        if not np.isnan(aux[slot]):
+            v = max(aux[slot + 3], 1e-9)
+            t_hertz = 2.943 * (5.0 * 0.5 * p[P_M] * v * v / (4.0 * p[P_KB])) ** 0.4 / v
+            duration = t_end - aux[slot]
+            still_open.append([aux[slot], j, aux[slot + 2] % (2 * np.pi), aux[slot + 1], duration,
+                               float(duration > RUBBING_FACTOR * t_hertz)])
+    if still_open:
+        rows = np.vstack([rows, np.array(still_open)])
+    table = pd.DataFrame({
+        "time": rows[:, 0], "pair": rows[:, 1].astype(np.int64), "angle": rows[:, 2], "peak_force": rows[:, 3],
+        "duration": rows[:, 4], "kind": np.where(rows[:, 5] > 0.5, "rubbing", "impact").astype(object),
+    })
+    table.attrs["dropped"] = max(0, n - cap)
+    return table
 
 
 def planar_energy(problem: Problem, y: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:

@@ -61,13 +61,14 @@ def reference_rhs(t: float, y: npt.NDArray[np.float64], p: npt.NDArray[np.float6
         nx, nz = dx / ln, dz / ln
         ddot = -((vx[k] - vx) * nx + (vz[k] - vz) * nz)
         touching = delta > 0
-        aux[~touching] = 0.0
-        new = touching & (aux <= 0)
-        aux[new] = np.maximum(ddot[new], 1e-9)
+        speeds = aux[:z]  # approach speeds (a view: updated in place)
+        speeds[~touching] = 0.0
+        new = touching & (speeds <= 0)
+        speeds[new] = np.maximum(ddot[new], 1e-9)
         chi = p[P.P_CHI]
         el = p[P.P_KB] * np.clip(delta, 0, None) ** 1.5
-        f = np.where(touching, np.maximum(el * (1 + (chi * ddot / np.where(aux > 0, aux, 1.0) if chi > 0 else 0)), 0),
-                     0.0)
+        f = np.where(touching, np.maximum(el * (1 + (chi * ddot / np.where(speeds > 0, speeds, 1.0) if chi > 0 else 0)),
+                                          0), 0.0)
         power += np.sum((f - el) * ddot * touching)
         np.add.at(fy, np.arange(z), -f * nx)
         np.add.at(fz, np.arange(z), -f * nz)
