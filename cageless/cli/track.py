@@ -125,11 +125,11 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
         for (video, *_), (status, info) in zip(jobs, results, strict=True):
             if status == "ok":
                 warn = f"; QC: {'; '.join(info['warnings'])}" if info["warnings"] else ""
-                print(f"ok     {video.name}: {info['frames']} frames, {info['balls']} balls, "
-                      f"{100 * info['detected']:.1f}% detected, peak unloaded slip {100 * info['peak_slip']:.2f}% "
-                      f"-> {info['path']}{warn}")
+                tqdm.write(f"ok     {video.name}: {info['frames']} frames, {info['balls']} balls, "
+                           f"{100 * info['detected']:.1f}% detected, peak unloaded slip "
+                           f"{100 * info['peak_slip']:.2f}% -> {info['path']}{warn}")
             else:
-                print(f"FAILED {video.name}: {info}")
+                tqdm.write(f"FAILED {video.name}: {info}")
                 failed += 1
     return 1 if failed else 0
 
