@@ -356,3 +356,4 @@ def packed_start(bearing: Bearing, seed: int = 0, spread: float = 0.05) -> npt.N
     gaps = phi + extra
     span = gaps.sum()
     return 1.5 * math.pi - 0.5 * span + np.concatenate([[0.0], np.cumsum(gaps)])
+

@@ -1,0 +1,69 @@
+"""`cageless simulate` end to end on the planar core: refusals, the trace it writes, and failures."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from cageless.cli import main
+from cageless.conditions import OperatingConditions
+from cageless.errors import UsageError
+from cageless.trace import read_trace
+from simulation.effects import choose_model
+from simulation.run import initial_state, simulate
+from simulation.scene import Scene
+
+FORCE_OFF = ["--effect", "race_traction=off", "--effect", "ehl_film=off", "--effect", "ball_ball_film=off", "--force"]
+
+
+def test_unsupported_effects_are_refused_with_the_way_out(tmp_path, capsys):
+    assert main(["simulate", "--speed-rpm", "3000", "--radial-load-n", "500", "-o", str(tmp_path / "x.h5")]) == 2
+    err = capsys.readouterr().err
+    assert "race_traction" in err and "--effect race_traction=off" in err
+    assert not (tmp_path / "x.h5").exists()
+    assert main(["simulate", "--speed-rpm", "3000", "--axial-load-n", "300"]) == 2
+    assert "spatial level" in capsys.readouterr().err
+
+
+def test_run_writes_a_simulation_trace(tmp_path, capsys):
+    out = tmp_path / "sim.trace.h5"
+    code = main(["simulate", "--speed-rpm", "3000", "--radial-load-n", "500", "--duration", "0.003", "-q",
+                 "-o", str(out), *FORCE_OFF])
+    assert code == 0
+    text = capsys.readouterr().out
+    assert "complete:" in text and "contact episodes" in text
+    tr = read_trace(out)
+    assert tr.source == "simulation" and tr.status == "complete"
+    assert tr.n_samples == 31 and tr.n_balls == 14
+    assert np.all(np.isfinite(tr.angle))
+    assert set(tr.groups) == {"balls", "contacts", "inner_ring"}
+    effects = {e["name"]: e for e in json.loads(tr.simulation.effects_json)["effects"]}
+    assert effects["race_traction"]["forced"] and not effects["race_traction"]["on"]
+    assert tr.simulation.solver == "dp5" and tr.simulation.n_steps > 0
+    assert tr.provenance["config"]["solver"]["rtol"] == 1e-6
+    # The ring carries the 500 N load plus its weight: it sits about 6 um below the centre.
+    assert tr.groups["inner_ring"]["position"][:, 2].mean() == pytest.approx(-6.3e-6, rel=0.2)
+
+
+def test_initial_state_is_quasi_static():
+    scene = Scene(conditions=OperatingConditions(3000.0, 500.0))
+    theta, radius, ring = initial_state(scene)
+    assert ring[1] < 0 and np.all(np.diff(theta) > 0)
+    assert radius.max() > 0.5 * scene.bearing.geometry.pitch_diameter_m  # loaded balls pushed outward
+
+
+def test_solver_failure_is_an_incomplete_trace(tmp_path):
+    scene = Scene(conditions=OperatingConditions(3000.0, 500.0), duration_s=0.002)
+    choice = choose_model(scene, effects={"race_traction": False, "ehl_film": False, "ball_ball_film": False},
+                          force=True)
+    out = tmp_path / "bad.trace.h5"
+    res = simulate(scene, choice, out=out, progress=False, max_steps=300)  # runs out of steps at ~0.3 ms
+    assert not res.solution.success
+    tr = read_trace(out)
+    assert tr.status.startswith("incomplete: ")
+    assert not tr.valid[-1].any()
+    with pytest.raises(UsageError):
+        simulate(Scene(conditions=OperatingConditions(3000.0, 500.0)),
+                 choose_model(Scene(conditions=OperatingConditions(3000.0, 500.0))), progress=False)
