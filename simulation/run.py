@@ -29,7 +29,8 @@ from simulation.hertz import compliance, hertz_contact, race_curvatures
 from simulation.models import planar as P
 from simulation.quasistatic import radial_load_distribution
 from simulation.scene import Scene
-from simulation.solve import Problem, Solution, solve
+from simulation.problem import Problem
+from simulation.solve import Solution, solve
 
 __all__ = ["IMPLEMENTED", "SimulationResult", "check_supported", "initial_state", "simulate"]
 
@@ -112,8 +113,8 @@ def _solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: 
     sol = None
     with tqdm(total=float(t[-1] - t[0]), desc="simulated s", unit="s", disable=not progress, leave=False) as bar:
         for a, b in zip(edges[:-1], edges[1:], strict=True):
-            part = Problem(rhs=pr.rhs, post_step=pr.post_step, params=pr.params, aux=aux, y0=y0, t0=t0,
-                           atol=pr.atol, name=pr.name)
+            part = Problem(model_id=pr.model_id, params=pr.params, aux=aux, y0=y0, t0=t0, atol=pr.atol,
+                           name=pr.name)
             sol = solve(part, t[a + 1:b + 1], method=method, rtol=rtol, max_step=max_step,
                         max_steps=max(1, max_steps - steps - rej))
             ys.append(sol.y)

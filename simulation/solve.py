@@ -4,7 +4,7 @@
 
 * ``"dp5"``: Dormand-Prince 5(4) with its whole loop compiled (the default);
 * ``"RK45"``, ``"DOP853"``, ``"LSODA"``, ``"BDF"``, ``"Radau"``: ``scipy.integrate.solve_ivp``
-  on the same compiled right-hand side, as references (``post_step`` is not called by these).
+  on the same compiled right-hand side, as references (the accepted-step bookkeeping is not run).
 
 It returns a :class:`Solution` carrying the status, a message, and the solver
 statistics; a failure is a result with ``success = False``, never an exception.
@@ -23,25 +23,13 @@ from scipy.integrate import solve_ivp
 
 from cageless.errors import ParameterError, suggest
 from simulation.integrators.dp5 import STATUS_OK, dp5_integrate
+from simulation.kernels import model_rhs
+from simulation.problem import Problem
 
 __all__ = ["Problem", "Solution", "METHODS", "solve"]
 
 FloatArray = npt.NDArray[np.float64]
 _MESSAGES = {0: "reached the end", 1: "too many steps", 2: "step size underflow", 3: "the state became non-finite"}
-
-
-@dataclass(frozen=True)
-class Problem:
-    """An initial-value problem with a compiled right-hand side ``rhs(t, y, p, aux, dydt)``."""
-
-    rhs: Any
-    post_step: Any
-    params: FloatArray
-    aux: FloatArray
-    y0: FloatArray
-    t0: float
-    atol: FloatArray
-    name: str = "problem"
 
 
 @dataclass
@@ -72,7 +60,7 @@ def _solve_dp5(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float, fi
     aux = pr.aux.copy()
     h0 = first_step or min(max_step, 1e-3 * max(t_eval[-1] - pr.t0, 1e-12))
     t0 = time.perf_counter()
-    status = dp5_integrate(pr.rhs, pr.post_step, pr.params, aux, pr.y0.astype(np.float64), float(pr.t0), t_eval,
+    status = dp5_integrate(pr.model_id, pr.params, aux, pr.y0.astype(np.float64), float(pr.t0), t_eval,
                            float(rtol), pr.atol.astype(np.float64), float(h0), float(max_step), int(max_steps), out,
                            stats)
     return Solution(t=t_eval, y=out, status=int(status), message=_MESSAGES[int(status)], method="dp5",
@@ -89,7 +77,7 @@ def _scipy(method: str) -> Callable[..., Solution]:
 
         def fun(t: float, y: FloatArray) -> FloatArray:
             count[0] += 1
-            pr.rhs(t, y, pr.params, aux, buf)
+            model_rhs(pr.model_id, t, y, pr.params, aux, buf)
             return buf.copy()
 
         t0 = time.perf_counter()

@@ -11,17 +11,19 @@ Samples at the requested times come from cubic Hermite interpolation between
 the step ends (values and derivatives, both known), accurate to O(h^4), far
 below the tolerance at the small steps contact problems take.
 
-The right-hand side is a numba function ``rhs(t, y, p, aux, dydt)`` writing
-into ``dydt`` (no allocation); ``post_step(t, y, p, aux)`` runs after every
-accepted step and may update the auxiliary state ``aux`` (e.g. the impact
-velocity recorded when a contact starts). Each pair of functions compiles its
-own specialised integrator.
+The right-hand side is the compiled kernel of the problem's model
+(:func:`simulation.kernels.model_rhs`, writing into ``dydt``, no allocation);
+:func:`~simulation.kernels.model_post` runs after every accepted step and may
+update the auxiliary state ``aux`` (contact bookkeeping). The kernels are
+reached by a static switch on the model id, so this loop is cached on disk.
 """
 
 from __future__ import annotations
 
 import numba
 import numpy as np
+
+from simulation.kernels import model_post, model_rhs
 
 __all__ = ["dp5_integrate", "STATUS_OK", "STATUS_MAX_STEPS", "STATUS_STEP_UNDERFLOW", "STATUS_NONFINITE"]
 
@@ -42,7 +44,7 @@ E1, E3, E4, E5, E6, E7 = 71 / 57600, -71 / 16695, 71 / 1920, -17253 / 339200, 22
 
 
 @numba.njit(cache=True)
-def dp5_integrate(rhs, post_step, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, max_steps, out, stats):
+def dp5_integrate(model_id, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, max_steps, out, stats):
     """Integrate from ``t0`` and write ``y`` at each ``t_out[k]`` (increasing, >= t0) into ``out[k]``.
 
     ``stats`` receives [n_steps, n_rejected, n_rhs, last_h]. Returns a status code:
@@ -60,7 +62,7 @@ def dp5_integrate(rhs, post_step, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, 
     yt = np.empty(n)
     ynew = np.empty(n)
     t = t0
-    rhs(t, y, p, aux, k1)
+    model_rhs(model_id, t, y, p, aux, k1)
     n_rhs = 1
     n_steps = 0
     n_rej = 0
@@ -88,22 +90,22 @@ def dp5_integrate(rhs, post_step, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, 
             break
         for i in range(n):
             yt[i] = y[i] + h * A21 * k1[i]
-        rhs(t + C2 * h, yt, p, aux, k2)
+        model_rhs(model_id, t + C2 * h, yt, p, aux, k2)
         for i in range(n):
             yt[i] = y[i] + h * (A31 * k1[i] + A32 * k2[i])
-        rhs(t + C3 * h, yt, p, aux, k3)
+        model_rhs(model_id, t + C3 * h, yt, p, aux, k3)
         for i in range(n):
             yt[i] = y[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
-        rhs(t + C4 * h, yt, p, aux, k4)
+        model_rhs(model_id, t + C4 * h, yt, p, aux, k4)
         for i in range(n):
             yt[i] = y[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
-        rhs(t + C5 * h, yt, p, aux, k5)
+        model_rhs(model_id, t + C5 * h, yt, p, aux, k5)
         for i in range(n):
             yt[i] = y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i])
-        rhs(t + h, yt, p, aux, k6)
+        model_rhs(model_id, t + h, yt, p, aux, k6)
         for i in range(n):
             ynew[i] = y[i] + h * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
-        rhs(t + h, ynew, p, aux, k7)
+        model_rhs(model_id, t + h, ynew, p, aux, k7)
         n_rhs += 6
         err = 0.0
         finite = True
@@ -135,7 +137,7 @@ def dp5_integrate(rhs, post_step, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, 
                 y[i] = ynew[i]
                 k1[i] = k7[i]
             n_steps += 1
-            post_step(t, y, p, aux)
+            model_post(model_id, t, y, p, aux)
             h = h / fac
         else:
             n_rej += 1

@@ -35,12 +35,15 @@ import pandas as pd
 from cageless.bearing import Bearing
 from simulation.forces import damping_factor, hertz_damped
 from simulation.hertz import ball_ball_contact, compliance, hertz_contact, race_curvatures
-from simulation.solve import Problem
+from simulation.problem import Problem
 
 __all__ = [
     "PlanarLayout", "planar_problem", "planar_energy", "packed_start", "contact_events", "DEFAULT_CHO_N_S_M",
     "RUBBING_FACTOR",
 ]
+
+#: Id of this model in :mod:`simulation.kernels`.
+MODEL_ID = 0
 
 # Parameter vector layout.
 P_Z, P_D, P_M, P_I, P_MR, P_DI, P_DO, P_KI, P_KO, P_KB, P_CHI, P_G, P_FR, P_WI = range(14)
@@ -71,7 +74,7 @@ class PlanarLayout:
 
 
 @numba.njit(cache=True)
-def _rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
+def planar_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     z = int(p[P_Z])
     d, m, inertia, m_ring = p[P_D], p[P_M], p[P_I], p[P_MR]
     ri_race, ro_race = 0.5 * p[P_DI], 0.5 * p[P_DO]
@@ -184,7 +187,7 @@ def aux_size(n_balls: int, capacity: int) -> int:
 
 
 @numba.njit(cache=True)
-def _post(t, y, p, aux):  # pragma: no cover - compiled
+def planar_post(t, y, p, aux):  # pragma: no cover - compiled
     z = int(p[P_Z])
     if p[P_F_BB] < 0.5:
         return
@@ -282,8 +285,7 @@ def planar_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLi
     aux[g.n_balls + 1:5 * g.n_balls:4] = 0.0
     aux[g.n_balls + 2:5 * g.n_balls:4] = 0.0
     aux[g.n_balls + 3:5 * g.n_balls:4] = 0.0
-    return Problem(rhs=_rhs, post_step=_post, params=p, aux=aux, y0=y0, t0=0.0, atol=atol,
-                   name="planar cageless bearing")
+    return Problem(model_id=MODEL_ID, params=p, aux=aux, y0=y0, t0=0.0, atol=atol, name="planar cageless bearing")
 
 
 def contact_events(problem: Problem, aux: npt.NDArray[np.float64], t_end: float) -> pd.DataFrame:

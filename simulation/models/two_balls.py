@@ -11,13 +11,16 @@ import numba
 import numpy as np
 
 from simulation.forces import damping_factor, hertz_damped
-from simulation.solve import Problem
+from simulation.problem import Problem
 
-__all__ = ["two_ball_problem"]
+__all__ = ["two_ball_problem", "MODEL_ID"]
+
+#: Id of this model in :mod:`simulation.kernels`.
+MODEL_ID = 1
 
 
 @numba.njit(cache=True)
-def _rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
+def two_ball_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     diameter, mass1, mass2, stiffness, chi = p[0], p[1], p[2], p[3], p[4]
     delta = diameter - (y[1] - y[0])
     delta_dot = y[2] - y[3]
@@ -33,7 +36,7 @@ def _rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _post(t, y, p, aux):  # pragma: no cover - compiled
+def two_ball_post(t, y, p, aux):  # pragma: no cover - compiled
     if p[0] - (y[1] - y[0]) <= 0.0:
         aux[0] = 0.0
 
@@ -45,5 +48,4 @@ def two_ball_problem(diameter_m: float, mass_kg: float, stiffness: float, restit
     y0 = np.array([0.0, diameter_m + gap_m, v, -v])
     p = np.array([diameter_m, mass_kg, mass_kg, stiffness, damping_factor(restitution)])
     atol = np.array([1e-12, 1e-12, 1e-9, 1e-9])
-    return Problem(rhs=_rhs, post_step=_post, params=p, aux=np.zeros(1), y0=y0, t0=0.0, atol=atol,
-                   name="two balls")
+    return Problem(model_id=MODEL_ID, params=p, aux=np.zeros(1), y0=y0, t0=0.0, atol=atol, name="two balls")

@@ -2,34 +2,17 @@
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 import pytest
 
 from cageless.errors import ParameterError
+from simulation.models.textbook import oscillator_problem, riccati_problem
 from simulation.models.two_balls import two_ball_problem
-from simulation.solve import METHODS, Problem, solve
+from simulation.solve import METHODS, solve
 
 
-@numba.njit(cache=True)
-def _oscillator(t, y, p, aux, dydt):
-    dydt[0] = y[1]
-    dydt[1] = -p[0] * p[0] * y[0]
-
-
-@numba.njit(cache=True)
-def _nothing(t, y, p, aux):
-    pass
-
-
-@numba.njit(cache=True)
-def _blow_up(t, y, p, aux, dydt):
-    dydt[0] = y[0] * y[0] * 1e6
-
-
-def oscillator(w: float = 2 * np.pi * 50) -> Problem:
-    return Problem(rhs=_oscillator, post_step=_nothing, params=np.array([w]), aux=np.zeros(1),
-                   y0=np.array([1.0, 0.0]), t0=0.0, atol=np.array([1e-12, 1e-12 * w]))
+def oscillator(w: float = 2 * np.pi * 50):
+    return oscillator_problem(w)
 
 
 @pytest.mark.parametrize("method", list(METHODS))
@@ -60,10 +43,11 @@ def test_failures_are_results_not_exceptions():
     sol = solve(oscillator(), t, max_steps=5)
     assert not sol.success and sol.message == "too many steps"
     assert np.isnan(sol.y[-1]).all()
-    bad = Problem(rhs=_blow_up, post_step=_nothing, params=np.zeros(1), aux=np.zeros(1), y0=np.array([1.0]),
-                  t0=0.0, atol=np.array([1e-9]))
-    sol = solve(bad, np.linspace(0, 1, 5))
+    # y' = 1e6 y^2 from y = 1 blows up at t = 1e-6 s: the run must stop with a failure, not hang or raise.
+    sol = solve(riccati_problem(1e6, 1.0), np.linspace(0, 1e-5, 5))
     assert not sol.success
+    ok = np.isfinite(sol.y[:, 0])
+    np.testing.assert_allclose(sol.y[ok, 0], 1 / (1 - 1e6 * sol.t[ok]), rtol=1e-4)
 
 
 def test_registry_refuses_bad_arguments():

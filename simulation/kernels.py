@@ -1,0 +1,39 @@
+"""The registry of compiled model kernels: a static switch on the model id.
+
+The integrator calls :func:`model_rhs` and :func:`model_post`; each branch is a
+direct call to a module-level compiled function, which numba can inline and
+cache. Add a model by giving it an id here.
+"""
+
+from __future__ import annotations
+
+import numba
+
+from simulation.models import planar, textbook, two_balls
+
+__all__ = ["PLANAR", "TWO_BALLS", "OSCILLATOR", "RICCATI", "model_rhs", "model_post"]
+
+PLANAR, TWO_BALLS = planar.MODEL_ID, two_balls.MODEL_ID
+OSCILLATOR, RICCATI = textbook.OSCILLATOR, textbook.RICCATI
+
+
+@numba.njit(cache=True)
+def model_rhs(model_id, t, y, p, aux, dydt):  # pragma: no cover - compiled
+    """dy/dt of model ``model_id`` into ``dydt``."""
+    if model_id == PLANAR:
+        planar.planar_rhs(t, y, p, aux, dydt)
+    elif model_id == TWO_BALLS:
+        two_balls.two_ball_rhs(t, y, p, aux, dydt)
+    elif model_id == OSCILLATOR:
+        textbook.oscillator_rhs(t, y, p, aux, dydt)
+    else:
+        textbook.riccati_rhs(t, y, p, aux, dydt)
+
+
+@numba.njit(cache=True)
+def model_post(model_id, t, y, p, aux):  # pragma: no cover - compiled
+    """Bookkeeping after an accepted step (contact episodes)."""
+    if model_id == PLANAR:
+        planar.planar_post(t, y, p, aux)
+    elif model_id == TWO_BALLS:
+        two_balls.two_ball_post(t, y, p, aux)

@@ -1,0 +1,40 @@
+"""The initial-value problem the integrators solve.
+
+A problem names its model by :data:`model_id` (see :mod:`simulation.kernels`):
+the compiled integrator calls the model's right-hand side by a static switch,
+not through a function argument, so numba can cache the compiled loop on disk
+and a fresh process does not recompile it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = ["Problem"]
+
+FloatArray = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Problem:
+    """An initial-value problem: model, parameters, auxiliary state, start, absolute tolerances."""
+
+    model_id: int
+    params: FloatArray
+    aux: FloatArray
+    y0: FloatArray
+    t0: float
+    atol: FloatArray
+    name: str = "problem"
+
+    def rhs(self, t: float, y: FloatArray, aux: FloatArray | None = None) -> FloatArray:
+        """dy/dt at (t, y), evaluated by the compiled kernel (``aux`` defaults to a copy of the problem's)."""
+        from simulation.kernels import model_rhs
+
+        out = np.empty_like(np.asarray(y, dtype=np.float64))
+        model_rhs(self.model_id, float(t), np.asarray(y, dtype=np.float64), self.params,
+                  self.aux.copy() if aux is None else aux, out)
+        return out
