@@ -24,7 +24,7 @@ import numpy.typing as npt
 
 from cageless.bearing import Geometry, Masses
 from cageless.errors import ParameterError
-from cageless.units import rpm_to_hz, rpm_to_rad_s
+from cageless.units import rpm_to_hz
 
 __all__ = [
     "KinematicRatios",
@@ -201,7 +201,3 @@ def centrifugal_force(masses: Masses, geometry: Geometry, cage_speed_rad_s: floa
     _check_speed("cage_speed_rad_s", cage_speed_rad_s)
     return masses.ball_mass_kg * 0.5 * geometry.pitch_diameter_m * cage_speed_rad_s**2
 
-
-def speed_rpm_to_cage_speed(geometry: Geometry, speed_rpm: float) -> float:
-    """Convenience: pure-rolling cage speed (rad/s) at an inner-ring speed in rpm."""
-    return theoretical_cage_speed(geometry, rpm_to_rad_s(speed_rpm))

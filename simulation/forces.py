@@ -26,7 +26,7 @@ from scipy.integrate import solve_ivp
 
 from cageless.errors import ParameterError
 
-__all__ = ["hertz_damped", "damping_factor", "rebound"]
+__all__ = ["hertz_damped", "hertz_impact_duration", "damping_factor", "rebound"]
 
 
 @numba.njit(cache=True, inline="always")
@@ -38,6 +38,14 @@ def hertz_damped(delta, delta_dot, v_in, stiffness, chi):  # pragma: no cover - 
     if chi > 0.0 and v_in > 0.0:
         f *= 1.0 + chi * delta_dot / v_in
     return max(f, 0.0)
+
+
+@numba.njit(cache=True)
+def hertz_impact_duration(approach_speed, reduced_mass, stiffness):  # pragma: no cover - compiled
+    """Elastic Hertz impact duration (s): 2.943 delta_max / v with delta_max = (5 m* v^2 / (4 K))^(2/5)
+    (Johnson, *Contact Mechanics*, 1985, sect. 11.4)."""
+    v = max(approach_speed, 1e-9)
+    return 2.943 * (5.0 * reduced_mass * v * v / (4.0 * stiffness)) ** 0.4 / v
 
 
 def rebound(chi: float) -> float:

@@ -176,7 +176,7 @@ def _step(frame: np.ndarray, t: float, st: _State, s: TrackSetup, centre: tuple[
     st.theta = new_theta
     st.radius = np.where(ok, np.hypot(mu - centre[0], mv - centre[1]), st.radius)
     st.misses = np.where(ok, 0, st.misses + 1)
-    st.ref_mass = np.where(ok, 0.9 * st.ref_mass + 0.1 * np.where(ok, mm, 0.0), st.ref_mass)
+    st.ref_mass = np.where(ok, 0.9 * st.ref_mass + 0.1 * mm, st.ref_mass)
     st.t = t
     u, v, mass = out
     u[i], v[i], mass[i] = np.where(ok, mu, np.nan), np.where(ok, mv, np.nan), np.where(ok, mm, 0.0)

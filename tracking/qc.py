@@ -121,14 +121,14 @@ def write_qc(qc_dir: Path, stem: str, video_path: Path, qc: QCReport, table: pd.
     """Write ``<stem>.qc.json`` and ``n_frames`` overlay PNGs (balls numbered as in the trace)."""
     qc_dir.mkdir(parents=True, exist_ok=True)
     written: list[Path] = []
-    order = np.argsort(_column_of_ball(table, trace))
+    label = np.argsort(np.asarray(qc.ball_order))  # tracker column -> trace ball number
     with open_video(video_path, fps=fps) as video:
         n = len(video)
         picks = np.unique(np.linspace(0, n - 1, max(1, n_frames)).round().astype(int))
         scale = max(1, int(math.ceil(600 / max(video.frame_shape))))
         for i in picks:
             rows = table[table.frame == i].copy()
-            rows["ball"] = order[rows.ball.to_numpy()]
+            rows["ball"] = label[rows.ball.to_numpy()]
             img = _overlay(video[int(i)], rows, Orbit(tuple(trace.video.centre_px), qc.orbit_radius_px, 0.0), scale)
             target = qc_dir / f"{stem}.frame{i:06d}.png"
             with atomic_path(target) as tmp:
@@ -141,7 +141,3 @@ def write_qc(qc_dir: Path, stem: str, video_path: Path, qc: QCReport, table: pd.
     atomic_write_text(qc_dir / f"{stem}.slip_profile.csv", profile.to_csv(index=False, float_format="%.6g"))
     return written
 
-
-def _column_of_ball(table: pd.DataFrame, trace: Trace) -> np.ndarray:
-    """For each trace ball, the tracker column it came from (stored in the trace's QC)."""
-    return np.asarray(trace.qc["ball_order"]) if trace.qc and "ball_order" in trace.qc else np.arange(trace.n_balls)

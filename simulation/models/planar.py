@@ -33,7 +33,7 @@ import numpy.typing as npt
 import pandas as pd
 
 from cageless.bearing import Bearing
-from simulation.forces import damping_factor, hertz_damped
+from simulation.forces import damping_factor, hertz_damped, hertz_impact_duration
 from simulation.hertz import ball_ball_contact, compliance, hertz_contact, race_curvatures
 from simulation.problem import Problem
 
@@ -215,9 +215,7 @@ def planar_post(t, y, p, aux):  # pragma: no cover - compiled
             if n < cap:
                 e = base + EVENT_FIELDS * n
                 duration = t - aux[slot]
-                v = max(aux[slot + 3], 1e-9)
-                dmax = (5.0 * (0.5 * m) * v * v / (4.0 * k_b)) ** 0.4
-                t_hertz = 2.943 * dmax / v
+                t_hertz = hertz_impact_duration(aux[slot + 3], 0.5 * m, k_b)
                 aux[e] = aux[slot]
                 aux[e + 1] = j
                 aux[e + 2] = aux[slot + 2] % (2.0 * np.pi)
@@ -305,8 +303,7 @@ def contact_events(problem: Problem, aux: npt.NDArray[np.float64], t_end: float)
     for j in range(z):
         slot = z + 4 * j
         if not np.isnan(aux[slot]):
-            v = max(aux[slot + 3], 1e-9)
-            t_hertz = 2.943 * (5.0 * 0.5 * p[P_M] * v * v / (4.0 * p[P_KB])) ** 0.4 / v
+            t_hertz = hertz_impact_duration(aux[slot + 3], 0.5 * p[P_M], p[P_KB])
             duration = t_end - aux[slot]
             still_open.append([aux[slot], j, aux[slot + 2] % (2 * np.pi), aux[slot + 1], duration,
                                float(duration > RUBBING_FACTOR * t_hertz)])
