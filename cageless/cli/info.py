@@ -138,8 +138,8 @@ def _format_video(m: dict[str, Any]) -> str:
         f"  header rate       {fps(m['header_fps'])}",
         f"  time-stamp rate   {fps(m['timestamp_fps'])}",
         f"  time from         {m['time_source'] or 'nothing (give --fps)'}",
-        f"  duration          " + ("unknown" if m.get("last_time_s") is None else f"{m['last_time_s']:.6g} s (first to last frame)"),
-        f"  exposure          " + ("unknown" if m["exposure_s"] is None else f"{m['exposure_s'] * 1e6:.4g} us"),
+        "  duration          " + ("unknown" if m.get("last_time_s") is None else f"{m['last_time_s']:.6g} s (first to last frame)"),
+        "  exposure          " + ("unknown" if m["exposure_s"] is None else f"{m['exposure_s'] * 1e6:.4g} us"),
     ]
     if m["camera"]:
         lines.append(f"  camera            {m['camera']}")

@@ -191,7 +191,7 @@ def planar_post(t, y, p, aux):  # pragma: no cover - compiled
     z = int(p[P_Z])
     if p[P_F_BB] < 0.5:
         return
-    d, k_b, chi, m = p[P_D], p[P_KB], p[P_CHI], p[P_M]
+    d, k_b, m = p[P_D], p[P_KB], p[P_M]
     base = 5 * z + 1
     cap = (aux.shape[0] - base) // EVENT_FIELDS
     for j in range(z):
