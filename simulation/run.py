@@ -1,9 +1,8 @@
 """From a scene to a simulation trace: build the model, start it quasi-statically, solve, write.
 
-This release runs the planar level with the effects listed in :data:`IMPLEMENTED`;
-a scene that needs another effect (race traction, films, drag) or the spatial
-level is refused before anything compiles, with the way to force those effects
-off. The run is split into chunks of simulated time for the progress bar; the
+This release runs the planar level with every effect of its table
+(:data:`IMPLEMENTED`); a scene that needs the spatial level is refused before
+anything compiles, with the way to force the planar one. The run is split into chunks of simulated time for the progress bar; the
 state and the contact bookkeeping carry over between chunks.
 """
 
@@ -22,20 +21,29 @@ from tqdm.auto import tqdm
 
 from cageless.errors import UsageError
 from cageless.kinematics import slip_rate, theoretical_cage_speed
+from cageless.profiles import angle_profile
 from cageless.provenance import Provenance
 from cageless.trace import SimulationInfo, Trace, write_trace
 from simulation.effects import ModelChoice
 from simulation.hertz import compliance, hertz_contact, race_curvatures
+from simulation.models.planar_reference import tangential_force
+from simulation.traction import film_coefficient
 from simulation.models import planar as P
+from simulation.parameters import ModelParameters
 from simulation.quasistatic import radial_load_distribution
 from simulation.scene import Scene
 from simulation.problem import Problem
 from simulation.solve import Solution, solve
 
-__all__ = ["IMPLEMENTED", "SimulationResult", "check_supported", "initial_state", "simulate"]
+__all__ = ["IMPLEMENTED", "SimulationResult", "check_supported", "initial_state", "simulate", "peak_unloaded_slip",
+           "UNLOADED_ZONE_DEG"]
+
+#: The unloaded zone: the upper half of the bearing, opposite the radial load (DESIGN §3, §9).
+UNLOADED_ZONE_DEG = (0.0, 180.0)
 
 #: Effects this release can evaluate (the planar core).
-IMPLEMENTED = frozenset({"race_contact", "lubricant_damping", "ball_ball_contact", "gravity"})
+IMPLEMENTED = frozenset({"race_contact", "lubricant_damping", "race_traction", "ehl_film", "ball_ball_contact",
+                         "ball_ball_film", "gravity", "drag"})
 
 
 @dataclass
@@ -47,12 +55,26 @@ class SimulationResult:
     problem: Problem
 
 
+def peak_unloaded_slip(trace: Trace, settle_s: float = 0.0, bin_deg: float = 1.0) -> float:
+    """The peak of the mean slip profile in the unloaded zone (DESIGN §9), as a fraction.
+
+    Samples before ``settle_s`` (the start-up) and invalid samples are left out; the profile is
+    the mean over all balls per ``bin_deg`` orbital-angle bin. NaN when no bin of the zone has data.
+    """
+    keep = (trace.time >= settle_s)[:, None] & trace.valid
+    prof = angle_profile(trace.angle, trace.slip, bin_deg, valid=keep)
+    lo, hi = UNLOADED_ZONE_DEG
+    zone = prof[(prof.angle_deg > lo) & (prof.angle_deg < hi)]["mean"]
+    return float(zone.max()) if zone.notna().any() else float("nan")
+
+
 def check_supported(choice: ModelChoice) -> None:
     """Refuse, before any compile or solve, a model this release cannot run."""
     if choice.level != "planar":
         raise UsageError("the spatial level lands with the next simulator issue; this release runs planar scenes "
-                         "(pure radial load, aligned bearing, horizontal shaft).")
-    missing = [e for e in choice.active if e not in IMPLEMENTED]
+                         "(pure radial load, aligned bearing, horizontal shaft). To run this scene on the planar model "
+                         "anyway (axial load and tilt ignored), add --level planar --force.")
+    missing = [e for e in choice.active if e not in IMPLEMENTED]  # pragma: no cover - all planar effects exist
     if missing:
         flags = " ".join(f"--effect {e}=off" for e in missing)
         raise UsageError(f"effects not in this release yet: {', '.join(missing)}. To run without them, add "
@@ -82,27 +104,61 @@ def initial_state(scene: Scene) -> tuple[npt.NDArray[np.float64], npt.NDArray[np
     return theta, radius, (0.0, -e)
 
 
-def _observables(pr: Problem, y: npt.NDArray[np.float64]) -> dict[str, dict[str, np.ndarray]]:
-    """Normal contact forces (elastic part) and positions along the samples."""
+def _observables(pr: Problem, y: npt.NDArray[np.float64], scene: Scene,
+                 film_on: bool) -> dict[str, dict[str, np.ndarray]]:
+    """Contact forces (elastic normal part and traction), films, positions and spins along the samples."""
     p = pr.params
     z = int(p[P.P_Z])
-    d = p[P.P_D]
-    r, th = y[:, :z], y[:, z:2 * z]
-    cy, cz = y[:, 5 * z], y[:, 5 * z + 1]
-    outer = p[P.P_KO] * np.clip(r + 0.5 * d - 0.5 * p[P.P_DO], 0, None) ** 1.5
-    ln = np.hypot(r * np.cos(th) - cy[:, None], r * np.sin(th) - cz[:, None])
-    inner = p[P.P_KI] * np.clip(0.5 * p[P.P_DI] + 0.5 * d - ln, 0, None) ** 1.5
+    d, half = p[P.P_D], 0.5 * p[P.P_D]
+    r, th, rd, thd, om = (y[:, i * z:(i + 1) * z] for i in range(5))
+    cy, cz, cvy, cvz = (y[:, 5 * z + i][:, None] for i in range(4))
+    w_i = p[P.P_WI]
+    outer = p[P.P_KO] * np.clip(r + half - 0.5 * p[P.P_DO], 0, None) ** 1.5
+    sx, sz = r * np.cos(th) - cy, r * np.sin(th) - cz
+    ln = np.hypot(sx, sz)
+    inner = p[P.P_KI] * np.clip(0.5 * p[P.P_DI] + half - ln, 0, None) ** 1.5
     x, zz = r * np.cos(th), r * np.sin(th)
     gap = np.hypot(np.roll(x, -1, axis=1) - x, np.roll(zz, -1, axis=1) - zz)
     bb = p[P.P_KB] * np.clip(d - gap, 0, None) ** 1.5
+    u_o = r * thd + half * om
+    ur_o = 0.5 * np.abs(u_o - p[P.P_DO] * thd)
+    vt = (rd * np.sin(th) + r * thd * np.cos(th) - cvz) * sx / ln - (rd * np.cos(th) - r * thd * np.sin(th) - cvy) * sz / ln
+    r_i = 0.5 * p[P.P_DI]
+    u_i = vt - half * om - w_i * r_i
+    ur_i = 0.5 * np.abs(vt * (1 - 2 * r_i / ln) - half * om + w_i * r_i)
+    contacts = {"inner_normal": inner, "outer_normal": outer, "ball_ball_normal": bb}
+    if p[P.P_F_TRAC] > 0.5:
+        contacts["inner_traction"] = -tangential_force(u_i, ur_i, inner, p)
+        contacts["outer_traction"] = -tangential_force(u_o, ur_o, outer, p)
+    if film_on:
+        contacts.update(_films(scene, inner, outer, ur_i, ur_o))
     spin = np.zeros((len(y), z, 3))
-    spin[:, :, 0] = y[:, 4 * z:5 * z]
-    ring = np.column_stack([np.zeros(len(y)), cy, cz])
+    spin[:, :, 0] = om
+    ring = np.column_stack([np.zeros(len(y)), cy[:, 0], cz[:, 0]])
     return {
         "balls": {"radius": r, "axial": np.zeros_like(r), "spin": spin},
-        "contacts": {"inner_normal": inner, "outer_normal": outer, "ball_ball_normal": bb},
+        "contacts": contacts,
         "inner_ring": {"position": ring, "tilt": np.zeros((len(y), 2))},
     }
+
+
+def _films(scene: Scene, inner: np.ndarray, outer: np.ndarray, ur_i: np.ndarray,
+           ur_o: np.ndarray) -> dict[str, np.ndarray]:
+    """Hamrock-Dowson central film (m) at the race contacts (NaN where a contact is open)."""
+    b = scene.bearing
+    g, lub = b.geometry, b.lubricant
+    assert lub is not None
+    eta = compliance(b.material)
+    rc = race_curvatures(g)
+    d = g.ball_diameter_m
+    rx = {"inner": 1.0 / (2.0 / d + 2.0 / g.inner_race_diameter_m), "outer": 1.0 / (2.0 / d - 2.0 / g.outer_race_diameter_m)}
+    out = {}
+    for race, q, u in (("inner", inner, ur_i), ("outer", outer, ur_o)):
+        c_h = film_coefficient(hertz_contact(*rc[race], eta), rx[race], lub.dynamic_viscosity_pa_s,
+                               lub.pressure_viscosity_coefficient_1_pa, 2.0 / eta)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            out[f"{race}_film"] = np.where(q > 0, c_h * np.maximum(u, 1e-6) ** 0.67 * q ** -0.067, np.nan)
+    return out
 
 
 def _solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: str, max_step: float,
@@ -131,7 +187,7 @@ def _solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: 
                     n_rejected=rej, n_rhs=rhs, wall_s=wall, extra={"aux": aux})
 
 
-def simulate(scene: Scene, choice: ModelChoice, restitution: float = 0.8, rtol: float = 1e-6,
+def simulate(scene: Scene, choice: ModelChoice, parameters: ModelParameters | None = None, rtol: float = 1e-6,
              sample_rate_hz: float = 10_000.0, method: str = "dp5", max_step: float = 2e-6,
              out: str | Path | None = None, progress: bool = True, config: dict[str, Any] | None = None,
              max_steps: int = 50_000_000) -> SimulationResult:
@@ -143,14 +199,16 @@ def simulate(scene: Scene, choice: ModelChoice, restitution: float = 0.8, rtol: 
     ``status`` says ``"incomplete: <why>"``; samples after the failure are NaN.
     """
     check_supported(choice)
+    par = parameters or ModelParameters()
     prov = Provenance.start(config={"scene": scene.to_dict(), "model": json.loads(choice.to_json()),
                                     "solver": {"method": method, "rtol": rtol, "max_step": max_step},
-                                    "restitution": restitution, **(config or {})})
+                                    "parameters": par.to_dict(), **(config or {})})
     theta, radius, ring = initial_state(scene)
     effects = {e.name: e.on for e in choice.effects}
-    pr = P.planar_problem(scene.bearing, theta, radius, ring, scene.conditions.radial_load_n, restitution,
-                          scene.gravity_m_s2 if effects.get("gravity") else 0.0, scene.conditions.speed_rad_s,
-                          effects)
+    pr = P.planar_problem(scene.bearing, theta, radius, ring, scene.conditions.radial_load_n,
+                          gravity_m_s2=scene.gravity_m_s2 if effects.get("gravity") else 0.0,
+                          inner_speed_rad_s=scene.conditions.speed_rad_s, effects=effects, parameters=par,
+                          speed_ramp_s=scene.speed_ramp_s, oil_air_density_kg_m3=scene.oil_air_density_kg_m3)
     t = np.arange(0.0, scene.duration_s + 0.5 / sample_rate_hz, 1.0 / sample_rate_hz)
     start = time.perf_counter()
     sol = _solve_chunks(pr, t, rtol, method, max_step, min(50, len(t) - 1), progress, max_steps)
@@ -169,7 +227,8 @@ def _to_trace(scene: Scene, choice: ModelChoice, pr: Problem, sol: Solution, rto
     ok = np.all(np.isfinite(y), axis=1)
     angle, speed = y[:, z:2 * z], y[:, 3 * z:4 * z]
     omega_c = theoretical_cage_speed(g, scene.conditions.speed_rad_s)
-    groups = _observables(pr, np.where(ok[:, None], y, np.nan))
+    film_on = any(e.name == "ehl_film" and e.on for e in choice.effects)
+    groups = _observables(pr, np.where(ok[:, None], y, np.nan), scene, film_on)
     events = P.contact_events(pr, sol.extra["aux"], float(sol.t[ok][-1]) if ok.any() else 0.0)
     status = "complete" if sol.success else f"incomplete: {sol.message} at t = {sol.t[ok][-1] if ok.any() else 0:g} s"
     return Trace(

@@ -1,9 +1,11 @@
 """``cageless simulate``: the scene, the model it calls for, and the run.
 
 ``--explain`` prints the model level and effects with their reasons. A run
-writes a ``cageless-trace/1`` simulation file. This release runs the planar
-core (race and ball-ball contacts, lubricant damping, gravity); a scene whose
-effects are not in it yet is refused with the flags that force them off.
+writes a ``cageless-trace/1`` simulation file and prints a summary. This release
+runs the planar level (pure radial load on an aligned bearing); a scene that
+needs the spatial level is refused with the flags that force it. ``--set``
+changes an open model parameter (:class:`simulation.parameters.ModelParameters`),
+``--ensemble N`` runs seeds 0..N-1 on both cores.
 """
 
 from __future__ import annotations
@@ -22,6 +24,8 @@ examples:
   cageless simulate --speed-rpm 3000 --radial-load-n 500 --axial-load-n 400 --explain
   cageless simulate --speed-rpm 1800 --radial-load-n 500 --effect drag=on --oil-air-density 5 --explain
   cageless simulate --speed-rpm 3000 --axial-load-n 300 --level planar --force --explain
+  cageless simulate --speed-rpm 6000 --radial-load-n 500 --duration 0.1
+  cageless simulate --speed-rpm 1800 --radial-load-n 500 --set cho_n_s_m=2500 --ensemble 4
 """
 
 
@@ -51,8 +55,14 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--solver", default="dp5", help="integrator: dp5 (default), RK45, DOP853, LSODA, BDF, Radau")
     p.add_argument("--rtol", type=finite_float, default=1e-6, help="relative tolerance (default 1e-6)")
     p.add_argument("--max-step", type=finite_float, default=2e-6, help="largest step (s, default 2e-6)")
-    p.add_argument("--restitution", type=finite_float, default=0.8,
-                   help="ball-ball coefficient of restitution R, 0 < R <= 1 (default 0.8)")
+    p.add_argument("--restitution", type=finite_float,
+                   help="ball-ball coefficient of restitution R, 0 < R <= 1 (same as --set restitution=R)")
+    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", dest="set_values",
+                   help="change an open model parameter, e.g. --set cho_n_s_m=2500 (repeatable; "
+                   "simulation/parameters.py lists them with their sources)")
+    p.add_argument("--speed-ramp", type=finite_float, default=0.0,
+                   help="time for the ring to reach its speed from rest (s, default 0: at speed from the start)")
+    p.add_argument("--ensemble", type=int, default=1, metavar="N", help="run seeds 0..N-1 (N traces, both cores)")
     p.add_argument("--sample-rate", type=finite_float, default=10_000.0, help="samples per second (default 10000)")
     p.add_argument("-o", "--out", help="trace file to write (default sim_<rpm>rpm_Fr<N>.trace.h5)")
 
@@ -71,7 +81,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     scene = Scene(conditions=OperatingConditions(args.speed_rpm, args.radial_load_n, args.axial_load_n),
                   bearing=bearing, gravity_m_s2=args.gravity, orientation=args.orientation,
                   misalignment_rad=args.misalignment_rad, oil_air_density_kg_m3=args.oil_air_density,
-                  duration_s=args.duration, seed=args.seed)
+                  duration_s=args.duration, speed_ramp_s=args.speed_ramp, seed=args.seed)
     choice = choose_model(scene, args.level, parse_effect_overrides(args.effect), args.force)
     if args.explain:
         print(choice.to_json() if args.json else choice.explain())
@@ -79,24 +89,48 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     return _run(args, scene, choice, config)
 
 
-def _run(args: argparse.Namespace, scene: Any, choice: Any, config: dict[str, Any]) -> int:
-    import numpy as np
+def _parameters(args: argparse.Namespace) -> Any:
+    from simulation.parameters import ModelParameters, parse_set_overrides
 
-    from simulation.forces import damping_factor
-    from simulation.run import check_supported, simulate
+    values = parse_set_overrides(args.set_values)
+    if args.restitution is not None:
+        values["restitution"] = args.restitution
+    return ModelParameters().with_overrides(values)
+
+
+def _run(args: argparse.Namespace, scene: Any, choice: Any, config: dict[str, Any]) -> int:
+    from cageless.errors import UsageError
+    from simulation.run import check_supported
 
     check_supported(choice)
-    damping_factor(args.restitution)  # validates R before anything compiles
+    par = _parameters(args)  # validated before anything compiles
+    if args.ensemble < 1:
+        raise UsageError(f"--ensemble must be >= 1, got {args.ensemble}")
     out = args.out or f"sim_{args.speed_rpm:g}rpm_Fr{args.radial_load_n:g}.trace.h5"
-    res = simulate(scene, choice, restitution=args.restitution, rtol=args.rtol, sample_rate_hz=args.sample_rate,
-                   method=args.solver, max_step=args.max_step, out=out, progress=not args.quiet,
-                   config={"command": "simulate"})
-    sol, tr = res.solution, res.trace
-    unloaded = np.sin(tr.angle) > 0
-    peak = np.nanmax(np.where(unloaded, tr.slip, np.nan)) if unloaded.any() else float("nan")
+    kw = {"parameters": par, "rtol": args.rtol, "sample_rate_hz": args.sample_rate, "method": args.solver,
+          "max_step": args.max_step, "config": {"command": "simulate", "set": args.set_values}}
+    if args.ensemble == 1:
+        from simulation.run import simulate
+
+        res = simulate(scene, choice, out=out, progress=not args.quiet, **kw)
+        print(f"effects: {', '.join(choice.active)}")
+        print(_summary_line(res.trace, res.solution, out))
+        return 0 if res.solution.success else 1
+    from simulation.ensemble import run_ensemble
+
+    rows = run_ensemble(scene, choice, args.ensemble, out, progress=not args.quiet, **kw)
     print(f"effects: {', '.join(choice.active)}")
-    print(f"{tr.status}: {sol.n_steps} steps, {sol.n_rejected} rejected, {sol.n_rhs} RHS calls, "
-          f"{tr.simulation.wall_s:.2f} s wall for {scene.duration_s:g} s simulated")
-    print(f"contact episodes: {len(tr.events)} ({(tr.events.kind == 'impact').sum()} impacts); "
-          f"peak slip in the unloaded zone {100 * peak:.2f}% -> {out}")
-    return 0 if sol.success else 1
+    for row in rows:
+        print(f"seed {row['seed']}: {row['summary']}")
+    return 0 if all(r["success"] for r in rows) else 1
+
+
+def _summary_line(trace: Any, sol: Any, out: str) -> str:
+    from simulation.run import peak_unloaded_slip
+
+    ev = trace.events
+    settle = 0.2 * float(trace.time[-1])
+    return (f"{trace.status}: {sol.n_steps} steps, {sol.n_rejected} rejected, {sol.n_rhs} RHS calls, "
+            f"{trace.simulation.wall_s:.2f} s wall for {trace.time[-1]:g} s simulated; contact episodes "
+            f"{len(ev)} ({int((ev.kind == 'impact').sum())} impacts); peak slip in the unloaded zone after "
+            f"{1e3 * settle:.0f} ms: {100 * peak_unloaded_slip(trace, settle_s=settle):.2f}% -> {out}")

@@ -1,25 +1,35 @@
 """The planar cageless-bearing model (DESIGN §6, pure radial load on an aligned bearing).
 
-States (n = 5 Z + 5): per ball j the orbital radius r_j, angle theta_j, their
+States (n = 5 Z + 6): per ball j the orbital radius r_j, angle theta_j, their
 rates, and the spin omega_j about the shaft axis; then the inner-ring centre
-(y, z) and its velocity; last, the energy dissipated so far (J), so the energy
-balance can be checked. The ring's rotation is prescribed.
+(y, z) and its velocity; then the work put in by the ring's drive and the energy
+dissipated so far (J), so the energy balance can be checked: kinetic + potential
+energy + dissipated - input work stays constant. The ring's rotation is
+prescribed (with an optional linear ramp from rest).
 
-In this release the model carries the conservative effects, ball-ball damping
-and lubricant damping at the race contacts (C_ho d(delta)/dt, the total normal
-force never tensile; default C_ho = 5000 N s/m, the middle of the 2500-7500 N s/m
-range of the paper's sensitivity study, Wang et al. 2026 §4): Hertz race contacts (ball to outer groove: delta = r + D/2 - d_o/2;
-ball to the displaced inner groove: delta = d_i/2 + D/2 - |P - C|), Hertz
-ball-ball contact with restitution-calibrated damping
-(:func:`simulation.forces.hertz_damped`), gravity on balls and ring, and the
-radial load on the ring (toward -z). The centrifugal force is not an effect: it
-comes out of the polar equations, r'' = F_r / m + r theta'^2. Every ball-ball
-contact episode is logged after each accepted step (:func:`contact_events`):
-its onset, pair, orbital angle at the peak, peak force and duration, classed as
-rubbing when it lasts more than :data:`RUBBING_FACTOR` Hertz impact durations at
-its approach speed, else as an impact. Race traction,
-films and drag are the next slice (their parameter set must be cited first); the
-effect flags already gate every term.
+Effects, each gated by its flag so that an effect that is off is never evaluated:
+
+* race contact: Hertz, ball to outer groove delta = r + D/2 - d_o/2, ball to the
+  displaced inner groove delta = d_i/2 + D/2 - |P - C|;
+* lubricant damping C_ho d(delta)/dt at the race contacts, the total normal
+  force never tensile (default C_ho from :class:`~simulation.parameters.ModelParameters`);
+* race traction: the tangential force of :mod:`simulation.traction` against the
+  sliding of the ball surface on the race surface, with its moment on the spin;
+  the ring's share is the drive's input power;
+* EHL film: the Hamrock-Dowson film feeds the traction law (off: a fixed film h_0);
+* ball-ball contact: Hertz with restitution-calibrated damping
+  (:func:`simulation.forces.hertz_damped`) and friction from the sliding of the
+  two surfaces (the same traction law, or dry Coulomb friction);
+* ball-ball film: squeeze film 6 pi eta (D/4)^2 (-dh/dt) / h between approaching
+  neighbours with a gap below 4/3 Delta_r, h floored at Delta_r (= h_0);
+* gravity on balls and ring, the radial load on the ring (toward -z);
+* drag 1/2 C_D rho A V^2 against the orbital motion.
+
+The centrifugal force is not an effect: it comes out of the polar equations,
+r'' = F_r / m + r theta'^2. Every ball-ball contact episode is logged after each
+accepted step (:func:`contact_events`): onset, pair, orbital angle at the peak,
+peak force and duration, classed as rubbing when it lasts more than
+:data:`RUBBING_FACTOR` Hertz impact durations at its approach speed, else impact.
 """
 
 from __future__ import annotations
@@ -33,9 +43,12 @@ import numpy.typing as npt
 import pandas as pd
 
 from cageless.bearing import Bearing
+from cageless.errors import ParameterError
 from simulation.forces import damping_factor, hertz_damped, hertz_impact_duration
 from simulation.hertz import ball_ball_contact, compliance, hertz_contact, race_curvatures
+from simulation.parameters import ModelParameters
 from simulation.problem import Problem
+from simulation.traction import dry_friction, regression_traction
 
 __all__ = [
     "PlanarLayout", "planar_problem", "planar_energy", "packed_start", "contact_events", "DEFAULT_CHO_N_S_M",
@@ -48,10 +61,13 @@ MODEL_ID = 0
 # Parameter vector layout.
 P_Z, P_D, P_M, P_I, P_MR, P_DI, P_DO, P_KI, P_KO, P_KB, P_CHI, P_G, P_FR, P_WI = range(14)
 P_F_RACE, P_F_BB, P_F_GRAV, P_F_LUB, P_CHO = 14, 15, 16, 17, 18
-N_PARAMS = 19
+P_F_TRAC, P_F_FILM, P_F_BBFILM, P_F_DRAG, P_DRY = 19, 20, 21, 22, 23
+P_ETA0, P_H0, P_TA, P_TB, P_TC, P_TD = range(24, 30)
+P_MU_DRY, P_V_REG, P_CD, P_RHO_MIX, P_RAMP, P_U_FLOOR = range(30, 36)
+N_PARAMS = 36
 
 #: Lubricant damping coefficient at the race contacts (N s/m): the middle of the paper's 2500-7500 range.
-DEFAULT_CHO_N_S_M = 5000.0
+DEFAULT_CHO_N_S_M = ModelParameters().cho_n_s_m
 
 
 @dataclass(frozen=True)
@@ -62,111 +78,183 @@ class PlanarLayout:
 
     @property
     def size(self) -> int:
-        """Number of states, 5 Z + 5."""
-        return 5 * self.n_balls + 5
+        """Number of states, 5 Z + 6."""
+        return 5 * self.n_balls + 6
 
     def slices(self) -> dict[str, slice]:
-        """Named slices: r, theta, r_dot, theta_dot, spin, ring (y, z, y', z')."""
+        """Named slices: r, theta, r_dot, theta_dot, spin, ring (y, z, y', z'), input work, dissipated energy."""
         z = self.n_balls
         return {"r": slice(0, z), "theta": slice(z, 2 * z), "r_dot": slice(2 * z, 3 * z),
                 "theta_dot": slice(3 * z, 4 * z), "spin": slice(4 * z, 5 * z), "ring": slice(5 * z, 5 * z + 4),
-                "dissipated": slice(5 * z + 4, 5 * z + 5)}
+                "input_work": slice(5 * z + 4, 5 * z + 5), "dissipated": slice(5 * z + 5, 5 * z + 6)}
+
+
+@numba.njit(cache=True, inline="always")
+def _tangential(u_s, u_r, q, p):  # pragma: no cover - compiled
+    """Signed tangential force (N) at a contact sliding at u_s: lubricated traction, or dry friction."""
+    if p[P_DRY] > 0.5:
+        return dry_friction(u_s, q, p[P_MU_DRY], p[P_V_REG])
+    return regression_traction(u_s, u_r, q, p[P_TA], p[P_TB], p[P_TC], p[P_TD], p[P_U_FLOOR])
+
+
+@numba.njit(cache=True)
+def _race_forces(y, p, j, z, w_i):  # pragma: no cover - compiled
+    """Race forces on ball j: (f_y, f_z, spin torque, ring f_y, ring f_z, input power, dissipated power)."""
+    d = p[P_D]
+    half = 0.5 * d
+    r, th, rd, thd, om = y[j], y[z + j], y[2 * z + j], y[3 * z + j], y[4 * z + j]
+    cy, cz, cvy, cvz = y[5 * z], y[5 * z + 1], y[5 * z + 2], y[5 * z + 3]
+    c, s = np.cos(th), np.sin(th)
+    fy = fz = torque = ry = rz = p_in = p_diss = 0.0
+    trac = p[P_F_TRAC] > 0.5
+    d_o = r + half - 0.5 * p[P_DO]
+    if d_o > 0.0:
+        q = p[P_KO] * d_o**1.5
+        if p[P_F_LUB] > 0.5:
+            q_d = max(q + p[P_CHO] * rd, 0.0)  # d(delta_o)/dt = r'; never tensile
+            p_diss += (q_d - q) * rd
+            q = q_d
+        f_t = 0.0
+        if trac:
+            u = r * thd + half * om  # ball surface against the fixed outer race, along e_theta
+            u_r = 0.5 * abs(r * thd + half * om - p[P_DO] * thd)
+            f_t = -_tangential(u, u_r, q, p)
+            p_diss -= f_t * u
+            torque += half * f_t
+        fy += -q * c - f_t * s
+        fz += -q * s + f_t * c
+    sx, sz = r * c - cy, r * s - cz
+    ln = np.sqrt(sx * sx + sz * sz)
+    d_i = 0.5 * p[P_DI] + half - ln
+    if d_i > 0.0:
+        nx, nz = sx / ln, sz / ln
+        tx, tz = -nz, nx
+        vx = rd * c - r * thd * s - cvy
+        vz = rd * s + r * thd * c - cvz
+        q = p[P_KI] * d_i**1.5
+        if p[P_F_LUB] > 0.5:
+            ddot = -(vx * nx + vz * nz)
+            q_d = max(q + p[P_CHO] * ddot, 0.0)
+            p_diss += (q_d - q) * ddot
+            q = q_d
+        f_t = 0.0
+        if trac:
+            r_i = 0.5 * p[P_DI]
+            vt = vx * tx + vz * tz
+            u = vt - half * om - w_i * r_i  # ball surface against the ring surface, along t
+            u_r = 0.5 * abs(vt * (1.0 - 2.0 * r_i / ln) - half * om + w_i * r_i)
+            f_t = -_tangential(u, u_r, q, p)
+            p_diss -= f_t * u
+            p_in += w_i * r_i * f_t
+            torque -= half * f_t
+        gy, gz = q * nx + f_t * tx, q * nz + f_t * tz
+        fy += gy
+        fz += gz
+        ry -= gy
+        rz -= gz
+    return fy, fz, torque, ry, rz, p_in, p_diss
+
+
+@numba.njit(cache=True)
+def _pair_forces(y, p, aux, j, k, z):  # pragma: no cover - compiled
+    """Forces between balls j and k: (f_y on k, f_z on k, spin torque on both, dissipated power)."""
+    d = p[P_D]
+    rj, tj, rk, tk = y[j], y[z + j], y[k], y[z + k]
+    dx = rk * np.cos(tk) - rj * np.cos(tj)
+    dz = rk * np.sin(tk) - rj * np.sin(tj)
+    ln = np.sqrt(dx * dx + dz * dz)
+    delta = d - ln
+    film = p[P_F_BBFILM] > 0.5 and -delta < 4.0 / 3.0 * p[P_H0]
+    if delta <= 0.0:
+        aux[j] = 0.0
+        if not film:
+            return 0.0, 0.0, 0.0, 0.0
+    nx, nz = dx / ln, dz / ln
+    vjx = y[2 * z + j] * np.cos(tj) - rj * y[3 * z + j] * np.sin(tj)
+    vjz = y[2 * z + j] * np.sin(tj) + rj * y[3 * z + j] * np.cos(tj)
+    vkx = y[2 * z + k] * np.cos(tk) - rk * y[3 * z + k] * np.sin(tk)
+    vkz = y[2 * z + k] * np.sin(tk) + rk * y[3 * z + k] * np.cos(tk)
+    delta_dot = -((vkx - vjx) * nx + (vkz - vjz) * nz)
+    if delta <= 0.0:
+        # squeeze film between the approaching balls: F = 6 pi eta R^2 (-dh/dt) / h, R = D/4, h >= Delta_r
+        if delta_dot > 0.0:
+            f = 6.0 * np.pi * p[P_ETA0] * (0.25 * d) ** 2 * delta_dot / max(-delta, p[P_H0])
+            return f * nx, f * nz, 0.0, f * delta_dot
+        return 0.0, 0.0, 0.0, 0.0
+    if aux[j] <= 0.0:
+        aux[j] = max(delta_dot, 1e-9)
+    f = hertz_damped(delta, delta_dot, aux[j], p[P_KB], p[P_CHI])
+    p_diss = (f - p[P_KB] * delta**1.5) * delta_dot
+    f_t = torque = 0.0
+    if p[P_F_TRAC] > 0.5:
+        tx, tz = -nz, nx
+        om_j, om_k = y[4 * z + j], y[4 * z + k]
+        u = (vjx - vkx) * tx + (vjz - vkz) * tz + 0.5 * d * (om_j + om_k)  # surface of j against k, along t
+        u_r = 0.25 * d * abs(om_j - om_k)
+        f_t = -_tangential(u, u_r, f, p)  # on j, along t
+        p_diss -= f_t * u
+        torque = 0.5 * d * f_t
+        return f * nx - f_t * tx, f * nz - f_t * tz, torque, p_diss
+    return f * nx, f * nz, torque, p_diss
 
 
 @numba.njit(cache=True)
 def planar_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     z = int(p[P_Z])
-    d, m, inertia, m_ring = p[P_D], p[P_M], p[P_I], p[P_MR]
-    ri_race, ro_race = 0.5 * p[P_DI], 0.5 * p[P_DO]
-    k_i, k_o, k_b, chi, g, f_r = p[P_KI], p[P_KO], p[P_KB], p[P_CHI], p[P_G], p[P_FR]
-    race_on, bb_on, grav_on = p[P_F_RACE] > 0.5, p[P_F_BB] > 0.5, p[P_F_GRAV] > 0.5
-    lub_on, c_ho = p[P_F_LUB] > 0.5, p[P_CHO]
-    cy, cz, cvy, cvz = y[5 * z], y[5 * z + 1], y[5 * z + 2], y[5 * z + 3]
-    power = 0.0  # dissipated power (W)
-    fy_ring = 0.0
-    fz_ring = -f_r - (m_ring * g if grav_on else 0.0)
+    d, m, inertia, m_ring, g = p[P_D], p[P_M], p[P_I], p[P_MR], p[P_G]
+    grav_on = p[P_F_GRAV] > 0.5
+    ramp = p[P_RAMP]
+    w_i = p[P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
+    power_in, power = 0.0, 0.0
+    fy_ring, fz_ring = 0.0, -p[P_FR] - (m_ring * g if grav_on else 0.0)
     for j in range(z):
         dydt[j] = y[2 * z + j]
         dydt[z + j] = y[3 * z + j]
         dydt[2 * z + j] = 0.0  # force accumulators (Cartesian y, z) held in the acceleration slots for now
-        dydt[3 * z + j] = 0.0
-        dydt[4 * z + j] = 0.0
-    for j in range(z):
-        r, th = y[j], y[z + j]
-        c, s = np.cos(th), np.sin(th)
-        px, pz = r * c, r * s
-        fy = 0.0
-        fz = -m * g if grav_on else 0.0
-        if race_on:
-            rd, thd = y[2 * z + j], y[3 * z + j]
-            d_o = r + 0.5 * d - ro_race
-            if d_o > 0.0:
-                q = k_o * d_o**1.5
-                if lub_on:
-                    q_d = max(q + c_ho * rd, 0.0)  # d(delta_o)/dt = r'; never tensile
-                    power += (q_d - q) * rd
-                    q = q_d
-                fy -= q * c
-                fz -= q * s
-            sx, sz = px - cy, pz - cz
-            ln = np.sqrt(sx * sx + sz * sz)
-            d_i = ri_race + 0.5 * d - ln
-            if d_i > 0.0:
-                nx, nz = sx / ln, sz / ln
-                q = k_i * d_i**1.5
-                if lub_on:
-                    vx = rd * c - r * thd * s - cvy
-                    vz = rd * s + r * thd * c - cvz
-                    ddot = -(vx * nx + vz * nz)
-                    q_d = max(q + c_ho * ddot, 0.0)
-                    power += (q_d - q) * ddot
-                    q = q_d
-                fy += q * nx
-                fz += q * nz
-                fy_ring -= q * nx
-                fz_ring -= q * nz
-        dydt[2 * z + j] += fy
-        dydt[3 * z + j] += fz
-    if bb_on:
+        dydt[3 * z + j] = -m * g if grav_on else 0.0
+        dydt[4 * z + j] = 0.0  # torque accumulator
+    if p[P_F_RACE] > 0.5:
+        for j in range(z):
+            fy, fz, torque, ry, rz, p_in, p_diss = _race_forces(y, p, j, z, w_i)
+            dydt[2 * z + j] += fy
+            dydt[3 * z + j] += fz
+            dydt[4 * z + j] += torque
+            fy_ring += ry
+            fz_ring += rz
+            power_in += p_in
+            power += p_diss
+    if p[P_F_BB] > 0.5:
         for j in range(z):
             k = j + 1 if j + 1 < z else 0
-            rj, tj, rk, tk = y[j], y[z + j], y[k], y[z + k]
-            dx = rk * np.cos(tk) - rj * np.cos(tj)
-            dz = rk * np.sin(tk) - rj * np.sin(tj)
-            ln = np.sqrt(dx * dx + dz * dz)
-            delta = d - ln
-            if delta <= 0.0:
-                aux[j] = 0.0
-                continue
-            nx, nz = dx / ln, dz / ln
-            vjx = y[2 * z + j] * np.cos(tj) - rj * y[3 * z + j] * np.sin(tj)
-            vjz = y[2 * z + j] * np.sin(tj) + rj * y[3 * z + j] * np.cos(tj)
-            vkx = y[2 * z + k] * np.cos(tk) - rk * y[3 * z + k] * np.sin(tk)
-            vkz = y[2 * z + k] * np.sin(tk) + rk * y[3 * z + k] * np.cos(tk)
-            delta_dot = -((vkx - vjx) * nx + (vkz - vjz) * nz)
-            if aux[j] <= 0.0:
-                aux[j] = max(delta_dot, 1e-9)
-            f = hertz_damped(delta, delta_dot, aux[j], k_b, chi)
-            power += (f - k_b * delta**1.5) * delta_dot
-            dydt[2 * z + j] -= f * nx
-            dydt[3 * z + j] -= f * nz
-            dydt[2 * z + k] += f * nx
-            dydt[3 * z + k] += f * nz
+            fy, fz, torque, p_diss = _pair_forces(y, p, aux, j, k, z)
+            dydt[2 * z + j] -= fy
+            dydt[3 * z + j] -= fz
+            dydt[2 * z + k] += fy
+            dydt[3 * z + k] += fz
+            dydt[4 * z + j] += torque
+            dydt[4 * z + k] += torque
+            power += p_diss
+    drag = 0.5 * p[P_CD] * p[P_RHO_MIX] * 0.25 * np.pi * d * d if p[P_F_DRAG] > 0.5 else 0.0
     for j in range(z):
         r, th = y[j], y[z + j]
         c, s = np.cos(th), np.sin(th)
         fy, fz = dydt[2 * z + j], dydt[3 * z + j]
+        rd, thd = y[2 * z + j], y[3 * z + j]
         f_rad = fy * c + fz * s
         f_tan = -fy * s + fz * c
-        rd, thd = y[2 * z + j], y[3 * z + j]
+        if drag > 0.0:
+            v = r * thd
+            f_tan -= drag * v * abs(v)
+            power += drag * v * v * abs(v)
         dydt[2 * z + j] = f_rad / m + r * thd * thd
         dydt[3 * z + j] = (f_tan / m - 2.0 * rd * thd) / r
-        dydt[4 * z + j] = 0.0 / inertia  # spin torques come with traction (next slice)
-    dydt[5 * z] = cvy
-    dydt[5 * z + 1] = cvz
+        dydt[4 * z + j] /= inertia
+    dydt[5 * z] = y[5 * z + 2]
+    dydt[5 * z + 1] = y[5 * z + 3]
     dydt[5 * z + 2] = fy_ring / m_ring
     dydt[5 * z + 3] = fz_ring / m_ring
-    dydt[5 * z + 4] = power
+    dydt[5 * z + 4] = power_in
+    dydt[5 * z + 5] = power
 
 
 # Auxiliary array layout: per pair j (between ball j and j+1):
@@ -226,39 +314,72 @@ def planar_post(t, y, p, aux):  # pragma: no cover - compiled
             aux[slot] = np.nan
 
 
-def _params(bearing: Bearing, radial_load_n: float, restitution: float, gravity_m_s2: float, inner_speed: float,
-            effects: dict[str, bool], cho_n_s_m: float) -> npt.NDArray[np.float64]:
-    g, mat, masses = bearing.geometry, bearing.material, bearing.masses
+def _contact_params(bearing: Bearing, p: npt.NDArray[np.float64]) -> None:
+    """Hertz stiffnesses of the inner, outer and ball-ball contacts."""
+    g, mat = bearing.geometry, bearing.material
     eta = compliance(mat)
     rc = race_curvatures(g)
+    p[P_KI] = hertz_contact(*rc["inner"], eta).stiffness
+    p[P_KO] = hertz_contact(*rc["outer"], eta).stiffness
+    p[P_KB] = ball_ball_contact(g, mat).stiffness
+    if bearing.lubricant is not None:
+        p[P_ETA0] = bearing.lubricant.dynamic_viscosity_pa_s
+
+
+def _params(bearing: Bearing, radial_load_n: float, gravity_m_s2: float, inner_speed: float,
+            effects: dict[str, bool], par: ModelParameters, speed_ramp_s: float,
+            oil_air_density_kg_m3: float | None) -> npt.NDArray[np.float64]:
+    g, masses = bearing.geometry, bearing.masses
     p = np.zeros(N_PARAMS)
     p[P_Z], p[P_D], p[P_M] = g.n_balls, g.ball_diameter_m, masses.ball_mass_kg
     p[P_I] = 0.1 * masses.ball_mass_kg * g.ball_diameter_m**2
     p[P_MR] = masses.ring_translational_mass_kg
     p[P_DI], p[P_DO] = g.inner_race_diameter_m, g.outer_race_diameter_m
-    p[P_KI] = hertz_contact(*rc["inner"], eta).stiffness
-    p[P_KO] = hertz_contact(*rc["outer"], eta).stiffness
-    p[P_KB] = ball_ball_contact(g, mat).stiffness
-    p[P_CHI] = damping_factor(restitution)
-    p[P_G], p[P_FR], p[P_WI] = gravity_m_s2, radial_load_n, inner_speed
-    p[P_F_RACE] = float(effects.get("race_contact", True))
-    p[P_F_BB] = float(effects.get("ball_ball_contact", True))
-    p[P_F_GRAV] = float(effects.get("gravity", True))
-    p[P_F_LUB] = float(effects.get("lubricant_damping", bearing.lubricant is not None))
-    p[P_CHO] = cho_n_s_m
+    _contact_params(bearing, p)
+    p[P_CHI] = damping_factor(par.restitution)
+    p[P_G], p[P_FR], p[P_WI], p[P_RAMP] = gravity_m_s2, radial_load_n, inner_speed, speed_ramp_s
+    lubricated = bearing.lubricant is not None
+    flags = {P_F_RACE: ("race_contact", True), P_F_BB: ("ball_ball_contact", True), P_F_GRAV: ("gravity", True),
+             P_F_LUB: ("lubricant_damping", lubricated), P_F_TRAC: ("race_traction", False),
+             P_F_FILM: ("ehl_film", False), P_F_BBFILM: ("ball_ball_film", False), P_F_DRAG: ("drag", False)}
+    for slot, (name, default) in flags.items():
+        p[slot] = float(effects.get(name, default))
+    if not lubricated and (p[P_F_LUB] or p[P_F_FILM] or p[P_F_BBFILM]):
+        raise ParameterError("effects", "a lubricant effect is on but the bearing has no lubricant")
+    p[P_CHO], p[P_H0] = par.cho_n_s_m, par.film_thickness_m
+    p[P_TA], p[P_TB], p[P_TC], p[P_TD] = par.traction_coefficients
+    p[P_V_REG], p[P_U_FLOOR], p[P_CD] = par.slip_regularisation_m_s, par.min_entrainment_m_s, par.drag_coefficient
+    if p[P_F_TRAC] and not lubricated:
+        if par.dry_friction_coefficient is None:
+            raise ParameterError("dry_friction_coefficient", "a dry scene needs the Coulomb friction of the bare "
+                                 "steel contacts, which has no cited default: give it with "
+                                 "--set dry_friction_coefficient=VALUE (or add a lubricant)")
+        p[P_DRY], p[P_MU_DRY] = 1.0, par.dry_friction_coefficient
+    if p[P_F_DRAG]:
+        if oil_air_density_kg_m3 is None:
+            raise ParameterError("oil_air_density_kg_m3", "drag is on but no oil-air mixture density is given")
+        p[P_RHO_MIX] = oil_air_density_kg_m3
     return p
 
 
 def planar_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLike, ring0: tuple[float, float],
-                   radial_load_n: float, restitution: float = 0.8, gravity_m_s2: float = 9.81,
+                   radial_load_n: float, restitution: float | None = None, gravity_m_s2: float = 9.81,
                    inner_speed_rad_s: float = 0.0, effects: dict[str, bool] | None = None,
-                   atol_scale: float = 1.0, cho_n_s_m: float = DEFAULT_CHO_N_S_M,
-                   theta_dot0: npt.ArrayLike | None = None, event_capacity: int = 10_000) -> Problem:
-    """The planar model from a given state (balls at rest), as a :class:`~simulation.solve.Problem`.
+                   atol_scale: float = 1.0, cho_n_s_m: float | None = None,
+                   theta_dot0: npt.ArrayLike | None = None, event_capacity: int = 10_000,
+                   parameters: ModelParameters | None = None, speed_ramp_s: float = 0.0,
+                   oil_air_density_kg_m3: float | None = None, spin0: npt.ArrayLike | None = None) -> Problem:
+    """The planar model from a given state, as a :class:`~simulation.solve.Problem`.
 
+    Effects missing from ``effects`` take their defaults: contacts and gravity on, lubricant
+    damping on for a lubricated bearing, and traction, films and drag off. ``parameters`` holds
+    the open model parameters; ``restitution`` and ``cho_n_s_m``, when given, replace theirs.
     The absolute tolerances (0.1 nm on positions, 0.1 um/s on speeds) are multiplied by ``atol_scale``;
     contact overlaps are micrometres, so energy-level checks want a smaller scale.
     """
+    par = parameters or ModelParameters()
+    over = {k: v for k, v in (("restitution", restitution), ("cho_n_s_m", cho_n_s_m)) if v is not None}
+    par = par.with_overrides(over) if over else par
     g = bearing.geometry
     lay = PlanarLayout(g.n_balls)
     sl = lay.slices()
@@ -268,16 +389,20 @@ def planar_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLi
     y0[5 * g.n_balls:5 * g.n_balls + 2] = ring0
     if theta_dot0 is not None:
         y0[sl["theta_dot"]] = theta_dot0
+    if spin0 is not None:
+        y0[sl["spin"]] = spin0
     atol = np.empty(lay.size)
     atol[sl["r"]] = 1e-10
     atol[sl["theta"]] = 1e-10 / (0.5 * g.pitch_diameter_m)
     atol[sl["r_dot"]] = 1e-7
     atol[sl["theta_dot"]] = 1e-7 / (0.5 * g.pitch_diameter_m)
-    atol[sl["spin"]] = 1e-6
+    atol[sl["spin"]] = 1e-7 / (0.5 * g.ball_diameter_m)
     atol[sl["ring"]] = [1e-10, 1e-10, 1e-7, 1e-7]
+    atol[sl["input_work"]] = 1e-9
     atol[sl["dissipated"]] = 1e-9
     atol *= atol_scale
-    p = _params(bearing, radial_load_n, restitution, gravity_m_s2, inner_speed_rad_s, effects or {}, cho_n_s_m)
+    p = _params(bearing, radial_load_n, gravity_m_s2, inner_speed_rad_s, effects or {}, par, speed_ramp_s,
+                oil_air_density_kg_m3)
     aux = np.zeros(aux_size(g.n_balls, event_capacity))
     aux[g.n_balls:5 * g.n_balls] = np.nan  # no contact episode open
     aux[g.n_balls + 1:5 * g.n_balls:4] = 0.0
@@ -329,6 +454,7 @@ def planar_energy(problem: Problem, y: npt.NDArray[np.float64]) -> npt.NDArray[n
     r, th, rd, thd = y[:, :z], y[:, z:2 * z], y[:, 2 * z:3 * z], y[:, 3 * z:4 * z]
     cy, cz, cvy, cvz = (y[:, 5 * z + i] for i in range(4))
     ke = 0.5 * m * np.sum(rd**2 + (r * thd) ** 2, axis=1) + 0.5 * m_ring * (cvy**2 + cvz**2)
+    ke += 0.5 * p[P_I] * np.sum(y[:, 4 * z:5 * z] ** 2, axis=1)
     pe = m * g * np.sum(r * np.sin(th), axis=1) * (p[P_F_GRAV] > 0.5) + (m_ring * g * (p[P_F_GRAV] > 0.5) + f_r) * cz
     if p[P_F_RACE] > 0.5:
         d_o = np.clip(r + 0.5 * d - 0.5 * p[P_DO], 0, None)

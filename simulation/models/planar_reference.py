@@ -12,7 +12,16 @@ import numpy.typing as npt
 
 from simulation.models import planar as P
 
-__all__ = ["reference_rhs"]
+__all__ = ["reference_rhs", "tangential_force"]
+
+
+def tangential_force(u_s: np.ndarray, u_r: np.ndarray, q: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """Signed tangential force (N): the traction regression, or dry Coulomb friction."""
+    if p[P.P_DRY] > 0.5:
+        return p[P.P_MU_DRY] * q * np.tanh(u_s / p[P.P_V_REG])
+    sr = np.abs(u_s) / np.maximum(np.abs(u_r), p[P.P_U_FLOOR])
+    mu = (p[P.P_TA] + p[P.P_TB] * sr) * np.exp(-p[P.P_TC] * sr) + p[P.P_TD]
+    return np.where((q > 0) & (u_s != 0), np.sign(u_s) * mu * q, 0.0)
 
 
 def reference_rhs(t: float, y: npt.NDArray[np.float64], p: npt.NDArray[np.float64],
@@ -20,67 +29,119 @@ def reference_rhs(t: float, y: npt.NDArray[np.float64], p: npt.NDArray[np.float6
     """dy/dt of the planar model (numpy). ``aux`` holds the ball-ball approach speeds, updated in place."""
     z = int(p[P.P_Z])
     d, m, m_ring = p[P.P_D], p[P.P_M], p[P.P_MR]
+    half = 0.5 * d
     g = p[P.P_G] if p[P.P_F_GRAV] > 0.5 else 0.0
-    r, th, rd, thd = y[:z], y[z:2 * z], y[2 * z:3 * z], y[3 * z:4 * z]
+    w_i = p[P.P_WI] * (min(t / p[P.P_RAMP], 1.0) if p[P.P_RAMP] > 0 else 1.0)
+    trac = p[P.P_F_TRAC] > 0.5
+    r, th, rd, thd, om = y[:z], y[z:2 * z], y[2 * z:3 * z], y[3 * z:4 * z], y[4 * z:5 * z]
     cy, cz, cvy, cvz = y[5 * z:5 * z + 4]
     c, s = np.cos(th), np.sin(th)
     fy = np.zeros(z)
     fz = np.full(z, -m * g)
+    torque = np.zeros(z)
     ring = np.array([0.0, -p[P.P_FR] - m_ring * g])
-    power = 0.0
+    power, power_in = 0.0, 0.0
     lub, c_ho = p[P.P_F_LUB] > 0.5, p[P.P_CHO]
     if p[P.P_F_RACE] > 0.5:
-        d_o = r + 0.5 * d - 0.5 * p[P.P_DO]
+        d_o = r + half - 0.5 * p[P.P_DO]
         q = np.where(d_o > 0, p[P.P_KO] * np.clip(d_o, 0, None) ** 1.5, 0.0)
         if lub:
             qd = np.where(d_o > 0, np.maximum(q + c_ho * rd, 0.0), 0.0)
             power += np.sum((qd - q) * rd)
             q = qd
-        fy -= q * c
-        fz -= q * s
+        f_t = np.zeros(z)
+        if trac:
+            u = r * thd + half * om
+            f_t = -tangential_force(u, 0.5 * np.abs(u - p[P.P_DO] * thd), q, p)
+            power -= np.sum(f_t * u)
+            torque += half * f_t
+        fy += -q * c - f_t * s
+        fz += -q * s + f_t * c
         sx, sz = r * c - cy, r * s - cz
         ln = np.hypot(sx, sz)
-        d_i = 0.5 * p[P.P_DI] + 0.5 * d - ln
+        d_i = 0.5 * p[P.P_DI] + half - ln
         nx, nz = sx / ln, sz / ln
+        vx, vz = rd * c - r * thd * s - cvy, rd * s + r * thd * c - cvz
         q = np.where(d_i > 0, p[P.P_KI] * np.clip(d_i, 0, None) ** 1.5, 0.0)
         if lub:
-            ddot = -((rd * c - r * thd * s - cvy) * nx + (rd * s + r * thd * c - cvz) * nz)
+            ddot = -(vx * nx + vz * nz)
             qd = np.where(d_i > 0, np.maximum(q + c_ho * ddot, 0.0), 0.0)
             power += np.sum((qd - q) * ddot)
             q = qd
-        fy += q * nx
-        fz += q * nz
-        ring -= [np.sum(q * nx), np.sum(q * nz)]
+        f_t = np.zeros(z)
+        if trac:
+            r_i = 0.5 * p[P.P_DI]
+            vt = -vx * nz + vz * nx
+            u = vt - half * om - w_i * r_i
+            f_t = -tangential_force(u, 0.5 * np.abs(vt * (1 - 2 * r_i / ln) - half * om + w_i * r_i), q, p)
+            power -= np.sum(f_t * u)
+            power_in += np.sum(w_i * r_i * f_t)
+            torque -= half * f_t
+        gy, gz = q * nx - f_t * nz, q * nz + f_t * nx
+        fy += gy
+        fz += gz
+        ring -= [np.sum(gy), np.sum(gz)]
     if p[P.P_F_BB] > 0.5:
-        x, zz = r * c, r * s
-        vx, vz = rd * c - r * thd * s, rd * s + r * thd * c
-        k = np.roll(np.arange(z), -1)
-        dx, dz = x[k] - x, zz[k] - zz
-        ln = np.hypot(dx, dz)
-        delta = d - ln
-        nx, nz = dx / ln, dz / ln
-        ddot = -((vx[k] - vx) * nx + (vz[k] - vz) * nz)
-        touching = delta > 0
-        speeds = aux[:z]  # approach speeds (a view: updated in place)
-        speeds[~touching] = 0.0
-        new = touching & (speeds <= 0)
-        speeds[new] = np.maximum(ddot[new], 1e-9)
-        chi = p[P.P_CHI]
-        el = p[P.P_KB] * np.clip(delta, 0, None) ** 1.5
-        f = np.where(touching, np.maximum(el * (1 + (chi * ddot / np.where(speeds > 0, speeds, 1.0) if chi > 0 else 0)),
-                                          0), 0.0)
-        power += np.sum((f - el) * ddot * touching)
-        np.add.at(fy, np.arange(z), -f * nx)
-        np.add.at(fz, np.arange(z), -f * nz)
-        np.add.at(fy, k, f * nx)
-        np.add.at(fz, k, f * nz)
+        power += _pairs(y, p, aux, fy, fz, torque)
     f_rad, f_tan = fy * c + fz * s, -fy * s + fz * c
+    if p[P.P_F_DRAG] > 0.5:
+        v = r * thd
+        k_d = 0.5 * p[P.P_CD] * p[P.P_RHO_MIX] * 0.25 * np.pi * d * d
+        f_tan = f_tan - k_d * v * np.abs(v)
+        power += np.sum(k_d * v * v * np.abs(v))
     out = np.empty_like(y)
     out[:z], out[z:2 * z] = rd, thd
     out[2 * z:3 * z] = f_rad / m + r * thd**2
     out[3 * z:4 * z] = (f_tan / m - 2 * rd * thd) / r
-    out[4 * z:5 * z] = 0.0
+    out[4 * z:5 * z] = torque / p[P.P_I]
     out[5 * z:5 * z + 2] = cvy, cvz
     out[5 * z + 2:5 * z + 4] = ring / m_ring
-    out[5 * z + 4] = power
+    out[5 * z + 4] = power_in
+    out[5 * z + 5] = power
     return out
+
+
+def _pairs(y: np.ndarray, p: np.ndarray, aux: np.ndarray, fy: np.ndarray, fz: np.ndarray,
+           torque: np.ndarray) -> float:
+    """Ball-ball Hertz, friction and squeeze film into fy, fz, torque (in place); returns dissipated power."""
+    z = int(p[P.P_Z])
+    d = p[P.P_D]
+    r, th, rd, thd, om = y[:z], y[z:2 * z], y[2 * z:3 * z], y[3 * z:4 * z], y[4 * z:5 * z]
+    c, s = np.cos(th), np.sin(th)
+    x, zz = r * c, r * s
+    vx, vz = rd * c - r * thd * s, rd * s + r * thd * c
+    k = np.roll(np.arange(z), -1)
+    dx, dz = x[k] - x, zz[k] - zz
+    ln = np.hypot(dx, dz)
+    delta = d - ln
+    nx, nz = dx / ln, dz / ln
+    ddot = -((vx[k] - vx) * nx + (vz[k] - vz) * nz)
+    touching = delta > 0
+    speeds = aux[:z]  # approach speeds (a view: updated in place)
+    speeds[~touching] = 0.0
+    new = touching & (speeds <= 0)
+    speeds[new] = np.maximum(ddot[new], 1e-9)
+    chi = p[P.P_CHI]
+    el = p[P.P_KB] * np.clip(delta, 0, None) ** 1.5
+    f = np.where(touching, np.maximum(el * (1 + (chi * ddot / np.where(speeds > 0, speeds, 1.0) if chi > 0 else 0)),
+                                      0), 0.0)
+    power = np.sum((f - el) * ddot * touching)
+    ft = np.zeros(z)
+    if p[P.P_F_TRAC] > 0.5:
+        u = (vx - vx[k]) * -nz + (vz - vz[k]) * nx + 0.5 * d * (om + om[k])
+        ft = np.where(touching, -tangential_force(u, 0.25 * d * np.abs(om - om[k]), f, p), 0.0)
+        power -= np.sum(ft * u)
+        torque += 0.5 * d * ft
+        np.add.at(torque, k, 0.5 * d * ft)
+    film = np.zeros(z)
+    if p[P.P_F_BBFILM] > 0.5:
+        near = (~touching) & (-delta < 4.0 / 3.0 * p[P.P_H0]) & (ddot > 0)
+        film = np.where(near, 6 * np.pi * p[P.P_ETA0] * (0.25 * d) ** 2 * ddot / np.maximum(-delta, p[P.P_H0]), 0.0)
+        power += np.sum(film * ddot)
+    on_k_y = (f + film) * nx + ft * nz
+    on_k_z = (f + film) * nz - ft * nx
+    np.add.at(fy, np.arange(z), -on_k_y)
+    np.add.at(fz, np.arange(z), -on_k_z)
+    np.add.at(fy, k, on_k_y)
+    np.add.at(fz, k, on_k_z)
+    return float(power)

@@ -71,31 +71,38 @@ def test_energy_balance_closes_with_damping():
 
 def test_layout():
     lay = PlanarLayout(14)
-    assert lay.size == 75
+    assert lay.size == 76
     assert lay.slices()["ring"] == slice(70, 74)
     angles = packed_start(B, seed=3)
     phi = 2 * np.arcsin(G.ball_diameter_m / G.pitch_diameter_m)
     assert np.all(np.diff(angles) >= phi) and angles.mean() == pytest.approx(1.5 * np.pi, abs=0.2)
 
 
-def test_compiled_and_numpy_right_hand_sides_agree():
+ALL_ON = {"race_traction": True, "ehl_film": True, "ball_ball_film": True, "drag": True}
+
+
+@pytest.mark.parametrize("effects", [{}, ALL_ON], ids=["core", "all-effects"])
+def test_compiled_and_numpy_right_hand_sides_agree(effects):
     """The compiled RHS against the plain-numpy reference, on perturbed states with contacts and motion."""
     from simulation.models.planar_reference import reference_rhs
 
     rng = np.random.default_rng(5)
     th = packed_start(B, seed=2, spread=0.0)  # neighbours exactly touching
     pr = planar_problem(B, th, np.full(G.n_balls, 0.5 * G.pitch_diameter_m), (1e-6, -4e-6), 500.0,
-                        restitution=0.6)
+                        restitution=0.6, effects=effects, inner_speed_rad_s=300.0, speed_ramp_s=1e-3,
+                        oil_air_density_kg_m3=20.0)
     z = G.n_balls
     for _ in range(5):
         y = pr.y0.copy()
         y[:z] += rng.normal(0, 2e-6, z)
         y[z:2 * z] -= np.linspace(0, 1e-4, z)  # squeeze neighbours a little
-        y[2 * z:4 * z] = rng.normal(0, 1e-2, 2 * z)
+        y[2 * z:3 * z] = rng.normal(0, 1e-2, z)
+        y[3 * z:4 * z] = rng.normal(100.0, 5.0, z)
+        y[4 * z:5 * z] = rng.normal(-500.0, 50.0, z)
         y[5 * z + 2:5 * z + 4] = rng.normal(0, 1e-3, 2)
         aux_fast, aux_ref = pr.aux.copy(), pr.aux.copy()
-        fast = pr.rhs(0.0, y, aux_fast)
-        ref = reference_rhs(0.0, y, pr.params, aux_ref)
+        fast = pr.rhs(4e-4, y, aux_fast)
+        ref = reference_rhs(4e-4, y, pr.params, aux_ref)
         np.testing.assert_allclose(fast, ref, rtol=1e-10, atol=1e-12)
         np.testing.assert_allclose(aux_fast[:z], aux_ref[:z], rtol=1e-12)
 

@@ -18,13 +18,29 @@ from simulation.scene import Scene
 FORCE_OFF = ["--effect", "race_traction=off", "--effect", "ehl_film=off", "--effect", "ball_ball_film=off", "--force"]
 
 
-def test_unsupported_effects_are_refused_with_the_way_out(tmp_path, capsys):
-    assert main(["simulate", "--speed-rpm", "3000", "--radial-load-n", "500", "-o", str(tmp_path / "x.h5")]) == 2
-    err = capsys.readouterr().err
-    assert "race_traction" in err and "--effect race_traction=off" in err
-    assert not (tmp_path / "x.h5").exists()
-    assert main(["simulate", "--speed-rpm", "3000", "--axial-load-n", "300"]) == 2
+def test_unsupported_scenes_are_refused_with_the_way_out(tmp_path, capsys):
+    out = tmp_path / "x.h5"
+    assert main(["simulate", "--speed-rpm", "3000", "--axial-load-n", "300", "-o", str(out)]) == 2
     assert "spatial level" in capsys.readouterr().err
+    assert main(["simulate", "--speed-rpm", "3000", "--dry", "-o", str(out)]) == 2  # no cited dry friction
+    assert "--set dry_friction_coefficient=" in capsys.readouterr().err
+    assert main(["simulate", "--speed-rpm", "3000", "--set", "restitution=1.5", "-o", str(out)]) == 2
+    assert "parameters.restitution" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_full_model_run_writes_traction_and_films(tmp_path, capsys):
+    out = tmp_path / "full.trace.h5"
+    assert main(["simulate", "--speed-rpm", "6000", "--radial-load-n", "500", "--duration", "0.005", "-q",
+                 "-o", str(out), "--set", "cho_n_s_m=2500"]) == 0
+    assert "peak slip in the unloaded zone" in capsys.readouterr().out
+    tr = read_trace(out)
+    c = tr.groups["contacts"]
+    assert {"inner_traction", "outer_traction", "inner_film", "outer_film"} <= set(c)
+    loaded = c["inner_normal"] > 50
+    # Hamrock-Dowson films of a few tenths of a micrometre where the balls carry the load.
+    assert 0.05e-6 < np.nanmedian(c["inner_film"][loaded]) < 1e-6
+    assert tr.provenance["config"]["parameters"]["cho_n_s_m"] == 2500
 
 
 def test_run_writes_a_simulation_trace(tmp_path, capsys):
@@ -65,5 +81,5 @@ def test_solver_failure_is_an_incomplete_trace(tmp_path):
     assert tr.status.startswith("incomplete: ")
     assert not tr.valid[-1].any()
     with pytest.raises(UsageError):
-        simulate(Scene(conditions=OperatingConditions(3000.0, 500.0)),
-                 choose_model(Scene(conditions=OperatingConditions(3000.0, 500.0))), progress=False)
+        spatial = Scene(conditions=OperatingConditions(3000.0, 500.0, 300.0))
+        simulate(spatial, choose_model(spatial), progress=False)

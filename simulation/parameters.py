@@ -1,0 +1,155 @@
+"""The model parameters the paper leaves open, with their defaults and sources (DESIGN §6).
+
+Every value here can be changed per run (``cageless simulate --set name=value``)
+and is recorded in the trace's configuration. Where a default is a choice inside
+a published range rather than a published value, the docstring says so.
+
+Sources
+-------
+* ``cho_n_s_m``: Wang et al. (2026) §4 vary the race lubricant damping C_ho over
+  2500-7500 N s/m in their sensitivity study; the default is the middle, 5000.
+* ``film_thickness_m``: the same study varies the oil film thickness h_0 over
+  0.1-0.35 um; the default is the middle, 0.225 um. It is the film used by the
+  traction law when the ``ehl_film`` effect is off, and the critical film
+  thickness Delta_r of the ball-ball squeeze film (DESIGN §6).
+* ``traction_peak_coefficient``, ``traction_peak_slide_roll``,
+  ``traction_sliding_coefficient``: the traction curve of
+  :mod:`simulation.traction` (the Sakaguchi & Harada / Gupta regression form the
+  paper cites as [22], [23]), stated by its peak 0.06 at a slide-to-roll ratio of
+  2 % and its sliding value 0.04. **These are representative values of mineral
+  oil traction curves, not the coefficients of the paper's oil**: the paper does
+  not print its regression coefficients and no copy of Sakaguchi & Harada (2006)
+  was available to this project. They are the first thing to replace with a
+  measured curve (``--set``).
+* ``restitution``: ball-ball coefficient of restitution R; 0.8 is a
+  representative value for lubricated steel spheres. The paper does not give
+  one; R is swept in the stability tests.
+* ``drag_coefficient``: 0.47, the textbook drag coefficient of a smooth sphere
+  in the subcritical Reynolds range (F. M. White, Fluid Mechanics, Fig. 7.16).
+  Used only when the scene gives an oil-air mixture density.
+* ``dry_friction_coefficient``: no default. A dry scene has no film, and the
+  Coulomb friction of the bare steel contact must be given (``--set
+  dry_friction_coefficient=...``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from cageless.errors import ParameterError, suggest
+
+__all__ = ["ModelParameters", "parse_set_overrides"]
+
+
+@dataclass(frozen=True)
+class ModelParameters:
+    """Open model parameters (SI units; the names carry them).
+
+    Parameters
+    ----------
+    cho_n_s_m
+        Race-contact lubricant damping C_ho (N s/m), >= 0.
+    film_thickness_m
+        Oil film thickness h_0 (m), > 0: the traction film when ``ehl_film`` is off, and the
+        critical film Delta_r of the ball-ball squeeze film.
+    traction_peak_coefficient
+        Peak of the lubricated traction curve, mu_peak, in (0, 1), above the sliding value.
+    traction_peak_slide_roll
+        Slide-to-roll ratio at the peak, in (0, 1).
+    traction_sliding_coefficient
+        Traction coefficient at large slide-to-roll ratio, mu_inf, in (0, 1); also the ball-ball
+        sliding friction of a lubricated bearing.
+    restitution
+        Ball-ball coefficient of restitution R, in (0, 1].
+    drag_coefficient
+        Drag coefficient C_D of a ball in the oil-air mixture, >= 0.
+    dry_friction_coefficient
+        Coulomb friction of a dry steel contact, in (0, 1), or None when not given.
+    slip_regularisation_m_s
+        Sliding speed (m/s) over which the dry Coulomb friction builds up (tanh), > 0.
+    min_entrainment_m_s
+        Floor on the entrainment speed in the slide-to-roll ratio (m/s), > 0: a contact that rolls
+        slower than this is treated as sliding (the film has collapsed), which also bounds the
+        traction slope at start-up.
+    """
+
+    cho_n_s_m: float = 5000.0
+    film_thickness_m: float = 0.225e-6
+    traction_peak_coefficient: float = 0.06
+    traction_peak_slide_roll: float = 0.02
+    traction_sliding_coefficient: float = 0.04
+    restitution: float = 0.8
+    drag_coefficient: float = 0.47
+    dry_friction_coefficient: float | None = None
+    slip_regularisation_m_s: float = 1e-3
+    min_entrainment_m_s: float = 0.1
+
+    def __post_init__(self) -> None:
+        rules = {
+            "cho_n_s_m": (lambda v: v >= 0, "must be >= 0"),
+            "film_thickness_m": (lambda v: 0 < v < 1e-4, "must lie in (0, 100 um)"),
+            "traction_peak_coefficient": (lambda v: 0 < v < 1, "must lie in (0, 1)"),
+            "traction_peak_slide_roll": (lambda v: 0 < v < 1, "must lie in (0, 1)"),
+            "traction_sliding_coefficient": (lambda v: 0 < v < 1, "must lie in (0, 1)"),
+            "restitution": (lambda v: 0 < v <= 1, "must lie in (0, 1]"),
+            "drag_coefficient": (lambda v: v >= 0, "must be >= 0"),
+            "slip_regularisation_m_s": (lambda v: v > 0, "must be > 0"),
+            "min_entrainment_m_s": (lambda v: v > 0, "must be > 0"),
+        }
+        for name, (ok, rule) in rules.items():
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value) \
+                    or not ok(value):
+                raise ParameterError(f"parameters.{name}", rule, value)
+        mu = self.dry_friction_coefficient
+        if mu is not None and not (isinstance(mu, int | float) and math.isfinite(mu) and 0 < mu < 1):
+            raise ParameterError("parameters.dry_friction_coefficient", "must lie in (0, 1), or be None", mu)
+        if self.traction_peak_coefficient <= self.traction_sliding_coefficient:
+            raise ParameterError("parameters.traction_peak_coefficient", "must exceed traction_sliding_coefficient",
+                                 self.traction_peak_coefficient)
+
+    @property
+    def traction_coefficients(self) -> tuple[float, float, float, float]:
+        """(A, B, C, D) of the traction regression (:func:`simulation.traction.regression_coefficients`)."""
+        from simulation.traction import regression_coefficients
+
+        return regression_coefficients(self.traction_peak_coefficient, self.traction_peak_slide_roll,
+                                       self.traction_sliding_coefficient)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready values."""
+        return dataclasses.asdict(self)
+
+    def with_overrides(self, values: Mapping[str, float]) -> ModelParameters:
+        """A copy with ``values`` replaced; unknown names get a suggestion."""
+        names = [f.name for f in dataclasses.fields(self)]
+        for name in values:
+            if name not in names:
+                raise ParameterError("--set", f"{name!r} is not a model parameter"
+                                     + (suggest(name, names) or f"; the parameters are {', '.join(names)}"))
+        return dataclasses.replace(self, **values)
+
+
+def parse_set_overrides(items: list[str]) -> dict[str, float]:
+    """Parse ``--set name=value`` items into numbers (``none`` clears an optional parameter)."""
+    out: dict[str, Any] = {}
+    for item in items:
+        name, sep, text = item.partition("=")
+        if not sep or not name.strip():
+            raise ParameterError("--set", f"expects name=value, got {item!r} (e.g. --set cho_n_s_m=2500)")
+        text = text.strip()
+        if text.lower() == "none":
+            out[name.strip()] = None
+            continue
+        try:
+            value = float(text)
+        except ValueError:
+            raise ParameterError("--set", f"{name.strip()}={text!r}: the value must be a number") from None
+        if not math.isfinite(value):
+            raise ParameterError("--set", f"{name.strip()}: the value must be finite", value)
+        out[name.strip()] = value
+    return out
