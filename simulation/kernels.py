@@ -11,7 +11,7 @@ import numba
 
 from simulation.models import planar, textbook, two_balls
 
-__all__ = ["PLANAR", "TWO_BALLS", "OSCILLATOR", "RICCATI", "model_rhs", "model_post"]
+__all__ = ["PLANAR", "TWO_BALLS", "OSCILLATOR", "RICCATI", "model_rhs", "model_post", "model_signature"]
 
 PLANAR, TWO_BALLS = planar.MODEL_ID, two_balls.MODEL_ID
 OSCILLATOR, RICCATI = textbook.OSCILLATOR, textbook.RICCATI
@@ -37,3 +37,11 @@ def model_post(model_id, t, y, p, aux):  # pragma: no cover - compiled
         planar.planar_post(t, y, p, aux)
     elif model_id == TWO_BALLS:
         two_balls.two_ball_post(t, y, p, aux)
+
+
+@numba.njit(cache=True)
+def model_signature(model_id, y, p):  # pragma: no cover - compiled
+    """A number that changes whenever a contact opens or closes (0 for models without contacts)."""
+    if model_id == PLANAR:
+        return planar.planar_signature(y, p)
+    return 0.0

@@ -29,6 +29,9 @@ class Problem:
     t0: float
     atol: FloatArray
     name: str = "problem"
+    #: Steps longer than this (s) in which a contact opens or closes are rejected and retried shorter
+    #: (0: no contact-onset control). See :func:`simulation.kernels.model_signature`.
+    onset_step: float = 0.0
 
     def rhs(self, t: float, y: FloatArray, aux: FloatArray | None = None) -> FloatArray:
         """dy/dt at (t, y), evaluated by the compiled kernel (``aux`` defaults to a copy of the problem's)."""

@@ -164,17 +164,18 @@ def _films(scene: Scene, inner: np.ndarray, outer: np.ndarray, ur_i: np.ndarray,
 def _solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: str, max_step: float,
                   chunks: int, progress: bool, max_steps: int) -> Solution:
     edges = np.unique(np.linspace(0, len(t) - 1, chunks + 1).astype(int))
-    ys, steps, rej, rhs, wall = [pr.y0[None, :]], 0, 0, 0, 0.0
+    ys, steps, rej, rhs, wall, onset, changes = [pr.y0[None, :]], 0, 0, 0, 0.0, 0, 0
     y0, aux, t0 = pr.y0.copy(), pr.aux.copy(), float(t[0])
     sol = None
     with tqdm(total=float(t[-1] - t[0]), desc="simulated s", unit="s", disable=not progress, leave=False) as bar:
         for a, b in zip(edges[:-1], edges[1:], strict=True):
             part = Problem(model_id=pr.model_id, params=pr.params, aux=aux, y0=y0, t0=t0, atol=pr.atol,
-                           name=pr.name)
+                           name=pr.name, onset_step=pr.onset_step)
             sol = solve(part, t[a + 1:b + 1], method=method, rtol=rtol, max_step=max_step,
                         max_steps=max(1, max_steps - steps - rej))
             ys.append(sol.y)
             steps, rej, rhs, wall = steps + sol.n_steps, rej + sol.n_rejected, rhs + sol.n_rhs, wall + sol.wall_s
+            onset, changes = onset + sol.n_onset_retries, changes + sol.n_contact_changes
             bar.update(float(t[b] - t[a]))
             if not sol.success:
                 break
@@ -184,7 +185,8 @@ def _solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: 
         y = np.vstack([y, np.full((len(t) - len(y), y.shape[1]), np.nan)])
     assert sol is not None
     return Solution(t=t, y=y, status=sol.status, message=sol.message, method=method, n_steps=steps,
-                    n_rejected=rej, n_rhs=rhs, wall_s=wall, extra={"aux": aux})
+                    n_rejected=rej, n_rhs=rhs, wall_s=wall, n_onset_retries=onset, n_contact_changes=changes,
+                    extra={"aux": aux})
 
 
 def simulate(scene: Scene, choice: ModelChoice, parameters: ModelParameters | None = None, rtol: float = 1e-6,
@@ -213,7 +215,11 @@ def simulate(scene: Scene, choice: ModelChoice, parameters: ModelParameters | No
     start = time.perf_counter()
     sol = _solve_chunks(pr, t, rtol, method, max_step, min(50, len(t) - 1), progress, max_steps)
     wall = time.perf_counter() - start
-    trace = _to_trace(scene, choice, pr, sol, rtol, wall, prov.finish().to_dict())
+    provenance = prov.finish().to_dict()
+    provenance["solver_stats"] = {"n_steps": sol.n_steps, "n_rejected": sol.n_rejected, "n_rhs": sol.n_rhs,
+                                  "n_onset_retries": sol.n_onset_retries, "n_contact_changes": sol.n_contact_changes,
+                                  "onset_step_s": pr.onset_step, "wall_s": wall}
+    trace = _to_trace(scene, choice, pr, sol, rtol, wall, provenance)
     if out is not None:
         write_trace(out, trace)
     return SimulationResult(solution=sol, trace=trace, problem=pr)

@@ -2,7 +2,8 @@
 
 :func:`solve` runs a :class:`Problem` with the method named in :data:`METHODS`:
 
-* ``"dp5"``: Dormand-Prince 5(4) with its whole loop compiled (the default);
+* ``"dp5"``: Dormand-Prince 5(4) with its whole loop compiled (the default); it rejects and retries
+  any step longer than ``Problem.onset_step`` in which a contact opens or closes, and counts them;
 * ``"RK45"``, ``"DOP853"``, ``"LSODA"``, ``"BDF"``, ``"Radau"``: ``scipy.integrate.solve_ivp``
   on the same compiled right-hand side, as references (the accepted-step bookkeeping is not run).
 
@@ -45,6 +46,8 @@ class Solution:
     n_rejected: int = 0
     n_rhs: int = 0
     wall_s: float = 0.0
+    n_onset_retries: int = 0
+    n_contact_changes: int = 0
     extra: dict[str, Any] = field(default_factory=dict)
 
     @property
@@ -56,16 +59,16 @@ class Solution:
 def _solve_dp5(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float, first_step: float | None,
                max_steps: int) -> Solution:
     out = np.full((len(t_eval), len(pr.y0)), np.nan)
-    stats = np.zeros(4)
+    stats = np.zeros(6)
     aux = pr.aux.copy()
     h0 = first_step or min(max_step, 1e-3 * max(t_eval[-1] - pr.t0, 1e-12))
     t0 = time.perf_counter()
     status = dp5_integrate(pr.model_id, pr.params, aux, pr.y0.astype(np.float64), float(pr.t0), t_eval,
                            float(rtol), pr.atol.astype(np.float64), float(h0), float(max_step), int(max_steps), out,
-                           stats)
+                           stats, float(pr.onset_step))
     return Solution(t=t_eval, y=out, status=int(status), message=_MESSAGES[int(status)], method="dp5",
                     n_steps=int(stats[0]), n_rejected=int(stats[1]), n_rhs=int(stats[2]),
-                    wall_s=time.perf_counter() - t0, extra={"aux": aux, "last_h": float(stats[3])})
+                    wall_s=time.perf_counter() - t0, n_onset_retries=int(stats[4]), n_contact_changes=int(stats[5]), extra={"aux": aux, "last_h": float(stats[3])})
 
 
 def _scipy(method: str) -> Callable[..., Solution]:

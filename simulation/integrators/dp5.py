@@ -23,7 +23,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from simulation.kernels import model_post, model_rhs
+from simulation.kernels import model_post, model_rhs, model_signature
 
 __all__ = ["dp5_integrate", "STATUS_OK", "STATUS_MAX_STEPS", "STATUS_STEP_UNDERFLOW", "STATUS_NONFINITE"]
 
@@ -44,10 +44,13 @@ E1, E3, E4, E5, E6, E7 = 71 / 57600, -71 / 16695, 71 / 1920, -17253 / 339200, 22
 
 
 @numba.njit(cache=True)
-def dp5_integrate(model_id, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, max_steps, out, stats):
+def dp5_integrate(model_id, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, max_steps, out, stats, h_onset=0.0):
     """Integrate from ``t0`` and write ``y`` at each ``t_out[k]`` (increasing, >= t0) into ``out[k]``.
 
-    ``stats`` receives [n_steps, n_rejected, n_rhs, last_h]. Returns a status code:
+    A step longer than ``h_onset`` during which a contact opens or closes (the model's signature
+    changes) is rejected and retried at most ``h_onset`` long, so contact onsets are never stepped over.
+    ``stats`` receives [n_steps, n_rejected, n_rhs, last_h, n_onset_retries, n_contact_changes].
+    Returns a status code:
     0 ok, 1 too many steps, 2 step-size underflow, 3 non-finite state.
     """  # noqa: D401
     n = y0.shape[0]
@@ -63,6 +66,9 @@ def dp5_integrate(model_id, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, max_st
     ynew = np.empty(n)
     t = t0
     model_rhs(model_id, t, y, p, aux, k1)
+    sig = model_signature(model_id, y, p) if h_onset > 0.0 else 0.0
+    n_onset = 0
+    n_changes = 0
     n_rhs = 1
     n_steps = 0
     n_rej = 0
@@ -124,6 +130,16 @@ def dp5_integrate(model_id, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, max_st
                 break
             continue
         fac11 = err ** 0.17  # 0.2 - 0.75 beta, beta = 0.04
+        if err <= 1.0 and h_onset > 0.0:
+            sig_new = model_signature(model_id, ynew, p)
+            if sig_new != sig:
+                if h > h_onset:
+                    n_onset += 1
+                    n_rej += 1
+                    h = h_onset
+                    continue
+                n_changes += 1
+                sig = sig_new
         if err <= 1.0:
             fac = fac11 / err_old ** 0.04
             fac = max(0.1, min(5.0, fac / 0.9))
@@ -146,6 +162,8 @@ def dp5_integrate(model_id, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, max_st
     stats[1] = n_rej
     stats[2] = n_rhs
     stats[3] = h
+    stats[4] = n_onset
+    stats[5] = n_changes
     return status
 
 

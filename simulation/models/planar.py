@@ -257,6 +257,28 @@ def planar_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     dydt[5 * z + 5] = power
 
 
+@numba.njit(cache=True)
+def planar_signature(y, p):  # pragma: no cover - compiled
+    """Which contacts are closed, as a number: sum over contacts of (its index + 1) when closed."""
+    z = int(p[P_Z])
+    d = p[P_D]
+    cy, cz = y[5 * z], y[5 * z + 1]
+    sig = 0.0
+    for j in range(z):
+        r, th = y[j], y[z + j]
+        if r + 0.5 * d - 0.5 * p[P_DO] > 0.0:
+            sig += 1.0 + j
+        sx, sz = r * np.cos(th) - cy, r * np.sin(th) - cz
+        if 0.5 * p[P_DI] + 0.5 * d - np.sqrt(sx * sx + sz * sz) > 0.0:
+            sig += 1.0 + z + j
+        k = j + 1 if j + 1 < z else 0
+        dx = y[k] * np.cos(y[z + k]) - r * np.cos(th)
+        dz = y[k] * np.sin(y[z + k]) - r * np.sin(th)
+        if d * d - (dx * dx + dz * dz) > 0.0:
+            sig += 1.0 + 2 * z + j
+    return sig * (sig + 1.0)  # spreads sums so that one contact swapping for another rarely keeps the value
+
+
 # Auxiliary array layout: per pair j (between ball j and j+1):
 #   aux[j]           approach speed recorded at contact onset (used by the damping term)
 #   aux[Z + 4j + 0]  onset time (NaN when apart)
@@ -267,6 +289,8 @@ def planar_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
 EVENT_FIELDS = 6  # time, pair, angle, peak_force, duration, kind (0 impact, 1 rubbing)
 #: An episode longer than this many Hertz impact durations (at its approach speed) is rubbing.
 RUBBING_FACTOR = 3.0
+#: Contact onsets are resolved to this fraction of the Hertz impact duration at 1 m/s approach.
+ONSET_RESOLUTION = 20.0
 
 
 def aux_size(n_balls: int, capacity: int) -> int:
@@ -408,7 +432,10 @@ def planar_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLi
     aux[g.n_balls + 1:5 * g.n_balls:4] = 0.0
     aux[g.n_balls + 2:5 * g.n_balls:4] = 0.0
     aux[g.n_balls + 3:5 * g.n_balls:4] = 0.0
-    return Problem(model_id=MODEL_ID, params=p, aux=aux, y0=y0, t0=0.0, atol=atol, name="planar cageless bearing")
+    # An impact at 1 m/s approach lasts t_H; contact onsets are resolved to t_H / ONSET_RESOLUTION.
+    onset = hertz_impact_duration(1.0, 0.5 * p[P_M], p[P_KB]) / ONSET_RESOLUTION
+    return Problem(model_id=MODEL_ID, params=p, aux=aux, y0=y0, t0=0.0, atol=atol, name="planar cageless bearing",
+                   onset_step=onset)
 
 
 def contact_events(problem: Problem, aux: npt.NDArray[np.float64], t_end: float) -> pd.DataFrame:

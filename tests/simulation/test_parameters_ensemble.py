@@ -1,0 +1,55 @@
+"""Open model parameters (`--set`), the traction curve, and seed ensembles."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from cageless.cli import main
+from cageless.errors import ParameterError
+from cageless.trace import read_trace
+from simulation.parameters import ModelParameters, parse_set_overrides
+from simulation.traction import regression_coefficients, traction_coefficient
+
+
+def test_set_overrides_are_parsed_validated_and_suggested():
+    assert parse_set_overrides(["cho_n_s_m=2500", "dry_friction_coefficient=none"]) == {
+        "cho_n_s_m": 2500.0, "dry_friction_coefficient": None}
+    for bad in (["cho_n_s_m"], ["cho_n_s_m=abc"], ["cho_n_s_m=nan"]):
+        with pytest.raises(ParameterError):
+            parse_set_overrides(bad)
+    with pytest.raises(ParameterError, match="Did you mean 'restitution'"):
+        ModelParameters().with_overrides({"restitutoin": 0.5})
+    with pytest.raises(ParameterError, match="film_thickness_m"):
+        ModelParameters(film_thickness_m=-1.0)
+    with pytest.raises(ParameterError, match="traction_peak_coefficient"):
+        ModelParameters(traction_peak_coefficient=0.03)  # below the sliding value
+
+
+@pytest.mark.parametrize("peak,s_peak,slide", [(0.06, 0.02, 0.04), (0.09, 0.005, 0.03), (0.05, 0.1, 0.049)])
+def test_traction_curve_has_the_stated_peak_and_sliding_value(peak, s_peak, slide):
+    """The (A, B, C, D) solved from the readable quantities reproduce them: mu(0) = 0, the maximum mu_peak sits
+    at s_peak, and mu tends to the sliding value (the shape of Sakaguchi & Harada 2006 / Gupta's regression)."""
+    coef = regression_coefficients(peak, s_peak, slide)
+    s = np.linspace(1e-6, 1, 200_001)
+    mu = np.array([traction_coefficient(v, coef) for v in s[::100]])
+    assert traction_coefficient(0.0, coef) == 0.0
+    assert mu.max() == pytest.approx(peak, rel=1e-4)
+    assert s[::100][mu.argmax()] == pytest.approx(s_peak, rel=0.01, abs=2e-4)
+    assert traction_coefficient(50.0, coef) == pytest.approx(slide, rel=1e-6)
+    assert traction_coefficient(-s_peak, coef) == pytest.approx(-peak, rel=1e-6)  # odd in the slip
+    assert math.isclose(coef[0], -slide)
+
+
+def test_ensemble_writes_one_trace_per_seed(tmp_path, capsys):
+    out = tmp_path / "ens.trace.h5"
+    assert main(["simulate", "--speed-rpm", "6000", "--radial-load-n", "500", "--duration", "0.002", "-q",
+                 "--ensemble", "2", "-o", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "seed 0:" in text and "seed 1:" in text
+    a, b = read_trace(tmp_path / "ens_seed0.trace.h5"), read_trace(tmp_path / "ens_seed1.trace.h5")
+    assert a.status == b.status == "complete"
+    assert not np.allclose(a.angle[0], b.angle[0])  # the seeds perturb the initial gaps
+    assert main(["simulate", "--speed-rpm", "6000", "--ensemble", "0", "-o", str(out)]) == 2
