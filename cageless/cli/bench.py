@@ -13,6 +13,7 @@ _EXAMPLES = """\
 examples:
   cageless bench tracking                       render 2400 full-size frames once, then measure
   cageless bench tracking --frames 600 --json bench.json
+  cageless bench accuracy --plot work_precision.png   simulator: error against wall time per solver/tolerance
 """
 
 
@@ -21,10 +22,13 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p = subparsers.add_parser(
         "bench", parents=[parent], help="accuracy-versus-time studies (tables)",
         description="Measure what accuracy costs in time. 'tracking': end-to-end frames/s on full-size "
-        "footage, detector and smoothing-window trade-offs, trackpy on the same frames, peak memory.",
+        "footage, detector and smoothing-window trade-offs, trackpy on the same frames, peak memory. "
+        "'accuracy': the simulator's work-precision table (solvers x tolerances against a tight reference).",
         epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("study", choices=("tracking",), help="which study to run")
+    p.add_argument("study", choices=("tracking", "accuracy"), help="which study to run")
+    p.add_argument("--window", type=float, default=0.005, help="accuracy: simulated window (s, default 0.005)")
+    p.add_argument("--plot", help="accuracy: write the work-precision diagram to this image")
     p.add_argument("--dir", default="bench_footage", help="where rendered footage is kept (default ./bench_footage)")
     p.add_argument("--frames", type=int, default=2400, help="frames of full-size footage (default 2400, 4.9 GB)")
     p.add_argument("--repeats", type=int, default=3, help="timing repeats, best taken (default 3)")
@@ -33,12 +37,20 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Run the study and print its tables."""
-    from tracking.bench import format_tables, run_benchmark
+    if args.study == "accuracy":
+        from simulation.bench import accuracy_study, format_accuracy, plot_accuracy
 
-    folder = Path(args.dir)
-    folder.mkdir(parents=True, exist_ok=True)
-    result = run_benchmark(folder, args.frames, args.repeats)
-    print(format_tables(result))
+        result = accuracy_study(window_s=args.window)
+        print(format_accuracy(result))
+        if args.plot:
+            plot_accuracy(result, args.plot)
+    else:
+        from tracking.bench import format_tables, run_benchmark
+
+        folder = Path(args.dir)
+        folder.mkdir(parents=True, exist_ok=True)
+        result = run_benchmark(folder, args.frames, args.repeats)
+        print(format_tables(result))
     if args.json:
         from cageless.atomic import atomic_write_text
 

@@ -165,10 +165,8 @@ def _pair_forces(y, p, aux, j, k, z):  # pragma: no cover - compiled
     ln = np.sqrt(dx * dx + dz * dz)
     delta = d - ln
     film = p[P_F_BBFILM] > 0.5 and -delta < 4.0 / 3.0 * p[P_H0]
-    if delta <= 0.0:
-        aux[j] = 0.0
-        if not film:
-            return 0.0, 0.0, 0.0, 0.0
+    if delta <= 0.0 and not film:
+        return 0.0, 0.0, 0.0, 0.0
     nx, nz = dx / ln, dz / ln
     vjx = y[2 * z + j] * np.cos(tj) - rj * y[3 * z + j] * np.sin(tj)
     vjz = y[2 * z + j] * np.sin(tj) + rj * y[3 * z + j] * np.cos(tj)
@@ -181,9 +179,10 @@ def _pair_forces(y, p, aux, j, k, z):  # pragma: no cover - compiled
             f = 6.0 * np.pi * p[P_ETA0] * (0.25 * d) ** 2 * delta_dot / max(-delta, p[P_H0])
             return f * nx, f * nz, 0.0, f * delta_dot
         return 0.0, 0.0, 0.0, 0.0
-    if aux[j] <= 0.0:
-        aux[j] = max(delta_dot, 1e-9)
-    f = hertz_damped(delta, delta_dot, aux[j], p[P_KB], p[P_CHI])
+    # approach speed at onset: recorded after the first accepted step in contact (planar_post); until
+    # then the current approach speed, so the force depends on no trial stage of any step
+    v_in = aux[j] if aux[j] > 0.0 else max(delta_dot, 1e-9)
+    f = hertz_damped(delta, delta_dot, v_in, p[P_KB], p[P_CHI])
     p_diss = (f - p[P_KB] * delta**1.5) * delta_dot
     f_t = torque = 0.0
     if p[P_F_TRAC] > 0.5:
@@ -311,8 +310,17 @@ def planar_post(t, y, p, aux):  # pragma: no cover - compiled
         rj, tj, rk, tk = y[j], y[z + j], y[k], y[z + k]
         dx = rk * np.cos(tk) - rj * np.cos(tj)
         dz = rk * np.sin(tk) - rj * np.sin(tj)
-        delta = d - np.sqrt(dx * dx + dz * dz)
+        ln = np.sqrt(dx * dx + dz * dz)
+        delta = d - ln
         slot = z + 4 * j
+        if delta > 0.0 and aux[j] <= 0.0:
+            vx = y[2 * z + k] * np.cos(tk) - rk * y[3 * z + k] * np.sin(tk) - (
+                y[2 * z + j] * np.cos(tj) - rj * y[3 * z + j] * np.sin(tj))
+            vz = y[2 * z + k] * np.sin(tk) + rk * y[3 * z + k] * np.cos(tk) - (
+                y[2 * z + j] * np.sin(tj) + rj * y[3 * z + j] * np.cos(tj))
+            aux[j] = max(-(vx * dx + vz * dz) / ln, 1e-9)
+        elif delta <= 0.0:
+            aux[j] = 0.0
         if delta > 0.0:
             f = k_b * delta**1.5
             if np.isnan(aux[slot]):

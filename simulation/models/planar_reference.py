@@ -26,7 +26,7 @@ def tangential_force(u_s: np.ndarray, u_r: np.ndarray, q: np.ndarray, p: np.ndar
 
 def reference_rhs(t: float, y: npt.NDArray[np.float64], p: npt.NDArray[np.float64],
                   aux: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
-    """dy/dt of the planar model (numpy). ``aux`` holds the ball-ball approach speeds, updated in place."""
+    """dy/dt of the planar model (numpy). ``aux`` holds the ball-ball approach speeds recorded at onset."""
     z = int(p[P.P_Z])
     d, m, m_ring = p[P.P_D], p[P.P_M], p[P.P_MR]
     half = 0.5 * d
@@ -117,10 +117,7 @@ def _pairs(y: np.ndarray, p: np.ndarray, aux: np.ndarray, fy: np.ndarray, fz: np
     nx, nz = dx / ln, dz / ln
     ddot = -((vx[k] - vx) * nx + (vz[k] - vz) * nz)
     touching = delta > 0
-    speeds = aux[:z]  # approach speeds (a view: updated in place)
-    speeds[~touching] = 0.0
-    new = touching & (speeds <= 0)
-    speeds[new] = np.maximum(ddot[new], 1e-9)
+    speeds = np.where(aux[:z] > 0, aux[:z], np.maximum(ddot, 1e-9))  # recorded onset speed, else the current one
     chi = p[P.P_CHI]
     el = p[P.P_KB] * np.clip(delta, 0, None) ** 1.5
     f = np.where(touching, np.maximum(el * (1 + (chi * ddot / np.where(speeds > 0, speeds, 1.0) if chi > 0 else 0)),

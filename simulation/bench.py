@@ -1,0 +1,139 @@
+"""What simulator accuracy costs in time: a work-precision study (``cageless bench accuracy``).
+
+One scene (3000 rpm, 500 N, every effect of a lubricated scene) is run past its
+start-up; from that state, each candidate integrates the same window, and its
+error is measured against a tight-tolerance reference run in the same process:
+
+* the compiled Dormand-Prince loop across tolerances (rtol 1e-4 ... 1e-8);
+* scipy's LSODA, BDF and DOP853 on the same compiled right-hand side;
+* scipy's LSODA on the plain-numpy right-hand side (the "numpy" baseline).
+
+scipy's steppers run through :func:`simulation.solve.step_scipy`, so the contact bookkeeping
+after each accepted step is the same for every candidate.
+
+The ball ring is chaotic, so the window is kept at a few milliseconds (DESIGN
+§7). Error: the largest difference in slip over all balls and samples, in
+percentage points, and the RMS ball-position difference along the orbit (um).
+Times are wall seconds per simulated second; the ratio column divides by the
+default (dp5, rtol 1e-6) measured in the same run, since absolute times on a
+shared 2-core machine are noisy.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from cageless.conditions import OperatingConditions
+from cageless.kinematics import theoretical_cage_speed
+from simulation.effects import choose_model
+from simulation.models.planar_reference import reference_rhs
+from simulation.problem import Problem
+from simulation.run import initial_state
+from simulation.models import planar as P
+from simulation.scene import Scene
+from simulation.solve import solve, step_scipy
+
+__all__ = ["accuracy_study", "format_accuracy", "plot_accuracy"]
+
+CANDIDATES: tuple[tuple[str, float], ...] = (
+    ("dp5", 1e-4), ("dp5", 1e-5), ("dp5", 1e-6), ("dp5", 1e-7), ("dp5", 1e-8),
+    ("LSODA", 1e-6), ("BDF", 1e-6), ("DOP853", 1e-6),
+)
+
+
+def _settled_problem(rpm: float, load_n: float, settle_s: float) -> tuple[Problem, float]:
+    scene = Scene(conditions=OperatingConditions(rpm, load_n))
+    choice = choose_model(scene)
+    theta, radius, ring = initial_state(scene)
+    pr = P.planar_problem(scene.bearing, theta, radius, ring, load_n, inner_speed_rad_s=scene.conditions.speed_rad_s,
+                          effects={e.name: e.on for e in choice.effects})
+    sol = solve(pr, np.array([settle_s]), rtol=1e-8, max_step=1e-6)
+    y0 = sol.y[-1].copy()
+    y0[-2:] = 0.0  # restart the work and dissipation counters
+    cage = theoretical_cage_speed(scene.bearing.geometry, scene.conditions.speed_rad_s)
+    return replace(pr, y0=y0, aux=sol.extra["aux"], t0=0.0), cage
+
+
+def _errors(y: npt.NDArray[np.float64], ref: npt.NDArray[np.float64], z: int, cage: float,
+            radius: float) -> tuple[float, float]:
+    slip_pp = 100 * np.nanmax(np.abs(y[:, 3 * z:4 * z] - ref[:, 3 * z:4 * z])) / cage
+    pos_um = 1e6 * radius * float(np.sqrt(np.nanmean((y[-1, z:2 * z] - ref[-1, z:2 * z]) ** 2)))
+    return float(slip_pp), pos_um
+
+
+def _numpy_lsoda(pr: Problem, t: npt.NDArray[np.float64], rtol: float) -> tuple[npt.NDArray[np.float64], float]:
+    sol = step_scipy(pr, t, "LSODA", rtol, max_step=2e-6, fun=lambda tt, yy, aux: reference_rhs(tt, yy, pr.params, aux))
+    return sol.y, sol.wall_s
+
+
+def accuracy_study(rpm: float = 3000.0, load_n: float = 500.0, window_s: float = 0.005, settle_s: float = 0.03,
+                   numpy_window_s: float = 0.0005) -> dict[str, Any]:
+    """Run every candidate over the same window and return rows of error and cost.
+
+    The plain-numpy baseline runs over ``numpy_window_s`` only (it is ~100x slower); its error is
+    measured against the reference over that shorter window.
+    """
+    pr, cage = _settled_problem(rpm, load_n, settle_s)
+    z = int(pr.params[P.P_Z])
+    radius = float(np.mean(pr.y0[:z]))
+    t = np.linspace(0.0, window_s, 51)
+    ref = solve(pr, t, rtol=1e-10, max_step=2.5e-7)
+    rows = []
+    for method, rtol in CANDIDATES:
+        sol = solve(pr, t, method=method, rtol=rtol, max_step=2e-6)
+        slip_pp, pos_um = _errors(sol.y, ref.y, z, cage, radius)
+        rows.append({"solver": f"{method} (compiled RHS)", "rtol": rtol, "ok": sol.success,
+                     "wall_s_per_sim_s": sol.wall_s / window_s, "slip_error_pp": slip_pp, "position_error_um": pos_um,
+                     "steps": sol.n_steps, "rhs_calls": sol.n_rhs})
+    tn = np.linspace(0.0, numpy_window_s, 6)
+    y_np, wall = _numpy_lsoda(pr, tn, 1e-6)
+    ref_short = solve(pr, tn, rtol=1e-10, max_step=2.5e-7)
+    slip_pp, pos_um = _errors(y_np, ref_short.y, z, cage, radius)
+    rows.append({"solver": "LSODA (numpy RHS)", "rtol": 1e-6, "ok": True, "wall_s_per_sim_s": wall / numpy_window_s,
+                 "slip_error_pp": slip_pp, "position_error_um": pos_um, "steps": 0, "rhs_calls": 0})
+    base = next(r for r in rows if r["solver"].startswith("dp5") and r["rtol"] == 1e-6)["wall_s_per_sim_s"]
+    for r in rows:
+        r["time_ratio"] = r["wall_s_per_sim_s"] / base
+    return {"scene": {"speed_rpm": rpm, "radial_load_n": load_n, "window_s": window_s, "settle_s": settle_s},
+            "reference": {"method": "dp5", "rtol": 1e-10, "max_step": 2.5e-7, "wall_s": ref.wall_s}, "rows": rows}
+
+
+def format_accuracy(result: dict[str, Any]) -> str:
+    """The study as a Markdown table."""
+    sc = result["scene"]
+    lines = [f"Work-precision, {sc['speed_rpm']:g} rpm, {sc['radial_load_n']:g} N, {1e3 * sc['window_s']:g} ms "
+             f"window after {1e3 * sc['settle_s']:g} ms (reference: dp5 rtol 1e-10)", "",
+             "| solver | rtol | wall s / sim s | x dp5 1e-6 | slip error (pp) | position error (um) |",
+             "|---|---|---|---|---|---|"]
+    for r in result["rows"]:
+        flag = "" if r["ok"] else " (failed)"
+        lines.append(f"| {r['solver']}{flag} | {r['rtol']:g} | {r['wall_s_per_sim_s']:.1f} | {r['time_ratio']:.2f} | "
+                     f"{r['slip_error_pp']:.3g} | {r['position_error_um']:.3g} |")
+    return "\n".join(lines)
+
+
+def plot_accuracy(result: dict[str, Any], path: str) -> None:
+    """Write the work-precision diagram (error against wall time) as an image."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    with matplotlib.rc_context():
+        fig, ax = plt.subplots(figsize=(5.5, 3.8))
+        for solver in dict.fromkeys(r["solver"] for r in result["rows"]):
+            rows = [r for r in result["rows"] if r["solver"] == solver]
+            ax.loglog([r["wall_s_per_sim_s"] for r in rows], [max(r["slip_error_pp"], 1e-6) for r in rows], "o-",
+                      label=solver)
+        ax.set_xlabel("wall seconds per simulated second")
+        ax.set_ylabel("largest slip error (pp)")
+        ax.legend(fontsize=7)
+        ax.grid(True, which="both", alpha=0.3)
+        fig.tight_layout()
+        fig.savefig(path, dpi=120)
+        plt.close(fig)

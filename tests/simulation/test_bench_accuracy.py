@@ -1,0 +1,18 @@
+"""`cageless bench accuracy` runs and prints its table (times are not asserted: benchmarks measure, tests check)."""
+
+from __future__ import annotations
+
+from simulation.bench import CANDIDATES, accuracy_study, format_accuracy, plot_accuracy
+
+
+def test_accuracy_study_table_and_plot(tmp_path):
+    result = accuracy_study(window_s=0.001, settle_s=0.03, numpy_window_s=0.0002)
+    assert len(result["rows"]) == len(CANDIDATES) + 1
+    assert all(r["ok"] for r in result["rows"])
+    dp5 = [r for r in result["rows"] if r["solver"].startswith("dp5")]
+    # past the start-up every tolerance stays well within the 0.5 pp convergence bar of DESIGN §7
+    assert all(r["slip_error_pp"] < 0.05 for r in dp5)
+    text = format_accuracy(result)
+    assert "| dp5 (compiled RHS) | 1e-06 |" in text and "LSODA (numpy RHS)" in text
+    plot_accuracy(result, str(tmp_path / "wp.png"))
+    assert (tmp_path / "wp.png").stat().st_size > 1000
