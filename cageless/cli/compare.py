@@ -1,0 +1,66 @@
+"""``cageless compare VIDEO_TRACE SIM_TRACE``: one Table-2 row, optionally the figures."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+from cageless.cli.common import finite_float
+
+__all__ = ["register", "run"]
+
+_EXAMPLES = """\
+examples:
+  cageless compare out/traces/clip_3000rpm.trace.h5 sim_3000rpm_Fr500.trace.h5
+  cageless compare measured.trace.h5 simulated.trace.h5 --figures figs/ --align-ball 3
+"""
+
+
+def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
+    """Add the ``compare`` subcommand."""
+    p = subparsers.add_parser(
+        "compare", parents=[parent], help="compare a measured and a simulated trace (one Table-2 row)",
+        description="Align a video trace and a simulation trace as slip and speed profiles against orbital "
+        "angle and print the Table-2-style row: theoretical and experimental slip, MAE, RMSE, maximum error.",
+        epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("video_trace", help="trace of a video (source = video)")
+    p.add_argument("sim_trace", help="trace of a simulation (source = simulation)")
+    p.add_argument("--bin-deg", type=finite_float, default=1.0, help="angle bin width (deg, default 1)")
+    p.add_argument("--settle", type=finite_float, default=0.04,
+                   help="simulated start-up left out of the simulation's profile (s, default 0.04)")
+    p.add_argument("--force", action="store_true", help="compare traces of different conditions or bearings")
+    p.add_argument("--align-ball", type=int, help="also align this ball's speed in time (cross-correlation)")
+    p.add_argument("--figures", help="write the speed, slip, contact and ring figures (SVG) to this folder")
+
+
+def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
+    """Compare and print."""
+    from cageless.atomic import atomic_write_text
+    from cageless.errors import UsageError
+    from cageless.trace import read_trace
+    from comparison.align import align_time
+    from comparison.compare import compare
+    from comparison.report import describe_condition, figures
+    from comparison.table import table_frame, to_markdown
+
+    measured, simulated = read_trace(args.video_trace), read_trace(args.sim_trace)
+    if measured.source != "video" or simulated.source != "simulation":
+        raise UsageError(f"give the video trace first and the simulation trace second (got {measured.source} "
+                         f"and {simulated.source}).")
+    c = compare(measured, simulated, args.bin_deg, args.settle, args.force, label=Path(args.video_trace).name)
+    print(to_markdown(table_frame([c.row])), end="")
+    if args.align_ball is not None:
+        a = align_time(measured, simulated, args.align_ball)
+        print(f"time alignment of ball {a.ball}: measured(t) ~ simulated(t {a.lag_s:+.6f} s), "
+              f"correlation {a.correlation:.3f}")
+    if args.figures:
+        d = describe_condition(c.row.label, c, measured, simulated)
+        folder = Path(args.figures)
+        folder.mkdir(parents=True, exist_ok=True)
+        for name, fn in (("speed", figures.speed_figure), ("slip", figures.slip_figure),
+                         ("contacts", figures.contact_polar_figure), ("ring", figures.ring_figure)):
+            atomic_write_text(folder / f"{name}.svg", fn(d))
+        print(f"figures -> {folder}")
+    return 0

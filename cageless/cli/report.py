@@ -1,0 +1,64 @@
+"""``cageless report LAB_FOLDER -o OUT``: track, simulate, compare, and write one HTML report."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from cageless.cli.common import finite_float
+
+__all__ = ["register", "run"]
+
+_EXAMPLES = """\
+examples:
+  cageless report sample_data/lab -o report
+  cageless report lab -o out --duration 0.2 --set cho_n_s_m=2500
+  cageless report lab -o out --scheduler tcp://10.0.0.5:8786     the same workflow on a Dask cluster
+"""
+
+
+def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
+    """Add the ``report`` subcommand."""
+    p = subparsers.add_parser(
+        "report", parents=[parent], help="lab folder -> traces, simulations, slip table and report.html",
+        description="For a lab folder: track every video, simulate each distinct condition once, compare, and "
+        "write OUT/report.html and OUT/slip_table.csv (also .md, .tex, .html). Unchanged work is skipped on a "
+        "re-run. A video or simulation that fails is a failed row in the report; the rest completes (exit 1).",
+        epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("lab", help="lab folder (videos with their conditions, DESIGN §5)")
+    p.add_argument("-o", "--out", default="report", help="output folder (default ./report)")
+    p.add_argument("--duration", type=finite_float,
+                   help="simulated time after the start-up (s; default: the longest video, at least one cage "
+                   "revolution)")
+    p.add_argument("--settle", type=finite_float, default=0.04,
+                   help="simulated start-up left out of the comparison (s, default 0.04)")
+    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", dest="set_values",
+                   help="change an open model parameter (see `cageless simulate --help`)")
+    p.add_argument("--rtol", type=finite_float, default=1e-6, help="simulation tolerance (default 1e-6)")
+    p.add_argument("--workers", type=int, default=2, help="local processes (default 2)")
+    p.add_argument("--scheduler", help="address of a Dask scheduler to run the jobs on")
+    p.add_argument("--force", action="store_true", help="compare even when a trace's conditions differ")
+
+
+def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
+    """Run the workflow and print where the report is."""
+    from cageless.config import bearing_from_config
+    from cageless.lab import LabOptions, run_lab
+    from simulation.parameters import ModelParameters, parse_set_overrides
+
+    values = parse_set_overrides(args.set_values)
+    ModelParameters().with_overrides(values)  # validated before any work starts
+    options = LabOptions(duration_s=args.duration, settle_s=args.settle, rtol=args.rtol, workers=args.workers,
+                         scheduler=args.scheduler, force=args.force, parameters=values)
+    res = run_lab(args.lab, args.out, options, bearing_from_config(config), progress=not args.quiet)
+    for row in res.rows:
+        if row.status == "failed":
+            print(f"FAILED {row.label}: {row.message}")
+        else:
+            print(f"{row.label}: {row.speed_rpm:g} r/min, {row.radial_load_n:g} N: theoretical slip "
+                  f"{row.theoretical_slip_pct:.2f} %, experimental {row.experimental_slip_pct:.2f} %, "
+                  f"MAE {row.mae_pp:.2f} pp")
+    timing = ", ".join(f"{k} {v:.1f} s" for k, v in res.timings.items())
+    print(f"report -> {res.report}; table -> {res.table} ({timing}; {res.skipped} jobs unchanged and skipped)")
+    return 1 if res.n_failed else 0

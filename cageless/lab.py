@@ -1,0 +1,295 @@
+"""The lab-folder workflow behind ``cageless report LAB -o OUT`` (DESIGN §1, §5, §9, §10).
+
+1. Discover the videos and their conditions.
+2. Track each video (``OUT/traces/<video>.trace.h5`` and ``OUT/traces/qc/``).
+3. Simulate the matching scene once per distinct condition (``OUT/simulations/``). The simulated time
+   is the start-up that the comparison leaves out plus the longest video of the condition, and at
+   least one cage revolution, unless ``duration_s`` is given.
+4. Compare each video with its condition's simulation.
+5. Write ``OUT/report.html`` and ``OUT/slip_table.{csv,md,tex,html}``.
+
+Work whose inputs and configuration are unchanged is skipped on a re-run: each job has a key (the
+SHA-256 of the input file, the resolved configuration and the software version) kept with its output
+in ``OUT/.cageless-cache.json``. A failing video or simulation becomes a failed row with its message;
+the rest completes. Jobs run in local processes on both cores, or on a Dask cluster when a scheduler
+address is given (one task per video, one per scene).
+
+This module is the app layer: it alone imports tracking, simulation and comparison.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import time
+from collections.abc import Callable, Iterable
+from concurrent.futures import Future, ProcessPoolExecutor
+from dataclasses import dataclass, field, replace
+from multiprocessing import get_context
+from pathlib import Path
+from typing import Any
+
+from tqdm.auto import tqdm
+
+from cageless import __version__
+from cageless.atomic import atomic_write_text
+from cageless.bearing import Bearing, default_bearing
+from cageless.conditions import LabEntry, OperatingConditions, discover_lab
+from cageless.errors import CagelessError
+from cageless.kinematics import theoretical_cage_speed
+from cageless.provenance import sha256_file
+from cageless.trace import read_trace
+
+__all__ = ["LabOptions", "LabResult", "run_lab"]
+
+CACHE_NAME = ".cageless-cache.json"
+
+
+@dataclass(frozen=True)
+class LabOptions:
+    """Choices of a lab run (the resolved configuration of the report)."""
+
+    duration_s: float | None = None
+    settle_s: float = 0.04
+    bin_deg: float = 1.0
+    rtol: float = 1e-6
+    workers: int = 2
+    scheduler: str | None = None
+    force: bool = False
+    parameters: dict[str, float] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready, without the scheduler address (it does not change results)."""
+        return {"duration_s": self.duration_s, "settle_s": self.settle_s, "bin_deg": self.bin_deg, "rtol": self.rtol,
+                "force": self.force, "parameters": dict(self.parameters)}
+
+
+@dataclass
+class LabResult:
+    """What a lab run produced."""
+
+    report: Path
+    table: Path
+    rows: list[Any]
+    n_failed: int
+    timings: dict[str, float]
+    skipped: int = 0
+
+
+# -- jobs (top-level so processes and Dask workers can run them) --------------------------------------
+
+def _track_job(video: str, conditions: OperatingConditions, bearing: Bearing, out_dir: str) -> tuple[str, str]:
+    from tracking.pipeline import track_video
+
+    try:
+        res = track_video(video, conditions, bearing, out_dir=out_dir, progress=False, config={"command": "report"})
+    except CagelessError as exc:
+        return "failed", str(exc)
+    return "ok", str(res.path)
+
+
+def _simulate_job(conditions: OperatingConditions, bearing: Bearing, duration_s: float, parameters: dict[str, float],
+                  rtol: float, out: str) -> tuple[str, str]:
+    from simulation.effects import choose_model
+    from simulation.parameters import ModelParameters
+    from simulation.run import simulate
+    from simulation.scene import Scene
+
+    try:
+        scene = Scene(conditions=OperatingConditions(conditions.speed_rpm, conditions.radial_load_n,
+                                                     conditions.axial_load_n), bearing=bearing, duration_s=duration_s)
+        res = simulate(scene, choose_model(scene), parameters=ModelParameters().with_overrides(parameters), rtol=rtol,
+                       out=out, progress=False, config={"command": "report"})
+    except CagelessError as exc:
+        return "failed", str(exc)
+    if not res.solution.success:
+        return "failed", f"the simulation stopped early: {res.trace.status}"
+    return "ok", out
+
+
+# -- caching --------------------------------------------------------------------------------------------
+
+class _Cache:
+    def __init__(self, out: Path) -> None:
+        self.path = out / CACHE_NAME
+        try:
+            self.data: dict[str, str] = json.loads(self.path.read_text()) if self.path.exists() else {}
+        except (OSError, json.JSONDecodeError):
+            self.data = {}
+
+    @staticmethod
+    def key(kind: str, payload: dict[str, Any]) -> str:
+        text = json.dumps({"kind": kind, "version": __version__, **payload}, sort_keys=True, default=str)
+        return hashlib.sha256(text.encode()).hexdigest()
+
+    def hit(self, key: str) -> str | None:
+        path = self.data.get(key)
+        return path if path and Path(path).exists() else None
+
+    def store(self, key: str, path: str) -> None:
+        self.data[key] = path
+        atomic_write_text(self.path, json.dumps(self.data, indent=1, sort_keys=True))
+
+
+# -- executors ------------------------------------------------------------------------------------------
+
+def _executor(options: LabOptions) -> Any:
+    if options.scheduler:
+        from distributed import Client
+
+        return Client(options.scheduler)
+    return ProcessPoolExecutor(max_workers=max(1, options.workers), mp_context=get_context("spawn"))
+
+
+def _run_jobs(pool: Any, jobs: list[tuple[Callable[..., tuple[str, str]], tuple[Any, ...]]], desc: str,
+              progress: bool) -> list[tuple[str, str]]:
+    futures: list[Future[Any]] = [pool.submit(fn, *args) for fn, args in jobs]
+    out = []
+    for fut in tqdm(futures, desc=desc, disable=not progress or not futures, leave=False):
+        try:
+            out.append(fut.result())
+        except Exception as exc:  # a crashed worker fails its job only  # noqa: BLE001
+            out.append(("failed", f"{type(exc).__name__}: {exc}"))
+    return out
+
+
+# -- the workflow ---------------------------------------------------------------------------------------
+
+def _condition_key(c: OperatingConditions) -> tuple[float, float, float]:
+    return (c.speed_rpm, c.radial_load_n, c.axial_load_n)
+
+
+def _sim_name(key: tuple[float, float, float]) -> str:
+    return f"n{key[0]:g}_Fr{key[1]:g}_Fa{key[2]:g}.sim.trace.h5"
+
+
+def _duration(key: tuple[float, float, float], video_s: Iterable[float], bearing: Bearing,
+              options: LabOptions) -> float:
+    if options.duration_s is not None:
+        return options.settle_s + options.duration_s
+    cage = theoretical_cage_speed(bearing.geometry, key[0] * math.pi / 30.0)
+    return options.settle_s + max([*video_s, 2 * math.pi / cage])
+
+
+def run_lab(folder: str | Path, out: str | Path, options: LabOptions | None = None, bearing: Bearing | None = None,
+            progress: bool = True) -> LabResult:
+    """Run the whole workflow on a lab folder; see the module docstring."""
+    from comparison.compare import ComparisonRow, compare
+    from comparison.report import build_report, describe_condition, write_report
+    from comparison.table import write_tables
+
+    options = options or LabOptions()
+    bearing = bearing or default_bearing()
+    out = Path(out)
+    (out / "traces").mkdir(parents=True, exist_ok=True)
+    (out / "simulations").mkdir(parents=True, exist_ok=True)
+    cache, timings, skipped = _Cache(out), {}, 0
+    entries = discover_lab(folder)
+    if not entries:
+        raise CagelessError(f"{folder}: no videos found. A lab folder holds videos (cine, avi/mp4/mkv or image "
+                            "folders) with their conditions (DESIGN §5).")
+    failed: list[ComparisonRow] = [_failed_row(e.video.name, None, str(e.error)) for e in entries if not e.ok]
+    good = [e for e in entries if e.ok]
+    with _executor(options) as pool:
+        t0 = time.perf_counter()
+        traces, n_skip = _track_all(pool, good, bearing, out, cache, progress)
+        skipped += n_skip
+        timings["tracking"] = time.perf_counter() - t0
+        for e in good:
+            if isinstance(traces[e.video], CagelessError):
+                failed.append(_failed_row(e.video.name, e.resolved.conditions, str(traces[e.video])))
+        t0 = time.perf_counter()
+        sims, n_skip = _simulate_all(pool, good, traces, bearing, out, cache, options, progress)
+        skipped += n_skip
+        timings["simulation"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    descriptions = []
+    for e in good:
+        tr = traces[e.video]
+        if isinstance(tr, CagelessError):
+            continue
+        sim = sims[_condition_key(e.resolved.conditions)]
+        if isinstance(sim, CagelessError):
+            failed.append(_failed_row(e.video.name, e.resolved.conditions, f"simulation failed: {sim}"))
+            continue
+        try:
+            measured, simulated = read_trace(tr), read_trace(sim)
+            c = compare(measured, simulated, options.bin_deg, options.settle_s, options.force, label=e.video.name)
+            descriptions.append(describe_condition(e.video.name, c, measured, simulated))
+        except CagelessError as exc:
+            failed.append(_failed_row(e.video.name, e.resolved.conditions, str(exc)))
+    timings["comparison"] = time.perf_counter() - t0
+    rows = [d.row for d in descriptions] + failed
+    tables = write_tables(rows, out / "slip_table")
+    structure = build_report(descriptions, failed, reproduction={
+        "lab folder": str(folder), "configuration": options.to_dict(), "bearing": bearing.to_dict()}, timings=timings)
+    report = write_report(structure, out / "report.html")
+    return LabResult(report=report, table=tables["csv"], rows=rows, n_failed=len(failed), timings=timings,
+                     skipped=skipped)
+
+
+def _failed_row(label: str, c: OperatingConditions | None, message: str) -> Any:
+    from comparison.compare import ComparisonRow
+
+    nan = float("nan")
+    speed, fr, fa = _condition_key(c) if c is not None else (nan, nan, nan)
+    return ComparisonRow(speed, fr, fa, nan, nan, nan, nan, nan, label=label, status="failed", message=message)
+
+
+def _track_all(pool: Any, entries: list[LabEntry], bearing: Bearing, out: Path, cache: _Cache,
+               progress: bool) -> tuple[dict[Path, Any], int]:
+    traces: dict[Path, Any] = {}
+    jobs, keys, pending = [], [], []
+    for e in entries:
+        key = cache.key("track", {"input": sha256_file(e.video), "conditions": e.resolved.conditions.to_dict(),
+                                  "bearing": bearing.to_dict()})
+        hit = cache.hit(key)
+        if hit:
+            traces[e.video] = hit
+            continue
+        jobs.append((_track_job, (str(e.video), e.resolved.conditions, bearing, str(out / "traces"))))
+        keys.append(key)
+        pending.append(e.video)
+    for video, key, (status, info) in zip(pending, keys, _run_jobs(pool, jobs, "tracking", progress), strict=True):
+        if status == "ok":
+            cache.store(key, info)
+            traces[video] = info
+        else:
+            traces[video] = CagelessError(info)
+    return traces, len(entries) - len(jobs)
+
+
+def _simulate_all(pool: Any, entries: list[LabEntry], traces: dict[Path, Any], bearing: Bearing, out: Path,
+                  cache: _Cache, options: LabOptions, progress: bool) -> tuple[dict[tuple[float, float, float], Any], int]:
+    lengths: dict[tuple[float, float, float], list[float]] = {}
+    conditions: dict[tuple[float, float, float], OperatingConditions] = {}
+    for e in entries:
+        k = _condition_key(e.resolved.conditions)
+        conditions.setdefault(k, e.resolved.conditions)
+        lengths.setdefault(k, [])
+        if not isinstance(traces[e.video], CagelessError):
+            tr = read_trace(traces[e.video])
+            lengths[k].append(float(tr.time[-1] - tr.time[0]))
+    sims: dict[tuple[float, float, float], Any] = {}
+    jobs, keys, pending = [], [], []
+    for k, c in conditions.items():
+        duration = _duration(k, lengths[k], bearing, options)
+        key = cache.key("simulate", {"conditions": list(k), "duration_s": duration, "bearing": bearing.to_dict(),
+                                     "parameters": options.parameters, "rtol": options.rtol})
+        hit = cache.hit(key)
+        if hit:
+            sims[k] = hit
+            continue
+        plain = replace(c, fps=None, px_per_mm=None, camera_roll_deg=None)
+        jobs.append((_simulate_job, (plain, bearing, duration, dict(options.parameters), options.rtol,
+                                     str(out / "simulations" / _sim_name(k)))))
+        keys.append(key)
+        pending.append(k)
+    for k, key, (status, info) in zip(pending, keys, _run_jobs(pool, jobs, "simulation", progress), strict=True):
+        if status == "ok":
+            cache.store(key, info)
+            sims[k] = info
+        else:
+            sims[k] = CagelessError(info)
+    return sims, len(conditions) - len(jobs)

@@ -1,0 +1,104 @@
+"""Figures of the report: plain matplotlib on the Agg backend, returned as SVG text.
+
+Every figure is drawn inside ``matplotlib.rc_context`` (so the caller's rcParams come back) and closed
+after rendering.
+"""
+
+from __future__ import annotations
+
+import io
+from collections.abc import Callable
+from typing import Any
+
+import matplotlib
+import numpy as np
+
+from comparison.report.describe import ConditionDescription
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
+
+__all__ = ["speed_figure", "slip_figure", "contact_polar_figure", "ring_figure"]
+
+_STYLE = {"font.size": 8, "axes.grid": True, "grid.alpha": 0.3, "svg.fonttype": "none"}
+
+
+def _svg(draw: Callable[[Any], None], size: tuple[float, float] = (5.6, 3.0), polar: bool = False) -> str:
+    with matplotlib.rc_context(_STYLE):
+        fig = plt.figure(figsize=size)
+        try:
+            draw(fig)
+            fig.tight_layout()
+            buf = io.StringIO()
+            fig.savefig(buf, format="svg")
+        finally:
+            plt.close(fig)
+    text = buf.getvalue()
+    return text[text.index("<svg"):]
+
+
+def _profile(ax: Any, prof: Any, scale: float, label: str, colour: str) -> None:
+    x, m, s = prof["angle_deg"].to_numpy(), prof["mean"].to_numpy() * scale, prof["std"].to_numpy() * scale
+    ax.plot(x, m, color=colour, lw=1.0, label=label)
+    ax.fill_between(x, m - s, m + s, color=colour, alpha=0.2, lw=0)
+
+
+def speed_figure(d: ConditionDescription) -> str:
+    """Revolution speed against orbital angle, measured and simulated (the paper's figures 18/19)."""
+    c = d.comparison
+    assert c is not None
+
+    def draw(fig: Any) -> None:
+        ax = fig.add_subplot()
+        _profile(ax, c.measured.speed, 30 / np.pi, "measured", "C0")
+        _profile(ax, c.simulated.speed, 30 / np.pi, "simulated", "C3")
+        ax.set(xlabel="orbital angle (deg)", ylabel="revolution speed (r/min)", xlim=(0, 360))
+        ax.axvspan(0, 180, color="0.9", zorder=0, label="unloaded zone")
+        ax.legend(fontsize=7)
+    return _svg(draw)
+
+
+def slip_figure(d: ConditionDescription) -> str:
+    """Slip rate against orbital angle with its spread (mean +- std over balls and revolutions)."""
+    c = d.comparison
+    assert c is not None
+
+    def draw(fig: Any) -> None:
+        ax = fig.add_subplot()
+        _profile(ax, c.measured.slip, 100.0, "measured", "C0")
+        _profile(ax, c.simulated.slip, 100.0, "simulated", "C3")
+        ax.set(xlabel="orbital angle (deg)", ylabel="slip rate (%)", xlim=(0, 360))
+        ax.legend(fontsize=7)
+    return _svg(draw)
+
+
+def contact_polar_figure(d: ConditionDescription) -> str:
+    """Ball-ball contact episodes: peak force against orbital angle (the paper's figure 5)."""
+    ev = d.events
+
+    def draw(fig: Any) -> None:
+        ax = fig.add_subplot(projection="polar")
+        if ev is not None and len(ev):
+            for kind, colour in (("impact", "C1"), ("rubbing", "C2")):
+                sel = ev[ev.kind == kind]
+                ax.scatter(sel.angle, sel.peak_force, s=6, color=colour, label=f"{kind} ({len(sel)})")
+            ax.legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.25, -0.15))
+        else:
+            ax.set_title("no ball-ball contact after the start-up", fontsize=8)
+        ax.set_xlabel("peak force (N) against orbital angle")
+    return _svg(draw, size=(3.6, 3.6))
+
+
+def ring_figure(d: ConditionDescription) -> str:
+    """Inner-ring centre orbit and its Poincare section, one point per shaft revolution (figures 14/15)."""
+    yz, pc = d.ring_yz_m, d.poincare_yz_m
+
+    def draw(fig: Any) -> None:
+        a1, a2 = fig.subplots(1, 2)
+        if yz is not None and len(yz):
+            a1.plot(1e6 * yz[:, 0], 1e6 * yz[:, 1], lw=0.5, color="C0")
+        a1.set(xlabel="y (um)", ylabel="z (um)", title="ring centre orbit")
+        if pc is not None and len(pc):
+            a2.scatter(1e6 * pc[:, 0], 1e6 * pc[:, 1], s=6, color="C3")
+        a2.set(xlabel="y (um)", ylabel="z (um)", title="Poincare section (per shaft revolution)")
+    return _svg(draw, size=(6.4, 2.9))

@@ -1,0 +1,91 @@
+"""Layer 2: the report as a neutral structure (sections, key-value tables, figures), free of HTML."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping, Sequence
+from datetime import datetime, timezone
+from typing import Any
+
+from cageless import __version__
+from comparison.compare import ComparisonRow
+from comparison.metrics import SLIP_RATE_DEFINITION
+from comparison.report import figures
+from comparison.report.describe import ConditionDescription
+from comparison.table import table_frame, to_html
+
+__all__ = ["build_report"]
+
+
+def _effects(info: Mapping[str, Any]) -> list[str]:
+    try:
+        data = json.loads(info.get("effects_json", "{}"))
+    except json.JSONDecodeError:
+        return []
+    return [f"{e['name']}: {'on' if e['on'] else 'off'} ({e['reason']})" for e in data.get("effects", [])]
+
+
+def _section(d: ConditionDescription) -> dict[str, Any]:
+    r = d.row
+    facts = [("speed", f"{r.speed_rpm:g} r/min"), ("radial load", f"{r.radial_load_n:g} N"),
+             ("axial load", f"{r.axial_load_n:g} N"), ("status", r.status)]
+    if r.message:
+        facts.append(("message", r.message))
+    section: dict[str, Any] = {"title": d.label, "status": r.status, "facts": facts, "figures": []}
+    if d.comparison is not None:
+        section["figures"] = [
+            {"caption": "Revolution speed against orbital angle (mean and spread)", "svg": figures.speed_figure(d)},
+            {"caption": "Slip rate against orbital angle (mean and spread)", "svg": figures.slip_figure(d)},
+            {"caption": "Ball-ball contact episodes (simulated): peak force by orbital angle",
+             "svg": figures.contact_polar_figure(d)},
+            {"caption": "Inner-ring centre orbit and Poincare section (simulated)", "svg": figures.ring_figure(d)},
+        ]
+        section["facts"] += [("settling time left out of the simulation", f"{d.comparison.settle_s:g} s")]
+    return section
+
+
+def _qc(d: ConditionDescription) -> dict[str, Any]:
+    qc = d.qc or {}
+    rate = qc.get("detection_rate") or []
+    facts = [("video", d.video_provenance.get("inputs", [{}])[0].get("name", d.label) if d.video_provenance
+              else d.label)]
+    if qc:
+        facts += [("balls found", f"{qc.get('n_balls_found')} of {qc.get('n_balls_expected')}"),
+                  ("detection rate (min / mean)", f"{100 * min(rate):.1f} % / {100 * sum(rate) / len(rate):.1f} %"
+                   if rate else "-"),
+                  ("interpolated samples", f"{100 * qc.get('interpolated_share', 0):.2f} %"),
+                  ("orbit fit residual", f"{qc.get('orbit_residual_px', float('nan')):.3f} px"),
+                  ("scale", f"{qc.get('px_per_mm', float('nan')):.3f} px/mm"),
+                  ("warnings", "; ".join(qc.get("warnings", [])) or "none")]
+    return {"title": d.label, "facts": facts}
+
+
+def build_report(descriptions: Sequence[ConditionDescription], failed_rows: Sequence[ComparisonRow] = (),
+                 reproduction: Mapping[str, Any] | None = None, timings: Mapping[str, float] | None = None,
+                 title: str = "cageless: model against experiment") -> dict[str, Any]:
+    """The report's structure: conditions, the Table-2-style table, one section per condition, QC, reproduction."""
+    rows = [d.row for d in descriptions] + list(failed_rows)
+    frame = table_frame(rows)
+    repro = [("software version", __version__)] + [(k, v if isinstance(v, str) else json.dumps(v, sort_keys=True))
+                                                    for k, v in (reproduction or {}).items()]
+    for d in descriptions:
+        info = d.simulation_info
+        if info:
+            repro.append((f"{d.label}: solver", f"{info['solver']} rtol {info['rtol']:g}, {info['steps']} steps, "
+                                                 f"{info['wall_s']:.1f} s"))
+            repro.append((f"{d.label}: effects", "; ".join(_effects(info))))
+        for item in d.video_provenance.get("inputs", []):
+            repro.append((f"input {item.get('name')}", f"sha256 {item.get('sha256')}"))
+    return {
+        "title": title,
+        "generated_utc": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC"),
+        "conditions": [[f"{r.speed_rpm:g}", f"{r.radial_load_n:g}", f"{r.axial_load_n:g}", r.label, r.status]
+                       for r in table_frame(rows).itertuples()],
+        "table_html": to_html(frame),
+        "definition": SLIP_RATE_DEFINITION,
+        "sections": [_section(d) for d in descriptions],
+        "failures": [{"title": r.label, "message": r.message} for r in failed_rows],
+        "qc": [_qc(d) for d in descriptions if d.qc],
+        "reproduction": repro,
+        "timings": [(k, f"{v:.1f} s") for k, v in (timings or {}).items()],
+    }

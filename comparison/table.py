@@ -1,0 +1,105 @@
+"""The Table-2-style table in CSV, Markdown, LaTeX and HTML (DESIGN §9).
+
+Failed conditions stay in the table as rows with their message, so a report
+never hides what did not run.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+from collections.abc import Sequence
+from pathlib import Path
+
+import pandas as pd
+
+from cageless.atomic import atomic_write_text
+from comparison.compare import ComparisonRow
+from comparison.metrics import SLIP_RATE_DEFINITION
+
+__all__ = ["table_frame", "to_csv", "to_markdown", "to_latex", "to_html", "write_tables", "HEADERS"]
+
+HEADERS = {
+    "speed_rpm": "Speed (r/min)", "radial_load_n": "Radial load (N)", "axial_load_n": "Axial load (N)",
+    "theoretical_slip_pct": "Theoretical slip (%)", "experimental_slip_pct": "Experimental slip (%)",
+    "mae_pp": "MAE (pp)", "rmse_pp": "RMSE (pp)", "max_error_pp": "Max error (pp)",
+}
+
+
+def table_frame(rows: Sequence[ComparisonRow]) -> pd.DataFrame:
+    """The rows as a frame, sorted by speed then loads; ``label``, ``status`` and ``message`` kept."""
+    frame = pd.DataFrame([r.to_dict() for r in rows], columns=[*HEADERS, "label", "status", "message"])
+    return frame.sort_values(["speed_rpm", "radial_load_n", "axial_load_n", "label"], kind="stable").reset_index(
+        drop=True)
+
+
+def _cells(frame: pd.DataFrame) -> list[list[str]]:
+    out = []
+    for _, r in frame.iterrows():
+        cells = [f"{r[c]:g}" for c in ("speed_rpm", "radial_load_n", "axial_load_n")]
+        if r["status"] == "failed":
+            cells += ["failed"] + [""] * 4
+        else:
+            cells += ["" if not math.isfinite(r[c]) else f"{r[c]:.2f}" for c in list(HEADERS)[3:]]
+        out.append(cells)
+    return out
+
+
+def _notes(frame: pd.DataFrame) -> list[str]:
+    notes = [SLIP_RATE_DEFINITION]
+    for _, r in frame.iterrows():
+        if r["status"] != "ok":
+            notes.append(f"{r['label'] or 'condition'} ({r['speed_rpm']:g} r/min, {r['radial_load_n']:g} N): "
+                         f"{r['status']}: {r['message']}")
+    return notes
+
+
+def to_csv(frame: pd.DataFrame) -> str:
+    """Machine-readable CSV with the raw column names."""
+    return frame.to_csv(index=False, float_format="%.6g")
+
+
+def to_markdown(frame: pd.DataFrame) -> str:
+    """A Markdown table with the definition and any failures as notes."""
+    lines = ["| " + " | ".join(HEADERS.values()) + " |", "|" + "---|" * len(HEADERS)]
+    lines += ["| " + " | ".join(c) + " |" for c in _cells(frame)]
+    return "\n".join(lines + [""] + [f"Note: {n}" for n in _notes(frame)]) + "\n"
+
+
+def _tex(text: str) -> str:
+    for a, b in (("\\", r"\textbackslash{}"), ("%", r"\%"), ("&", r"\&"), ("_", r"\_"), ("#", r"\#")):
+        text = text.replace(a, b)
+    return text
+
+
+def to_latex(frame: pd.DataFrame) -> str:
+    """A LaTeX ``tabular`` (booktabs) with the notes below."""
+    head = " & ".join(_tex(h) for h in HEADERS.values())
+    body = "\n".join(" & ".join(_tex(c) for c in cells) + r" \\" for cells in _cells(frame))
+    notes = "\n".join(r"\par\footnotesize " + _tex(n) for n in _notes(frame))
+    return (r"\begin{tabular}{" + "r" * len(HEADERS) + "}\n\\toprule\n" + head + r" \\" + "\n\\midrule\n" + body
+            + "\n\\bottomrule\n\\end{tabular}\n" + notes + "\n")
+
+
+def to_html(frame: pd.DataFrame) -> str:
+    """An HTML table (a fragment for the report, escaped)."""
+    head = "".join(f"<th>{html.escape(h)}</th>" for h in HEADERS.values())
+    rows = []
+    for (_, r), cells in zip(frame.iterrows(), _cells(frame), strict=True):
+        cls = "" if r["status"] == "ok" else f' class="{html.escape(r["status"])}"'
+        rows.append(f"<tr{cls}>" + "".join(f"<td>{html.escape(c)}</td>" for c in cells) + "</tr>")
+    notes = "".join(f"<p class='note'>{html.escape(n)}</p>" for n in _notes(frame))
+    return f"<table class='slip'><thead><tr>{head}</tr></thead><tbody>{''.join(rows)}</tbody></table>{notes}"
+
+
+def write_tables(rows: Sequence[ComparisonRow], stem: str | Path) -> dict[str, Path]:
+    """Write ``<stem>.csv``, ``.md``, ``.tex`` and ``.html`` atomically; returns the paths."""
+    frame = table_frame(rows)
+    stem = Path(stem)
+    out = {}
+    for ext, text in (("csv", to_csv(frame)), ("md", to_markdown(frame)), ("tex", to_latex(frame)),
+                      ("html", to_html(frame))):
+        path = stem.with_suffix(f".{ext}")
+        atomic_write_text(path, text)
+        out[ext] = path
+    return out

@@ -1,0 +1,103 @@
+"""Alignment (a known phase shift is recovered exactly), the metrics on hand-computed cases, and the table."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from cageless.errors import CagelessError
+from cageless.trace import SimulationInfo, Trace, VideoInfo
+from comparison.align import MismatchError, align_time, check_compatible, profiles
+from comparison.compare import ComparisonRow, compare
+from comparison.metrics import profile_errors, unloaded_peak
+from comparison.table import table_frame, to_csv, to_html, to_latex, to_markdown, write_tables
+
+VIDEO = VideoInfo(fps=10000.0, px_per_mm=12.5, centre_px=(640.0, 400.0), camera_roll_rad=0.0,
+                  input_file="x.cine", input_sha256="ab" * 32)
+SIM = SimulationInfo(scene_json="{}", effects_json="{}", solver="dp5", rtol=1e-6, atol=1e-9, n_steps=1, n_rhs=1,
+                     wall_s=0.1)
+
+
+def orbit_trace(source: str, slip_of_angle, t_end: float = 0.4, dt: float = 1e-4, z: int = 14, omega: float = 120.0,
+                speed_rpm: float = 3000.0, **kw) -> Trace:
+    """Balls evenly spaced, each at omega (1 - slip(angle)); slip given as a function of the angle in degrees."""
+    t = np.arange(0, t_end, dt)
+    theta0 = np.arange(z) * 2 * np.pi / z
+    angle = np.empty((len(t), z))
+    angle[0] = theta0
+    for i in range(1, len(t)):
+        s = slip_of_angle(np.degrees(angle[i - 1]) % 360)
+        angle[i] = angle[i - 1] + omega * (1 - s) * dt
+    deg = np.degrees(angle) % 360
+    slip = slip_of_angle(deg)
+    return Trace(source=source, time=t, angle=angle, speed=omega * (1 - slip), slip=slip,
+                 valid=np.ones_like(angle, dtype=bool), speed_rpm=speed_rpm, radial_load_n=500.0, axial_load_n=0.0,
+                 ball_diameter_m=9.525e-3, pitch_diameter_m=46.005e-3, config={},
+                 video=VIDEO if source == "video" else None, simulation=SIM if source == "simulation" else None, **kw)
+
+
+def bump(peak: float, centre: float = 90.0):
+    return lambda deg: peak * np.exp(-0.5 * ((deg - centre) / 25.0) ** 2)
+
+
+def test_metrics_on_hand_computed_profiles():
+    # differences 0.01, -0.02, 0.03 (fractions) -> 1, 2, 3 pp: MAE 2, RMSE sqrt(14/3), max 3
+    e = profile_errors([0.10, 0.20, 0.30, np.nan], [0.09, 0.22, 0.27, 0.5])
+    assert e.mae_pp == pytest.approx(2.0) and e.rmse_pp == pytest.approx(np.sqrt(14 / 3)) and e.max_pp == pytest.approx(3.0)
+    assert e.n_points == 3
+    with pytest.raises(CagelessError, match="share no angle bin"):
+        profile_errors([np.nan], [0.1])
+    prof = pd.DataFrame({"angle_deg": [45.0, 135.0, 225.0, 315.0], "mean": [0.1, 0.3, 0.9, np.nan]})
+    assert unloaded_peak(prof) == 0.3  # 225 deg lies in the loaded half
+
+
+def test_profiles_recover_the_slip_law():
+    tr = orbit_trace("video", bump(0.06))
+    p = profiles(tr, bin_deg=5.0)
+    centres = p.slip["angle_deg"].to_numpy()
+    np.testing.assert_allclose(p.slip["mean"], bump(0.06)(centres), atol=2e-3)
+    assert unloaded_peak(p.slip) == pytest.approx(0.06, abs=2e-3)
+    assert p.slip_per_ball.shape == (72, 14)
+
+
+def test_time_alignment_recovers_a_known_shift_exactly():
+    sim = orbit_trace("simulation", bump(0.06), t_end=0.3)
+    shift_samples = 37
+    measured = orbit_trace("video", bump(0.06), t_end=0.3)
+    # the "measurement" starts 3.7 ms later in the same motion: its samples are the simulation's, shifted
+    measured = Trace(**{**measured.__dict__, "time": sim.time[: -shift_samples] + 0.0,
+                        "angle": sim.angle[shift_samples:], "speed": sim.speed[shift_samples:],
+                        "slip": sim.slip[shift_samples:], "valid": sim.valid[shift_samples:]})
+    res = align_time(measured, sim, ball=3)
+    assert res.lag_s == pytest.approx(shift_samples * 1e-4, abs=1e-9)
+    assert res.correlation > 0.99
+
+
+def test_mismatched_traces_are_refused_unless_forced():
+    a = orbit_trace("video", bump(0.06), t_end=0.1)
+    b = orbit_trace("simulation", bump(0.04), t_end=0.2, speed_rpm=1800.0)
+    assert check_compatible(a, b) == ["speed_rpm: measured 3000 rpm, simulated 1800 rpm"]
+    with pytest.raises(MismatchError, match="--force"):
+        compare(a, b)
+    c = compare(a, b, settle_s=0.0, force=True)
+    assert c.row.status == "mismatch" and "speed_rpm" in c.row.message
+
+
+def test_compare_row_and_table_formats(tmp_path):
+    measured = orbit_trace("video", bump(0.06), t_end=0.4)
+    simulated = orbit_trace("simulation", bump(0.04), t_end=0.45)
+    c = compare(measured, simulated, settle_s=0.05, label="n3000")
+    assert c.row.experimental_slip_pct == pytest.approx(6.0, abs=0.1)
+    assert c.row.theoretical_slip_pct == pytest.approx(4.0, abs=0.1)
+    assert c.row.max_error_pp == pytest.approx(2.0, abs=0.1)
+    failed = ComparisonRow(1800, 500, 0, float("nan"), float("nan"), float("nan"), float("nan"), float("nan"),
+                           label="run_1800", status="failed", message="video unreadable")
+    frame = table_frame([c.row, failed])
+    assert list(frame.speed_rpm) == [1800, 3000]
+    md = to_markdown(frame)
+    assert "| 3000 | 500 | 0 | 4.00 | 6.00 |" in md and "run_1800" in md and "peak of the mean slip" in md
+    assert r"\toprule" in to_latex(frame) and "<table" in to_html(frame) and "failed" in to_html(frame)
+    assert "theoretical_slip_pct" in to_csv(frame).splitlines()[0]
+    paths = write_tables([c.row, failed], tmp_path / "slip_table")
+    assert sorted(paths) == ["csv", "html", "md", "tex"] and all(p.exists() for p in paths.values())

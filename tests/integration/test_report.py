@@ -1,0 +1,107 @@
+"""`cageless report` end to end: the sample lab, re-runs, failures, and footage of a simulation.
+
+The end-to-end check follows the comparison issue: render footage of a known simulation (the renderer
+of :mod:`tracking.synthetic`), run the report on it, and require MAE <= 0.5 percentage points between the
+measured and simulated slip profiles, since the "experiment" is the simulation itself; what remains is
+the tracking error (<= 0.3 pp slip-profile MAE in the tracking tests).
+"""
+
+from __future__ import annotations
+
+import re
+import shutil
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from cageless.bearing import default_bearing
+from cageless.cli import main
+from cageless.conditions import OperatingConditions
+from cageless.trace import Trace
+from simulation.effects import choose_model
+from simulation.run import simulate
+from simulation.scene import Scene
+
+LAB = Path(__file__).resolve().parents[2] / "sample_data" / "lab"
+
+
+def _report_checks(out: Path, n_rows: int) -> str:
+    table = pd.read_csv(out / "slip_table.csv")
+    assert len(table) == n_rows
+    for ext in ("md", "tex", "html"):
+        assert (out / f"slip_table.{ext}").exists()
+    html = (out / "report.html").read_text()
+    assert html.count('src="data:image/svg+xml;base64,') >= 4 * int((table.status != "failed").sum())
+    assert "Reproduction" in html and "Tracking quality" in html and "peak of the mean slip profile" in html
+    assert not re.search(r"""(src|href)=["']?(https?:)?//""", html)  # offline: no external resources
+    return html
+
+
+def test_sample_lab_report_and_rerun(tmp_path, capsys):
+    out = tmp_path / "report"
+    assert main(["report", str(LAB), "-o", str(out), "-q"]) == 0
+    text = capsys.readouterr().out
+    assert "0 jobs unchanged" in text
+    table = pd.read_csv(out / "slip_table.csv")
+    assert list(table.speed_rpm) == [1800, 3000, 6000] and set(table.status) == {"ok"}
+    assert np.all(np.isfinite(table[["theoretical_slip_pct", "experimental_slip_pct", "mae_pp"]].to_numpy()))
+    html = _report_checks(out, 3)
+    assert "run_1800" in html and "race_traction: on" in html
+    # unchanged inputs and configuration: nothing is redone
+    assert main(["report", str(LAB), "-o", str(out), "-q"]) == 0
+    assert "6 jobs unchanged and skipped" in capsys.readouterr().out
+    # a changed model parameter redoes the simulations only
+    assert main(["report", str(LAB), "-o", str(out), "-q", "--set", "cho_n_s_m=2500"]) == 0
+    assert "3 jobs unchanged and skipped" in capsys.readouterr().out
+
+
+def test_a_bad_video_is_a_failed_row_and_the_rest_completes(tmp_path, capsys):
+    lab = tmp_path / "lab"
+    lab.mkdir()
+    shutil.copy(LAB / "n6000_Fr500_Fa0.cine", lab)
+    (lab / "n3000_Fr500_Fa0.cine").write_bytes(b"not a cine file" * 100)
+    (lab / "mystery.avi").write_bytes(b"\x00" * 10)  # no conditions anywhere
+    out = tmp_path / "out"
+    assert main(["report", str(lab), "-o", str(out), "-q"]) == 1
+    text = capsys.readouterr().out
+    assert "FAILED n3000_Fr500_Fa0.cine" in text and "FAILED mystery.avi" in text
+    table = pd.read_csv(out / "slip_table.csv")
+    assert sorted(table.status) == ["failed", "failed", "ok"]
+    html = _report_checks(out, 3)
+    assert "n3000_Fr500_Fa0.cine" in html and "failed" in html
+
+
+def _after(trace: Trace, start_s: float) -> Trace:
+    """The trace from ``start_s`` on, with time restarted at 0 (footage taken after the start-up)."""
+    keep = trace.time >= start_s - 1e-12
+    groups = {g: {k: v[keep] for k, v in d.items()} for g, d in trace.groups.items()}
+    return replace(trace, time=trace.time[keep] - trace.time[keep][0], angle=trace.angle[keep],
+                   speed=trace.speed[keep], slip=trace.slip[keep], valid=trace.valid[keep], groups=groups)
+
+
+def test_footage_of_a_simulation_compares_within_tracking_accuracy(tmp_path, capsys):
+    from tracking.synthetic.camera import Appearance, Camera
+    from tracking.synthetic.clip import render_clip
+    from tracking.synthetic.render import Renderer
+
+    settle, duration = 0.04, 0.05
+    bearing = default_bearing()
+    lab = tmp_path / "lab"
+    lab.mkdir()
+    camera = Camera(width=640, height=400, px_per_mm=6.25, bit_depth=12)
+    for rpm in (3000.0, 6000.0):
+        scene = Scene(conditions=OperatingConditions(rpm, 500.0), duration_s=settle + duration)
+        sim = simulate(scene, choose_model(scene), progress=False).trace
+        footage = _after(sim, settle)
+        n_frames = int(0.95 * duration * camera.fps)
+        render_clip(lab / f"n{rpm:g}_Fr500_Fa0.cine", Renderer(bearing.geometry, camera, Appearance(), seed=3),
+                    n_frames, motion_source=footage, fmt="cine-16")
+    out = tmp_path / "out"
+    assert main(["report", str(lab), "-o", str(out), "-q", "--duration", str(duration)]) == 0
+    table = pd.read_csv(out / "slip_table.csv")
+    assert set(table.status) == {"ok"} and len(table) == 2
+    assert np.all(table.mae_pp <= 0.5), table.to_string()
+    _report_checks(out, 2)
