@@ -1,0 +1,174 @@
+"""``cageless sweep``: one scene over a parameter grid and seeds, locally or on Dask (DESIGN §10).
+
+This is the paper's lubrication sensitivity study (§4: viscosity, film thickness and damping varied
+at 1800 rpm). Each grid point runs ``seeds`` simulations; the result is the peak of the mean slip
+profile in the unloaded zone (DESIGN §9) after the start-up, per run, and its mean and seed spread
+per point. A parameter name is a scene quantity (``speed_rpm``, ``radial_load_n``, ``axial_load_n``),
+an open model parameter (``cho_n_s_m``, ``film_thickness_m``, ...) or a dotted bearing field
+(``lubricant.dynamic_viscosity_pa_s``; ``lubricant.viscosity`` is accepted for it).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import math
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from cageless.atomic import atomic_write_text
+from cageless.bearing import Bearing, default_bearing
+from cageless.errors import ParameterError, suggest
+
+__all__ = ["parse_vary", "sweep_grid", "run_sweep", "summarise", "plot_sweep", "SCENE_NAMES", "ALIASES"]
+
+SCENE_NAMES = ("speed_rpm", "radial_load_n", "axial_load_n")
+ALIASES = {"lubricant.viscosity": "lubricant.dynamic_viscosity_pa_s"}
+
+
+def _values(name: str, spec: str) -> list[float]:
+    try:
+        if ":" in spec:
+            lo, hi, n = spec.split(":")
+            if int(n) < 1 or float(n) != int(n):
+                raise ValueError
+            vals = np.linspace(float(lo), float(hi), int(n)).tolist()
+        else:
+            vals = [float(v) for v in spec.split(",") if v.strip()]
+    except ValueError:
+        raise ParameterError("--vary", f"{name}={spec!r}: write start:stop:count (e.g. 0.02:0.06:5) or a list "
+                             "(e.g. 1800,3000,6000)") from None
+    if not vals or not all(math.isfinite(v) for v in vals):
+        raise ParameterError("--vary", f"{name}={spec!r}: needs finite numbers")
+    return vals
+
+
+def parse_vary(items: Sequence[str], bearing: Bearing | None = None) -> dict[str, list[float]]:
+    """``NAME=start:stop:count`` or ``NAME=v1,v2`` items into {canonical name: values}; names are checked."""
+    from simulation.parameters import ModelParameters
+
+    bearing = bearing or default_bearing()
+    model = [f.name for f in dataclasses.fields(ModelParameters)]
+    dotted = [f"{s}.{k}" for s, d in bearing.to_dict().items() if isinstance(d, dict) for k in d]
+    known = [*SCENE_NAMES, *model, *dotted, *ALIASES]
+    out: dict[str, list[float]] = {}
+    for item in items:
+        name, sep, spec = item.partition("=")
+        name = name.strip()
+        if not sep:
+            raise ParameterError("--vary", f"expects NAME=VALUES, got {item!r}")
+        if name not in known:
+            raise ParameterError("--vary", f"{name!r} is not a sweepable parameter" + suggest(name, known))
+        out[ALIASES.get(name, name)] = _values(name, spec)
+    if not out:
+        raise ParameterError("--vary", "give at least one --vary NAME=VALUES")
+    return out
+
+
+def sweep_grid(vary: Mapping[str, Sequence[float]], seeds: int) -> list[dict[str, Any]]:
+    """Every combination of the varied values, times seeds 0..seeds-1."""
+    names = list(vary)
+    return [{**dict(zip(names, combo, strict=True)), "seed": s}
+            for combo in itertools.product(*(vary[n] for n in names)) for s in range(seeds)]
+
+
+def _run_point(point: dict[str, Any], base: dict[str, Any]) -> dict[str, Any]:
+    from cageless.conditions import OperatingConditions
+    from cageless.errors import CagelessError
+    from simulation.effects import choose_model
+    from simulation.parameters import ModelParameters
+    from simulation.run import peak_unloaded_slip, simulate
+    from simulation.scene import Scene
+
+    scene_kw = {n: point.get(n, base[n]) for n in SCENE_NAMES}
+    model = {k: v for k, v in point.items() if k not in SCENE_NAMES and "." not in k and k != "seed"}
+    dotted = {k: v for k, v in point.items() if "." in k}
+    try:
+        bearing = Bearing.from_dict(base["bearing"]).with_overrides(dotted)
+        scene = Scene(conditions=OperatingConditions(**scene_kw), bearing=bearing,
+                      duration_s=base["settle_s"] + base["duration_s"], seed=int(point["seed"]))
+        res = simulate(scene, choose_model(scene),
+                       parameters=ModelParameters().with_overrides({**base["parameters"], **model}),
+                       progress=False, config={"command": "sweep"})
+    except CagelessError as exc:
+        return {**point, "peak_slip_pct": float("nan"), "status": "failed", "message": str(exc), "wall_s": 0.0}
+    ok = res.solution.success
+    peak = peak_unloaded_slip(res.trace, settle_s=base["settle_s"]) if ok else float("nan")
+    return {**point, "peak_slip_pct": 100 * peak, "status": "ok" if ok else "failed",
+            "message": "" if ok else res.trace.status, "wall_s": res.trace.simulation.wall_s}
+
+
+def run_sweep(vary: Mapping[str, Sequence[float]], seeds: int, speed_rpm: float, radial_load_n: float = 0.0,
+              axial_load_n: float = 0.0, duration_s: float = 0.1, settle_s: float = 0.04,
+              parameters: Mapping[str, float] | None = None, bearing: Bearing | None = None, workers: int = 2,
+              scheduler: str | None = None, progress: bool = True) -> pd.DataFrame:
+    """Run the grid and return one row per run (the varied values, seed, peak slip in %, status)."""
+    from concurrent.futures import ProcessPoolExecutor
+    from multiprocessing import get_context
+
+    from tqdm.auto import tqdm
+
+    base = {"speed_rpm": speed_rpm, "radial_load_n": radial_load_n, "axial_load_n": axial_load_n,
+            "duration_s": duration_s, "settle_s": settle_s, "parameters": dict(parameters or {}),
+            "bearing": (bearing or default_bearing()).to_dict()}
+    points = sweep_grid(vary, seeds)
+    if scheduler:
+        from distributed import Client
+
+        pool: Any = Client(scheduler)
+    else:
+        pool = ProcessPoolExecutor(max_workers=max(1, workers), mp_context=get_context("spawn"))
+    with pool:
+        futures = [pool.submit(_run_point, p, base) for p in points]
+        rows = [f.result() for f in tqdm(futures, desc="sweep runs", disable=not progress, leave=False)]
+    return pd.DataFrame(rows)
+
+
+def summarise(runs: pd.DataFrame, names: Sequence[str]) -> pd.DataFrame:
+    """Mean, seed spread (std) and count of the peak slip per grid point."""
+    ok = runs[runs.status == "ok"]
+    g = ok.groupby(list(names), sort=True)["peak_slip_pct"]
+    return pd.DataFrame({"peak_slip_mean_pct": g.mean(), "peak_slip_std_pct": g.std(ddof=0),
+                         "runs": g.count()}).reset_index()
+
+
+def plot_sweep(summary: pd.DataFrame, names: Sequence[str], path: str | Path) -> None:
+    """One panel per varied parameter: peak slip (mean, seed spread) against it."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    with matplotlib.rc_context({"font.size": 8}):
+        fig, axes = plt.subplots(1, len(names), figsize=(3.4 * len(names), 2.8), squeeze=False)
+        for ax, name in zip(axes[0], names, strict=True):
+            others = [n for n in names if n != name]
+            groups = summary.groupby(others) if others else [((), summary)]
+            for key, part in groups:
+                part = part.sort_values(name)
+                label = ", ".join(f"{o}={v:g}" for o, v in zip(others, np.atleast_1d(key), strict=False)) or None
+                ax.errorbar(part[name], part.peak_slip_mean_pct, yerr=part.peak_slip_std_pct, marker="o",
+                            capsize=2, label=label)
+            ax.set(xlabel=name, ylabel="peak slip, unloaded zone (%)")
+            if others:
+                ax.legend(fontsize=6)
+            ax.grid(True, alpha=0.3)
+        fig.tight_layout()
+        fig.savefig(path, dpi=120)
+        plt.close(fig)
+
+
+def write_sweep(runs: pd.DataFrame, names: Sequence[str], out: str | Path) -> dict[str, Path]:
+    """Write ``runs.csv``, ``summary.csv`` and ``peak_slip.png`` into ``out``."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    summary = summarise(runs, names)
+    atomic_write_text(out / "runs.csv", runs.to_csv(index=False, float_format="%.6g"))
+    atomic_write_text(out / "summary.csv", summary.to_csv(index=False, float_format="%.6g"))
+    if len(summary):
+        plot_sweep(summary, names, out / "peak_slip.png")
+    return {"runs": out / "runs.csv", "summary": out / "summary.csv", "plot": out / "peak_slip.png"}
