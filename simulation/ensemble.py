@@ -1,5 +1,6 @@
 """An ensemble of seeds of one scene, run locally on both cores (``cageless simulate --ensemble N``).
 
+Locally the seeds share both cores; ``scheduler`` sends one task per seed to a Dask cluster.
 The ball ring is chaotic: runs that differ only in the seeded initial gaps part
 after a few milliseconds, so the paper's spread is a property of the ensemble,
 not of one trajectory (DESIGN §6). Each seed writes its own trace,
@@ -43,11 +44,22 @@ def _one(scene: Scene, choice: ModelChoice, out: str, kw: dict[str, Any]) -> dic
 
 
 def run_ensemble(scene: Scene, choice: ModelChoice, n_seeds: int, out: str | Path, workers: int = 2,
-                 progress: bool = True, **kw: Any) -> list[dict[str, Any]]:
-    """Run seeds 0..n_seeds-1 of ``scene`` in ``workers`` processes; one row per seed, in seed order."""
+                 progress: bool = True, scheduler: str | None = None, **kw: Any) -> list[dict[str, Any]]:
+    """Run seeds 0..n_seeds-1 of ``scene``; one row per seed, in seed order.
+
+    Locally the seeds run in ``workers`` spawned processes; with ``scheduler`` (a Dask scheduler
+    address) each seed is one task on that cluster, and the traces are written by the workers (so
+    ``out`` must be on storage they share).
+    """
     scenes = [dataclasses.replace(scene, seed=k) for k in range(n_seeds)]
-    paths = [str(seed_path(out, k)) for k in range(n_seeds)]
-    with ProcessPoolExecutor(max_workers=max(1, min(workers, n_seeds)), mp_context=get_context("spawn")) as pool:
+    paths = [str(Path(seed_path(out, k)).resolve()) for k in range(n_seeds)]
+    if scheduler:
+        from distributed import Client
+
+        pool: Any = Client(scheduler)
+    else:
+        pool = ProcessPoolExecutor(max_workers=max(1, min(workers, n_seeds)), mp_context=get_context("spawn"))
+    with pool:
         futures = [pool.submit(_one, s, choice, p, kw) for s, p in zip(scenes, paths, strict=True)]
         rows = [f.result() for f in tqdm(futures, desc="seeds", disable=not progress, leave=False)]
     return rows

@@ -63,6 +63,7 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--speed-ramp", type=finite_float, default=0.0,
                    help="time for the ring to reach its speed from rest (s, default 0: at speed from the start)")
     p.add_argument("--ensemble", type=int, default=1, metavar="N", help="run seeds 0..N-1 (N traces, both cores)")
+    p.add_argument("--scheduler", help="with --ensemble: address of a Dask scheduler to run the seeds on")
     p.add_argument("--sample-rate", type=finite_float, default=10_000.0, help="samples per second (default 10000)")
     p.add_argument("-o", "--out", help="trace file to write (default sim_<rpm>rpm_Fr<N>.trace.h5)")
 
@@ -109,6 +110,8 @@ def _run(args: argparse.Namespace, scene: Any, choice: Any, config: dict[str, An
     out = args.out or f"sim_{args.speed_rpm:g}rpm_Fr{args.radial_load_n:g}.trace.h5"
     kw = {"parameters": par, "rtol": args.rtol, "sample_rate_hz": args.sample_rate, "method": args.solver,
           "max_step": args.max_step, "config": {"command": "simulate", "set": args.set_values}}
+    if args.scheduler and args.ensemble == 1:
+        raise UsageError("--scheduler runs an ensemble on a Dask cluster: give --ensemble N as well")
     if args.ensemble == 1:
         from simulation.run import simulate
 
@@ -118,7 +121,7 @@ def _run(args: argparse.Namespace, scene: Any, choice: Any, config: dict[str, An
         return 0 if res.solution.success else 1
     from simulation.ensemble import run_ensemble
 
-    rows = run_ensemble(scene, choice, args.ensemble, out, progress=not args.quiet, **kw)
+    rows = run_ensemble(scene, choice, args.ensemble, out, progress=not args.quiet, scheduler=args.scheduler, **kw)
     print(f"effects: {', '.join(choice.active)}")
     for row in rows:
         print(f"seed {row['seed']}: {row['summary']}")

@@ -101,3 +101,21 @@ def test_compare_row_and_table_formats(tmp_path):
     assert "theoretical_slip_pct" in to_csv(frame).splitlines()[0]
     paths = write_tables([c.row, failed], tmp_path / "slip_table")
     assert sorted(paths) == ["csv", "html", "md", "tex"] and all(p.exists() for p in paths.values())
+
+
+def test_figures_restore_rcparams_and_close(tmp_path):
+    import matplotlib
+    import matplotlib.pyplot as plt
+
+    from comparison.report import describe_condition, figures
+
+    measured = orbit_trace("video", bump(0.06), t_end=0.2)
+    simulated = orbit_trace("simulation", bump(0.04), t_end=0.25)
+    d = describe_condition("x", compare(measured, simulated, settle_s=0.05), measured, simulated)
+    before = dict(matplotlib.rcParams)
+    n_open = len(plt.get_fignums())
+    svgs = [f(d) for f in (figures.speed_figure, figures.slip_figure, figures.contact_polar_figure,
+                           figures.ring_figure)]
+    assert all(s.startswith("<svg") for s in svgs)
+    assert len(plt.get_fignums()) == n_open
+    assert dict(matplotlib.rcParams) == before
