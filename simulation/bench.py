@@ -21,7 +21,6 @@ shared 2-core machine are noisy.
 
 from __future__ import annotations
 
-import time
 from dataclasses import replace
 from typing import Any
 

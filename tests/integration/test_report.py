@@ -15,7 +15,6 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import pytest
 
 from cageless.bearing import default_bearing
 from cageless.cli import main

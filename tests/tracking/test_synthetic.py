@@ -8,7 +8,6 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cageless.conditions import discover_lab
 from cageless.errors import ParameterError
 from cageless.kinematics import theoretical_cage_speed
 from cageless.parameter_sets import wang2026

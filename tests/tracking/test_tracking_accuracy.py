@@ -13,7 +13,6 @@ import math
 from dataclasses import replace
 
 import numpy as np
-import pandas as pd
 import pytest
 
 from cageless.bearing import default_bearing

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import dataclasses
-import shutil
 from pathlib import Path
 
 import numpy as np
@@ -14,7 +13,7 @@ from cageless.cli import main
 from cageless.conditions import OperatingConditions
 from cageless.errors import TrackingError, VideoError
 from cageless.trace import read_trace
-from tracking.io import write_cine, write_image_sequence
+from tracking.io import write_cine
 from tracking.link import BallCountWarning
 from tracking.pipeline import track_video
 from tracking.synthetic.camera import Appearance, Camera
