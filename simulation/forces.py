@@ -34,7 +34,7 @@ def hertz_damped(delta, delta_dot, v_in, stiffness, chi):  # pragma: no cover - 
     """Normal force (N) for overlap ``delta`` (m) > 0 at overlap rate ``delta_dot`` (m/s)."""
     if delta <= 0.0:
         return 0.0
-    f = stiffness * delta**1.5
+    f = stiffness * delta * np.sqrt(delta)
     if chi > 0.0 and v_in > 0.0:
         f *= 1.0 + chi * delta_dot / v_in
     return max(f, 0.0)

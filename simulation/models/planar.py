@@ -98,18 +98,17 @@ def _tangential(u_s, u_r, q, p):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _race_forces(y, p, j, z, w_i):  # pragma: no cover - compiled
+def _race_forces(y, p, j, z, w_i, c, s):  # pragma: no cover - compiled
     """Race forces on ball j: (f_y, f_z, spin torque, ring f_y, ring f_z, input power, dissipated power)."""
     d = p[P_D]
     half = 0.5 * d
-    r, th, rd, thd, om = y[j], y[z + j], y[2 * z + j], y[3 * z + j], y[4 * z + j]
+    r, rd, thd, om = y[j], y[2 * z + j], y[3 * z + j], y[4 * z + j]
     cy, cz, cvy, cvz = y[5 * z], y[5 * z + 1], y[5 * z + 2], y[5 * z + 3]
-    c, s = np.cos(th), np.sin(th)
     fy = fz = torque = ry = rz = p_in = p_diss = 0.0
     trac = p[P_F_TRAC] > 0.5
     d_o = r + half - 0.5 * p[P_DO]
     if d_o > 0.0:
-        q = p[P_KO] * d_o**1.5
+        q = p[P_KO] * d_o * np.sqrt(d_o)
         if p[P_F_LUB] > 0.5:
             q_d = max(q + p[P_CHO] * rd, 0.0)  # d(delta_o)/dt = r'; never tensile
             p_diss += (q_d - q) * rd
@@ -131,7 +130,7 @@ def _race_forces(y, p, j, z, w_i):  # pragma: no cover - compiled
         tx, tz = -nz, nx
         vx = rd * c - r * thd * s - cvy
         vz = rd * s + r * thd * c - cvz
-        q = p[P_KI] * d_i**1.5
+        q = p[P_KI] * d_i * np.sqrt(d_i)
         if p[P_F_LUB] > 0.5:
             ddot = -(vx * nx + vz * nz)
             q_d = max(q + p[P_CHO] * ddot, 0.0)
@@ -156,22 +155,22 @@ def _race_forces(y, p, j, z, w_i):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _pair_forces(y, p, aux, j, k, z):  # pragma: no cover - compiled
+def _pair_forces(y, p, aux, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
     """Forces between balls j and k: (f_y on k, f_z on k, spin torque on both, dissipated power)."""
     d = p[P_D]
-    rj, tj, rk, tk = y[j], y[z + j], y[k], y[z + k]
-    dx = rk * np.cos(tk) - rj * np.cos(tj)
-    dz = rk * np.sin(tk) - rj * np.sin(tj)
+    rj, rk = y[j], y[k]
+    dx = rk * ck - rj * cj
+    dz = rk * sk - rj * sj
     ln = np.sqrt(dx * dx + dz * dz)
     delta = d - ln
     film = p[P_F_BBFILM] > 0.5 and -delta < 4.0 / 3.0 * p[P_H0]
     if delta <= 0.0 and not film:
         return 0.0, 0.0, 0.0, 0.0
     nx, nz = dx / ln, dz / ln
-    vjx = y[2 * z + j] * np.cos(tj) - rj * y[3 * z + j] * np.sin(tj)
-    vjz = y[2 * z + j] * np.sin(tj) + rj * y[3 * z + j] * np.cos(tj)
-    vkx = y[2 * z + k] * np.cos(tk) - rk * y[3 * z + k] * np.sin(tk)
-    vkz = y[2 * z + k] * np.sin(tk) + rk * y[3 * z + k] * np.cos(tk)
+    vjx = y[2 * z + j] * cj - rj * y[3 * z + j] * sj
+    vjz = y[2 * z + j] * sj + rj * y[3 * z + j] * cj
+    vkx = y[2 * z + k] * ck - rk * y[3 * z + k] * sk
+    vkz = y[2 * z + k] * sk + rk * y[3 * z + k] * ck
     delta_dot = -((vkx - vjx) * nx + (vkz - vjz) * nz)
     if delta <= 0.0:
         # squeeze film between the approaching balls: F = 6 pi eta R^2 (-dh/dt) / h, R = D/4, h >= Delta_r
@@ -183,7 +182,7 @@ def _pair_forces(y, p, aux, j, k, z):  # pragma: no cover - compiled
     # then the current approach speed, so the force depends on no trial stage of any step
     v_in = aux[j] if aux[j] > 0.0 else max(delta_dot, 1e-9)
     f = hertz_damped(delta, delta_dot, v_in, p[P_KB], p[P_CHI])
-    p_diss = (f - p[P_KB] * delta**1.5) * delta_dot
+    p_diss = (f - p[P_KB] * delta * np.sqrt(delta)) * delta_dot
     f_t = torque = 0.0
     if p[P_F_TRAC] > 0.5:
         tx, tz = -nz, nx
@@ -206,7 +205,10 @@ def planar_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     w_i = p[P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
     power_in, power = 0.0, 0.0
     fy_ring, fz_ring = 0.0, -p[P_FR] - (m_ring * g if grav_on else 0.0)
+    trig = aux.shape[0] - 2 * z  # scratch: cos and sin of every ball's angle, computed once per call
     for j in range(z):
+        aux[trig + j] = np.cos(y[z + j])
+        aux[trig + z + j] = np.sin(y[z + j])
         dydt[j] = y[2 * z + j]
         dydt[z + j] = y[3 * z + j]
         dydt[2 * z + j] = 0.0  # force accumulators (Cartesian y, z) held in the acceleration slots for now
@@ -214,7 +216,7 @@ def planar_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
         dydt[4 * z + j] = 0.0  # torque accumulator
     if p[P_F_RACE] > 0.5:
         for j in range(z):
-            fy, fz, torque, ry, rz, p_in, p_diss = _race_forces(y, p, j, z, w_i)
+            fy, fz, torque, ry, rz, p_in, p_diss = _race_forces(y, p, j, z, w_i, aux[trig + j], aux[trig + z + j])
             dydt[2 * z + j] += fy
             dydt[3 * z + j] += fz
             dydt[4 * z + j] += torque
@@ -225,7 +227,8 @@ def planar_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     if p[P_F_BB] > 0.5:
         for j in range(z):
             k = j + 1 if j + 1 < z else 0
-            fy, fz, torque, p_diss = _pair_forces(y, p, aux, j, k, z)
+            fy, fz, torque, p_diss = _pair_forces(y, p, aux, j, k, z, aux[trig + j], aux[trig + z + j], aux[trig + k],
+                                                 aux[trig + z + k])
             dydt[2 * z + j] -= fy
             dydt[3 * z + j] -= fz
             dydt[2 * z + k] += fy
@@ -235,8 +238,8 @@ def planar_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
             power += p_diss
     drag = 0.5 * p[P_CD] * p[P_RHO_MIX] * 0.25 * np.pi * d * d if p[P_F_DRAG] > 0.5 else 0.0
     for j in range(z):
-        r, th = y[j], y[z + j]
-        c, s = np.cos(th), np.sin(th)
+        r = y[j]
+        c, s = aux[trig + j], aux[trig + z + j]
         fy, fz = dydt[2 * z + j], dydt[3 * z + j]
         rd, thd = y[2 * z + j], y[3 * z + j]
         f_rad = fy * c + fz * s
@@ -294,7 +297,7 @@ ONSET_RESOLUTION = 20.0
 
 def aux_size(n_balls: int, capacity: int) -> int:
     """Length of the auxiliary array for ``capacity`` logged contact episodes."""
-    return 5 * n_balls + 1 + EVENT_FIELDS * capacity
+    return 5 * n_balls + 1 + EVENT_FIELDS * capacity + 2 * n_balls  # last 2 Z: the RHS's trig scratch
 
 
 @numba.njit(cache=True)
@@ -304,7 +307,7 @@ def planar_post(t, y, p, aux):  # pragma: no cover - compiled
         return
     d, k_b, m = p[P_D], p[P_KB], p[P_M]
     base = 5 * z + 1
-    cap = (aux.shape[0] - base) // EVENT_FIELDS
+    cap = (aux.shape[0] - base - 2 * z) // EVENT_FIELDS
     for j in range(z):
         k = j + 1 if j + 1 < z else 0
         rj, tj, rk, tk = y[j], y[z + j], y[k], y[z + k]
@@ -457,7 +460,7 @@ def contact_events(problem: Problem, aux: npt.NDArray[np.float64], t_end: float)
     z = int(p[P_Z])
     base = 5 * z + 1
     n = int(aux[base - 1])
-    cap = (aux.shape[0] - base) // EVENT_FIELDS
+    cap = (aux.shape[0] - base - 2 * z) // EVENT_FIELDS
     rows = aux[base:base + EVENT_FIELDS * min(n, cap)].reshape(-1, EVENT_FIELDS)
     still_open = []
     for j in range(z):
