@@ -237,6 +237,17 @@ def _failed_row(label: str, c: OperatingConditions | None, message: str) -> Any:
     return ComparisonRow(speed, fr, fa, nan, nan, nan, nan, nan, label=label, status="failed", message=message)
 
 
+def _collect(results: dict[Any, Any], pending: list[Any], keys: list[str], outcomes: list[tuple[str, str]],
+             cache: _Cache) -> None:
+    """Store each finished job's output path (and cache it), or its error."""
+    for item, key, (status, info) in zip(pending, keys, outcomes, strict=True):
+        if status == "ok":
+            cache.store(key, info)
+            results[item] = info
+        else:
+            results[item] = CagelessError(info)
+
+
 def _track_all(pool: Any, entries: list[LabEntry], bearing: Bearing, out: Path, cache: _Cache,
                progress: bool) -> tuple[dict[Path, Any], int]:
     traces: dict[Path, Any] = {}
@@ -251,12 +262,7 @@ def _track_all(pool: Any, entries: list[LabEntry], bearing: Bearing, out: Path, 
         jobs.append((_track_job, (str(e.video), e.resolved.conditions, bearing, str(out / "traces"))))
         keys.append(key)
         pending.append(e.video)
-    for video, key, (status, info) in zip(pending, keys, _run_jobs(pool, jobs, "tracking", progress), strict=True):
-        if status == "ok":
-            cache.store(key, info)
-            traces[video] = info
-        else:
-            traces[video] = CagelessError(info)
+    _collect(traces, pending, keys, _run_jobs(pool, jobs, "tracking", progress), cache)
     return traces, len(entries) - len(jobs)
 
 
@@ -286,10 +292,5 @@ def _simulate_all(pool: Any, entries: list[LabEntry], traces: dict[Path, Any], b
                                      str(out / "simulations" / _sim_name(k)))))
         keys.append(key)
         pending.append(k)
-    for k, key, (status, info) in zip(pending, keys, _run_jobs(pool, jobs, "simulation", progress), strict=True):
-        if status == "ok":
-            cache.store(key, info)
-            sims[k] = info
-        else:
-            sims[k] = CagelessError(info)
+    _collect(sims, pending, keys, _run_jobs(pool, jobs, "simulation", progress), cache)
     return sims, len(conditions) - len(jobs)

@@ -107,20 +107,25 @@ def test_compiled_and_numpy_right_hand_sides_agree(effects):
         np.testing.assert_allclose(aux_fast[:z], aux_ref[:z], rtol=1e-12)
 
 
+def _coasting_ball(v: float, **kw):
+    """Ball 3 coasting at ``v`` onto its resting neighbour (no gravity, no load); the problem and a time just
+    past the first contact."""
+    z = G.n_balls
+    th = packed_start(B, seed=4, spread=0.6)
+    r0 = np.full(z, 0.5 * G.pitch_diameter_m)
+    thd = np.zeros(z)
+    thd[3] = v / r0[3]
+    pr = planar_problem(B, th, r0, (0.0, 0.0), 0.0, gravity_m_s2=0.0, theta_dot0=thd, **kw)
+    return pr, (th[4] - th[3] - 2 * np.arcsin(G.ball_diameter_m / G.pitch_diameter_m)) * r0[3] / v + 1e-4
+
+
 def test_contact_episodes_are_logged_and_classified():
     """One ball sent at 0.3 m/s into its resting neighbour: the first logged episode is an impact on that pair,
     lasting about the Hertz impact duration (Johnson 1985, sect. 11.4) at that approach speed."""
     from simulation.models.planar import contact_events
 
-    z = G.n_balls
-    th = packed_start(B, seed=4, spread=0.6)
-    r0 = np.full(z, 0.5 * G.pitch_diameter_m)
-    thd = np.zeros(z)
     v = 0.3
-    thd[3] = v / r0[3]
-    pr = planar_problem(B, th, r0, (0.0, 0.0), 0.0, restitution=0.9, gravity_m_s2=0.0, theta_dot0=thd,
-                        effects={"lubricant_damping": False})
-    t_end = (th[4] - th[3] - 2 * np.arcsin(G.ball_diameter_m / G.pitch_diameter_m)) * r0[3] / v + 1e-4
+    pr, t_end = _coasting_ball(v, restitution=0.9, effects={"lubricant_damping": False})
     sol = solve(pr, np.linspace(0, t_end, 11), rtol=1e-8)
     events = contact_events(pr, sol.extra["aux"], t_end)
     assert len(events) >= 1
@@ -156,15 +161,8 @@ def test_contact_onset_is_not_stepped_over():
 
     from simulation.models.planar import contact_events
 
-    z = G.n_balls
-    th = packed_start(B, seed=4, spread=0.6)
-    r0 = np.full(z, 0.5 * G.pitch_diameter_m)
-    thd = np.zeros(z)
     v = 0.3
-    thd[3] = v / r0[3]
-    pr = planar_problem(B, th, r0, (0.0, 0.0), 0.0, restitution=1.0, gravity_m_s2=0.0, theta_dot0=thd,
-                        effects={"lubricant_damping": False, "race_contact": False})
-    t_end = (th[4] - th[3] - 2 * np.arcsin(G.ball_diameter_m / G.pitch_diameter_m)) * r0[3] / v + 1e-4
+    pr, t_end = _coasting_ball(v, restitution=1.0, effects={"lubricant_damping": False, "race_contact": False})
     peaks = {}
     for name, problem, max_step in (("controlled", pr, 5e-4), ("fine", pr, pr.onset_step / 4),
                                     ("uncontrolled", replace(pr, onset_step=0.0), 5e-4)):
