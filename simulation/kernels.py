@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import numba
 
-from simulation.models import planar, textbook, two_balls
+from simulation.models import planar, spatial, textbook, two_balls
 
-__all__ = ["PLANAR", "TWO_BALLS", "OSCILLATOR", "RICCATI", "model_rhs", "model_post", "model_signature"]
+__all__ = ["PLANAR", "SPATIAL", "TWO_BALLS", "OSCILLATOR", "RICCATI", "model_rhs", "model_post", "model_signature"]
 
-PLANAR, TWO_BALLS = planar.MODEL_ID, two_balls.MODEL_ID
+PLANAR, TWO_BALLS, SPATIAL = planar.MODEL_ID, two_balls.MODEL_ID, spatial.MODEL_ID
 OSCILLATOR, RICCATI = textbook.OSCILLATOR, textbook.RICCATI
 
 
@@ -22,6 +22,8 @@ def model_rhs(model_id, t, y, p, aux, dydt):  # pragma: no cover - compiled
     """dy/dt of model ``model_id`` into ``dydt``."""
     if model_id == PLANAR:
         planar.planar_rhs(t, y, p, aux, dydt)
+    elif model_id == SPATIAL:
+        spatial.spatial_rhs(t, y, p, aux, dydt)
     elif model_id == TWO_BALLS:
         two_balls.two_ball_rhs(t, y, p, aux, dydt)
     elif model_id == OSCILLATOR:
@@ -33,7 +35,7 @@ def model_rhs(model_id, t, y, p, aux, dydt):  # pragma: no cover - compiled
 @numba.njit(cache=True)
 def model_post(model_id, t, y, p, aux):  # pragma: no cover - compiled
     """Bookkeeping after an accepted step (contact episodes)."""
-    if model_id == PLANAR:
+    if model_id == PLANAR or model_id == SPATIAL:
         planar.planar_post(t, y, p, aux)
     elif model_id == TWO_BALLS:
         two_balls.two_ball_post(t, y, p, aux)
@@ -44,4 +46,6 @@ def model_signature(model_id, y, p):  # pragma: no cover - compiled
     """A number that changes whenever a contact opens or closes (0 for models without contacts)."""
     if model_id == PLANAR:
         return planar.planar_signature(y, p)
+    if model_id == SPATIAL:
+        return spatial.spatial_signature(y, p)
     return 0.0

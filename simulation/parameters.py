@@ -27,6 +27,8 @@ Sources
 * ``drag_coefficient``: 0.47, the textbook drag coefficient of a smooth sphere
   in the subcritical Reynolds range (F. M. White, Fluid Mechanics, Fig. 7.16).
   Used only when the scene gives an oil-air mixture density.
+* ``strips``: 5 strips across each race contact ellipse in the spatial model, a
+  choice; the work-precision study measures what other counts cost.
 * ``dry_friction_coefficient``: no default. A dry scene has no film, and the
   Coulomb friction of the bare steel contact must be given (``--set
   dry_friction_coefficient=...``).
@@ -71,6 +73,9 @@ class ModelParameters:
         Coulomb friction of a dry steel contact, in (0, 1), or None when not given.
     slip_regularisation_m_s
         Sliding speed (m/s) over which the dry Coulomb friction builds up (tanh), > 0.
+    strips
+        Strips m across each race contact ellipse in the spatial model (1 = point contact), 1..101: an
+        accuracy knob (``cageless bench accuracy`` measures its cost).
     min_entrainment_m_s
         Floor on the entrainment speed in the slide-to-roll ratio (m/s), > 0: a contact that rolls
         slower than this is treated as sliding (the film has collapsed), which also bounds the
@@ -87,6 +92,7 @@ class ModelParameters:
     dry_friction_coefficient: float | None = None
     slip_regularisation_m_s: float = 1e-3
     min_entrainment_m_s: float = 0.1
+    strips: int = 5
 
     def __post_init__(self) -> None:
         rules = {
@@ -105,6 +111,10 @@ class ModelParameters:
             if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value) \
                     or not ok(value):
                 raise ParameterError(f"parameters.{name}", rule, value)
+        m = self.strips
+        if isinstance(m, bool) or not isinstance(m, int | float) or m != int(m) or not 1 <= m <= 101:
+            raise ParameterError("parameters.strips", "must be a whole number in 1..101", m)
+        object.__setattr__(self, "strips", int(m))
         mu = self.dry_friction_coefficient
         if mu is not None and not (isinstance(mu, int | float) and math.isfinite(mu) and 0 < mu < 1):
             raise ParameterError("parameters.dry_friction_coefficient", "must lie in (0, 1), or be None", mu)

@@ -1,8 +1,8 @@
 """From a scene to a simulation trace: build the model, start it quasi-statically, solve, write.
 
-This release runs the planar level with every effect of its table
-(:data:`IMPLEMENTED`); a scene that needs the spatial level is refused before
-anything compiles, with the way to force the planar one. The run is split into chunks of simulated time for the progress bar; the
+This release runs the planar and the spatial level with every effect of the
+table (:data:`IMPLEMENTED`); moment loads and a vertical shaft are refused
+before anything compiles. The run is split into chunks of simulated time for the progress bar; the
 state and the contact bookkeeping carry over between chunks.
 """
 
@@ -29,13 +29,15 @@ from simulation.hertz import compliance, hertz_contact, race_curvatures
 from simulation.models.planar_reference import tangential_force
 from simulation.traction import film_coefficient
 from simulation.models import planar as P
+from simulation.models import spatial as S
 from simulation.parameters import ModelParameters
 from simulation.quasistatic import radial_load_distribution
 from simulation.scene import Scene
 from simulation.problem import Problem
 from simulation.solve import Solution, solve
 
-__all__ = ["IMPLEMENTED", "SimulationResult", "check_supported", "initial_state", "simulate", "peak_unloaded_slip",
+__all__ = ["IMPLEMENTED", "SimulationResult", "build_problem", "check_supported", "initial_state", "simulate",
+           "peak_unloaded_slip",
            "UNLOADED_ZONE_DEG"]
 
 #: The unloaded zone: the upper half of the bearing, opposite the radial load (DESIGN §3, §9).
@@ -68,12 +70,13 @@ def peak_unloaded_slip(trace: Trace, settle_s: float = 0.0, bin_deg: float = 1.0
     return float(zone.max()) if zone.notna().any() else float("nan")
 
 
-def check_supported(choice: ModelChoice) -> None:
+def check_supported(choice: ModelChoice, scene: Scene | None = None) -> None:
     """Refuse, before any compile or solve, a model this release cannot run."""
-    if choice.level != "planar":
-        raise UsageError("the spatial level lands with the next simulator issue; this release runs planar scenes "
-                         "(pure radial load, aligned bearing, horizontal shaft). To run this scene on the planar model "
-                         "anyway (axial load and tilt ignored), add --level planar --force.")
+    if scene is not None and scene.moment_load_nm > 0:
+        raise UsageError("moment loads are not in this release: the spatial model prescribes the ring's tilt "
+                         "(--misalignment-rad) instead of solving it. Set the moment load to 0.")
+    if scene is not None and scene.orientation != "horizontal":
+        raise UsageError("a vertical shaft is not in this release: gravity acts along -z (horizontal shaft).")
     missing = [e for e in choice.active if e not in IMPLEMENTED]  # pragma: no cover - all planar effects exist
     if missing:
         flags = " ".join(f"--effect {e}=off" for e in missing)
@@ -102,6 +105,20 @@ def initial_state(scene: Scene) -> tuple[npt.NDArray[np.float64], npt.NDArray[np
     total = np.clip(e * np.cos(theta - 1.5 * math.pi) - 0.5 * g.diametral_clearance_m, 0.0, None)
     radius = radius + total / (1.0 + (k_o / k_i) ** (2.0 / 3.0))
     return theta, radius, (0.0, -e)
+
+
+def build_problem(scene: Scene, choice: ModelChoice, parameters: ModelParameters) -> Problem:
+    """The planar or spatial problem of ``choice`` for ``scene``, from the quasi-static start."""
+    theta, radius, ring = initial_state(scene)
+    effects = {e.name: e.on for e in choice.effects}
+    kw = {"gravity_m_s2": scene.gravity_m_s2 if effects.get("gravity") else 0.0,
+          "inner_speed_rad_s": scene.conditions.speed_rad_s, "effects": effects, "parameters": parameters,
+          "speed_ramp_s": scene.speed_ramp_s, "oil_air_density_kg_m3": scene.oil_air_density_kg_m3}
+    if choice.level == "spatial":
+        return S.spatial_problem(scene.bearing, theta, radius, ring, scene.conditions.radial_load_n,
+                                 axial_load_n=scene.conditions.axial_load_n,
+                                 misalignment_rad=(scene.misalignment_rad, 0.0), strips=parameters.strips, **kw)
+    return P.planar_problem(scene.bearing, theta, radius, ring, scene.conditions.radial_load_n, **kw)
 
 
 def _observables(pr: Problem, y: npt.NDArray[np.float64], scene: Scene,
@@ -135,11 +152,33 @@ def _observables(pr: Problem, y: npt.NDArray[np.float64], scene: Scene,
     spin = np.zeros((len(y), z, 3))
     spin[:, :, 0] = om
     ring = np.column_stack([np.zeros(len(y)), cy[:, 0], cz[:, 0]])
+    axial = np.zeros_like(r)
+    if pr.model_id == S.MODEL_ID:
+        sl = S.SpatialLayout(z).slices()
+        axial = y[:, sl["axial"]]
+        spin[:, :, 1], spin[:, :, 2] = y[:, sl["spin_y"]], y[:, sl["spin_z"]]
+        ring[:, 0] = y[:, sl["ring_axial"]][:, 0]
+        for race, (overlap, angle) in S.race_geometry(pr, y).items():
+            k_n = p[P.P_KI] if race == "inner" else p[P.P_KO]
+            contacts[f"{race}_normal"] = k_n * overlap**1.5
+            contacts[f"{race}_angle"] = angle
     return {
-        "balls": {"radius": r, "axial": np.zeros_like(r), "spin": spin},
+        "balls": {"radius": r, "axial": axial, "spin": spin},
         "contacts": contacts,
         "inner_ring": {"position": ring, "tilt": np.zeros((len(y), 2))},
     }
+
+
+def nominal_contact_angle(scene: Scene, groups: dict[str, dict[str, np.ndarray]]) -> float:
+    """The contact angle alpha of the slip rate (DESIGN §3): 0 unless an axial load sets it; then the median
+    inner contact angle of the loaded contacts over the second half of the run (rad, >= 0)."""
+    c = groups["contacts"]
+    if scene.conditions.axial_load_n <= 0 or "inner_angle" not in c:
+        return 0.0
+    half = len(c["inner_angle"]) // 2
+    angle, load = c["inner_angle"][half:], c["inner_normal"][half:]
+    loaded = np.isfinite(angle) & (load > 1.0)
+    return float(np.median(np.abs(angle[loaded]))) if loaded.any() else 0.0
 
 
 def _films(scene: Scene, inner: np.ndarray, outer: np.ndarray, ur_i: np.ndarray,
@@ -200,17 +239,12 @@ def simulate(scene: Scene, choice: ModelChoice, parameters: ModelParameters | No
     A solver failure does not raise: the result's ``solution.success`` is False and the trace's
     ``status`` says ``"incomplete: <why>"``; samples after the failure are NaN.
     """
-    check_supported(choice)
+    check_supported(choice, scene)
     par = parameters or ModelParameters()
     prov = Provenance.start(config={"scene": scene.to_dict(), "model": json.loads(choice.to_json()),
                                     "solver": {"method": method, "rtol": rtol, "max_step": max_step},
                                     "parameters": par.to_dict(), **(config or {})})
-    theta, radius, ring = initial_state(scene)
-    effects = {e.name: e.on for e in choice.effects}
-    pr = P.planar_problem(scene.bearing, theta, radius, ring, scene.conditions.radial_load_n,
-                          gravity_m_s2=scene.gravity_m_s2 if effects.get("gravity") else 0.0,
-                          inner_speed_rad_s=scene.conditions.speed_rad_s, effects=effects, parameters=par,
-                          speed_ramp_s=scene.speed_ramp_s, oil_air_density_kg_m3=scene.oil_air_density_kg_m3)
+    pr = build_problem(scene, choice, par)
     t = np.arange(0.0, scene.duration_s + 0.5 / sample_rate_hz, 1.0 / sample_rate_hz)
     start = time.perf_counter()
     sol = _solve_chunks(pr, t, rtol, method, max_step, min(50, len(t) - 1), progress, max_steps)
@@ -232,9 +266,11 @@ def _to_trace(scene: Scene, choice: ModelChoice, pr: Problem, sol: Solution, rto
     y = sol.y
     ok = np.all(np.isfinite(y), axis=1)
     angle, speed = y[:, z:2 * z], y[:, 3 * z:4 * z]
-    omega_c = theoretical_cage_speed(g, scene.conditions.speed_rad_s)
     film_on = any(e.name == "ehl_film" and e.on for e in choice.effects)
     groups = _observables(pr, np.where(ok[:, None], y, np.nan), scene, film_on)
+    alpha = nominal_contact_angle(scene, groups)
+    provenance["config"]["nominal_contact_angle_rad"] = alpha
+    omega_c = theoretical_cage_speed(g, scene.conditions.speed_rad_s, alpha)
     events = P.contact_events(pr, sol.extra["aux"], float(sol.t[ok][-1]) if ok.any() else 0.0)
     status = "complete" if sol.success else f"incomplete: {sol.message} at t = {sol.t[ok][-1] if ok.any() else 0:g} s"
     return Trace(

@@ -308,12 +308,16 @@ def planar_post(t, y, p, aux):  # pragma: no cover - compiled
     d, k_b, m = p[P_D], p[P_KB], p[P_M]
     base = 5 * z + 1
     cap = (aux.shape[0] - base - 2 * z) // EVENT_FIELDS
+    spatial = y.shape[0] > 5 * z + 6
     for j in range(z):
         k = j + 1 if j + 1 < z else 0
         rj, tj, rk, tk = y[j], y[z + j], y[k], y[z + k]
         dx = rk * np.cos(tk) - rj * np.cos(tj)
         dz = rk * np.sin(tk) - rj * np.sin(tj)
-        ln = np.sqrt(dx * dx + dz * dz)
+        da = dva = 0.0
+        if spatial:  # the spatial model appends axial positions and rates (simulation.models.spatial)
+            da, dva = y[5 * z + 6 + k] - y[5 * z + 6 + j], y[6 * z + 6 + k] - y[6 * z + 6 + j]
+        ln = np.sqrt(dx * dx + dz * dz + da * da)
         delta = d - ln
         slot = z + 4 * j
         if delta > 0.0 and aux[j] <= 0.0:
@@ -321,7 +325,7 @@ def planar_post(t, y, p, aux):  # pragma: no cover - compiled
                 y[2 * z + j] * np.cos(tj) - rj * y[3 * z + j] * np.sin(tj))
             vz = y[2 * z + k] * np.sin(tk) + rk * y[3 * z + k] * np.cos(tk) - (
                 y[2 * z + j] * np.sin(tj) + rj * y[3 * z + j] * np.cos(tj))
-            aux[j] = max(-(vx * dx + vz * dz) / ln, 1e-9)
+            aux[j] = max(-(vx * dx + vz * dz + dva * da) / ln, 1e-9)
         elif delta <= 0.0:
             aux[j] = 0.0
         if delta > 0.0:

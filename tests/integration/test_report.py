@@ -107,15 +107,17 @@ def test_footage_of_a_simulation_compares_within_tracking_accuracy(tmp_path, cap
 
 
 def test_a_failed_simulation_is_a_failed_row(tmp_path, capsys):
-    """An axial-load condition needs the spatial level, which this release refuses: the video is tracked, the
-    simulation fails with its message, and the report still completes."""
+    """A dry bearing (from the configuration) has no cited Coulomb friction, so its simulation fails with the
+    way out in the message: the video is tracked, the row is a failure, and the report still completes."""
     lab = tmp_path / "lab"
     lab.mkdir()
-    shutil.copy(LAB / "n6000_Fr500_Fa0.cine", lab / "n6000_Fr500_Fa300.cine")
+    shutil.copy(LAB / "n6000_Fr500_Fa0.cine", lab)
+    config = tmp_path / "dry.toml"
+    config.write_text("[bearing]\nlubricant = false\n")
     out = tmp_path / "out"
-    assert main(["report", str(lab), "-o", str(out), "-q"]) == 1
+    assert main(["report", str(lab), "-o", str(out), "-q", "--config", str(config)]) == 1
     assert "simulation failed" in capsys.readouterr().out
     table = pd.read_csv(out / "slip_table.csv")
-    assert list(table.status) == ["failed"] and "spatial level" in table.message[0]
-    assert (out / "traces" / "n6000_Fr500_Fa300.trace.h5").exists()
-    assert "spatial level" in (out / "report.html").read_text()
+    assert list(table.status) == ["failed"] and "dry_friction_coefficient" in table.message[0]
+    assert (out / "traces" / "n6000_Fr500_Fa0.trace.h5").exists()
+    assert "dry_friction_coefficient" in (out / "report.html").read_text()

@@ -82,7 +82,5 @@ def test_simulate_explain_cli(capsys):
     assert d["level"] == "spatial" and len(d["effects"]) == 8
     assert main(["simulate", "--speed-rpm", "3000", "--effect", "drag=maybe", "--explain"]) == 2
     assert "write NAME=on or NAME=off" in capsys.readouterr().err
-    assert main(["simulate", "--speed-rpm", "3000", "--axial-load-n", "300"]) == 2  # spatial: not in this release
-    assert "--level planar --force" in capsys.readouterr().err
     assert main(["simulate", "--speed-rpm", "3000", "--set", "cho_n_s=1"]) == 2
     assert "Did you mean 'cho_n_s_m'" in capsys.readouterr().err

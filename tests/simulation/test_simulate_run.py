@@ -20,8 +20,8 @@ FORCE_OFF = ["--effect", "race_traction=off", "--effect", "ehl_film=off", "--eff
 
 def test_unsupported_scenes_are_refused_with_the_way_out(tmp_path, capsys):
     out = tmp_path / "x.h5"
-    assert main(["simulate", "--speed-rpm", "3000", "--axial-load-n", "300", "-o", str(out)]) == 2
-    assert "spatial level" in capsys.readouterr().err
+    assert main(["simulate", "--speed-rpm", "3000", "--orientation", "vertical", "-o", str(out)]) == 2
+    assert "vertical shaft is not in this release" in capsys.readouterr().err
     assert main(["simulate", "--speed-rpm", "3000", "--dry", "-o", str(out)]) == 2  # no cited dry friction
     assert "--set dry_friction_coefficient=" in capsys.readouterr().err
     assert main(["simulate", "--speed-rpm", "3000", "--set", "restitution=1.5", "-o", str(out)]) == 2
@@ -81,5 +81,5 @@ def test_solver_failure_is_an_incomplete_trace(tmp_path):
     assert tr.status.startswith("incomplete: ")
     assert not tr.valid[-1].any()
     with pytest.raises(UsageError):
-        spatial = Scene(conditions=OperatingConditions(3000.0, 500.0, 300.0))
-        simulate(spatial, choose_model(spatial), progress=False)
+        moment = Scene(conditions=OperatingConditions(3000.0, 500.0), moment_load_nm=1.0)
+        simulate(moment, choose_model(moment), progress=False)

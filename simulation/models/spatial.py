@@ -1,0 +1,406 @@
+"""The spatial cageless-bearing model (DESIGN §6): axial positions, full spin vectors, contact angles.
+
+States (n = 9 Z + 8). The first 5 Z + 6 are laid out exactly as in the planar
+model (r, theta, their rates, spin about the shaft axis x, the ring centre
+(y, z) and its velocity, input work, dissipated energy), so everything that
+reads a planar state reads the planar part of a spatial one. Then, per ball,
+the axial position x and its rate and the spin components about y and z; last
+the ring's axial position and rate.
+
+Contacts follow the groove-curvature-centre geometry: the inner (outer) groove
+centre lies on a circle of radius rho_i = d_i/2 + f_i D (rho_o = d_o/2 - f_o D)
+in the ring's mid-plane; a ball touches when its centre is farther than
+(f - 1/2) D from the groove centre, along the normal through both, so contact
+angles come out of the positions. The inner ring translates in x, y and z under
+the radial and axial loads and gravity; its tilt (misalignment) is prescribed,
+not a degree of freedom. Race traction is integrated over ``m`` strips across
+the major axis of the contact ellipse, each carrying its share of the Hertz load
+(proportional to 1 - xi^2), so spin about the contact normal and differential
+slip produce forces and moments; ``m = 1`` is a point contact. Ball-ball contact
+acts along the 3-D line of centres with friction from the full relative surface
+velocity.
+
+A homogeneous sphere's spin obeys I d(omega)/dt = M in the inertial frame, with
+no gyroscopic term: the gyroscopic moments of the paper appear only when the
+spin is written in the rotating azimuthal frame. Under pure radial load the
+model reduces exactly to the planar one (the equivalence test checks it).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+import numpy.typing as npt
+
+from cageless.bearing import Bearing
+from simulation.forces import hertz_damped
+from simulation.hertz import compliance, hertz_contact, race_curvatures
+from simulation.models import planar as P
+from simulation.problem import Problem
+
+__all__ = ["MODEL_ID", "SpatialLayout", "spatial_problem", "spatial_rhs", "spatial_signature", "race_geometry", "spatial_energy"]
+
+MODEL_ID = 4
+P_RGI, P_RGO, P_FA, P_TILT_Y, P_TILT_Z, P_STRIPS, P_AI, P_AO = range(P.N_PARAMS, P.N_PARAMS + 8)
+N_PARAMS = P.N_PARAMS + 8
+
+
+class SpatialLayout(P.PlanarLayout):
+    """State layout: the planar one, then x, x', omega_y, omega_z per ball and the ring's (x, x')."""
+
+    @property
+    def size(self) -> int:
+        """Number of states, 9 Z + 8."""
+        return 9 * self.n_balls + 8
+
+    def slices(self) -> dict[str, slice]:
+        """The planar slices plus axial, axial_dot, spin_y, spin_z and ring_axial."""
+        z = self.n_balls
+        s = super().slices()
+        b = 5 * z + 6
+        s.update({"axial": slice(b, b + z), "axial_dot": slice(b + z, b + 2 * z), "spin_y": slice(b + 2 * z, b + 3 * z),
+                  "spin_z": slice(b + 3 * z, b + 4 * z), "ring_axial": slice(b + 4 * z, b + 4 * z + 2)})
+        return s
+
+
+@numba.njit(cache=True, inline="always")
+def _cross(a0, a1, a2, b0, b1, b2):  # pragma: no cover - compiled
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+
+
+@numba.njit(cache=True)
+def _tilt(p):  # pragma: no cover - compiled
+    """Rotation R = Rz(bz) Ry(by) of the inner ring, as 9 numbers (row-major)."""
+    cb, sb, cg, sg = math.cos(p[P_TILT_Y]), math.sin(p[P_TILT_Y]), math.cos(p[P_TILT_Z]), math.sin(p[P_TILT_Z])
+    return (cg * cb, -sg, cg * sb, sg * cb, cg, sg * sb, -sb, 0.0, cb)
+
+
+@numba.njit(cache=True)
+def _race(y, p, j, z, inner, w_i, rot, c, s):  # pragma: no cover - compiled
+    """One race contact of ball j: force (3), torque (3) on the ball, input and dissipated power, overlap."""
+    d = p[P.P_D]
+    half = 0.5 * d
+    b = 5 * z + 6
+    r, rd, thd = y[j], y[2 * z + j], y[3 * z + j]
+    px, py, pz = y[b + j], r * c, r * s
+    vx, vy, vz = y[b + z + j], rd * c - r * thd * s, rd * s + r * thd * c
+    ox, oy, oz = y[4 * z + j], y[b + 2 * z + j], y[b + 3 * z + j]
+    if inner:
+        cx, cy, cz = y[b + 4 * z], y[5 * z], y[5 * z + 1]
+        vcx, vcy, vcz = y[b + 4 * z + 1], y[5 * z + 2], y[5 * z + 3]
+        rho, rg, k_n, a_c = 0.5 * p[P.P_DI] + p[P_RGI], p[P_RGI], p[P.P_KI], p[P_AI]
+    else:
+        cx = cy = cz = vcx = vcy = vcz = 0.0
+        rho, rg, k_n, a_c = 0.5 * p[P.P_DO] - p[P_RGO], p[P_RGO], p[P.P_KO], p[P_AO]
+        rot = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
+    # ball centre in the ring frame (R^T (P - C))
+    dx, dy, dz = px - cx, py - cy, pz - cz
+    qx = rot[0] * dx + rot[3] * dy + rot[6] * dz
+    qy = rot[1] * dx + rot[4] * dy + rot[7] * dz
+    qz = rot[2] * dx + rot[5] * dy + rot[8] * dz
+    rq = math.sqrt(qy * qy + qz * qz)
+    cq, sq = qy / rq, qz / rq
+    ex, er = qx, rq - rho  # from the groove centre to the ball centre, in the (x, radial) plane of the ring
+    ln = math.sqrt(ex * ex + er * er)
+    delta = ln - (rg - half)
+    zero = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    if delta <= 0.0:
+        return zero
+    nrx, nrr = ex / ln, er / ln
+    # normal, radial and azimuthal directions in the fixed frame
+    nx0, ny0, nz0 = nrx, nrr * cq, nrr * sq
+    nx = rot[0] * nx0 + rot[1] * ny0 + rot[2] * nz0
+    ny = rot[3] * nx0 + rot[4] * ny0 + rot[5] * nz0
+    nz = rot[6] * nx0 + rot[7] * ny0 + rot[8] * nz0
+    tx = rot[1] * -sq + rot[2] * cq
+    ty = rot[4] * -sq + rot[5] * cq
+    tz = rot[7] * -sq + rot[8] * cq
+    q = k_n * delta * math.sqrt(delta)
+    rvx, rvy, rvz = vx - vcx, vy - vcy, vz - vcz
+    p_diss = 0.0
+    if p[P.P_F_LUB] > 0.5:
+        ddot = rvx * nx + rvy * ny + rvz * nz
+        q_d = max(q + p[P.P_CHO] * ddot, 0.0)
+        p_diss += (q_d - q) * ddot
+        q = q_d
+    fx, fy, fz = -q * nx, -q * ny, -q * nz
+    mx = my = mz = 0.0
+    p_in = 0.0
+    if p[P.P_F_TRAC] > 0.5 and q > 0.0:
+        # race surface point along the normal, its radius about the ring axis, the ring's spin vector
+        r_c = rho + rg * nrr
+        wx, wy, wz = (w_i * rot[0], w_i * rot[3], w_i * rot[6]) if inner else (0.0, 0.0, 0.0)
+        xrx = (rot[0] * rg * nrx + rot[1] * r_c * cq + rot[2] * r_c * sq)
+        xry = (rot[3] * rg * nrx + rot[4] * r_c * cq + rot[5] * r_c * sq)
+        xrz = (rot[6] * rg * nrx + rot[7] * r_c * cq + rot[8] * r_c * sq)
+        # major axis of the ellipse: across the rolling direction, in the contact plane
+        ax_, ay_, az_ = _cross(nx, ny, nz, tx, ty, tz)
+        a = a_c * q ** (1.0 / 3.0)
+        bsx, bsy, bsz = _cross(ox, oy, oz, half * nx, half * ny, half * nz)
+        rsx, rsy, rsz = _cross(wx, wy, wz, xrx, xry, xrz)
+        vt = rvx * tx + rvy * ty + rvz * tz
+        u_r = 0.5 * abs(vt * (1.0 - 2.0 * r_c / rq) + bsx * tx + bsy * ty + bsz * tz + rsx * tx + rsy * ty + rsz * tz)
+        # relative spin across the strips: slip grows linearly with the strip's offset xi along the major axis
+        wax, way, waz = _cross(ox - wx, oy - wy, oz - wz, ax_, ay_, az_)
+        u0x, u0y, u0z = rvx + bsx - rsx, rvy + bsy - rsy, rvz + bsz - rsz
+        gsx = gsy = gsz = 0.0  # traction on the ball, summed over the strips
+        hx = hy = hz = 0.0  # its first moment along the major axis, sum of xi g
+        m = int(p[P_STRIPS])
+        for k in range(m):
+            xi0, xi1 = -1.0 + 2.0 * k / m, -1.0 + 2.0 * (k + 1) / m
+            w = 0.75 * ((xi1 - xi1**3 / 3.0) - (xi0 - xi0**3 / 3.0))  # share of the Hertz load on the strip
+            xi = 0.5 * (xi0 + xi1) * a
+            ux, uy, uz = u0x + xi * wax, u0y + xi * way, u0z + xi * waz
+            un = ux * nx + uy * ny + uz * nz
+            ux, uy, uz = ux - un * nx, uy - un * ny, uz - un * nz
+            us = math.sqrt(ux * ux + uy * uy + uz * uz)
+            if us == 0.0:
+                continue
+            f = P._tangential(us, u_r, w * q, p) / us
+            gsx, gsy, gsz = gsx - f * ux, gsy - f * uy, gsz - f * uz
+            hx, hy, hz = hx - xi * f * ux, hy - xi * f * uy, hz - xi * f * uz
+            p_diss += f * us * us
+        fx, fy, fz = fx + gsx, fy + gsy, fz + gsz
+        t1x, t1y, t1z = _cross(half * nx, half * ny, half * nz, gsx, gsy, gsz)
+        t2x, t2y, t2z = _cross(ax_, ay_, az_, hx, hy, hz)
+        mx, my, mz = t1x + t2x, t1y + t2y, t1z + t2z
+        if inner:
+            # drive power: the ring's spin times the moment of the ball's traction on it
+            c1x, c1y, c1z = _cross(xrx, xry, xrz, gsx, gsy, gsz)
+            p_in = (c1x + t2x) * wx + (c1y + t2y) * wy + (c1z + t2z) * wz
+    return fx, fy, fz, mx, my, mz, p_in, p_diss, delta
+
+
+@numba.njit(cache=True)
+def _pair(y, p, aux, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
+    """Ball j against ball k along the 3-D line of centres: force on k (3), moment on both (3), dissipated power."""
+    d = p[P.P_D]
+    half = 0.5 * d
+    b = 5 * z + 6
+    dx = y[b + k] - y[b + j]
+    dy = y[k] * ck - y[j] * cj
+    dz = y[k] * sk - y[j] * sj
+    ln = math.sqrt(dx * dx + dy * dy + dz * dz)
+    delta = d - ln
+    zero = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    film = p[P.P_F_BBFILM] > 0.5 and -delta < 4.0 / 3.0 * p[P.P_H0]
+    if delta <= 0.0 and not film:
+        return zero
+    nx, ny, nz = dx / ln, dy / ln, dz / ln
+    vjx = y[b + z + j]
+    vjy = y[2 * z + j] * cj - y[j] * y[3 * z + j] * sj
+    vjz = y[2 * z + j] * sj + y[j] * y[3 * z + j] * cj
+    vkx = y[b + z + k]
+    vky = y[2 * z + k] * ck - y[k] * y[3 * z + k] * sk
+    vkz = y[2 * z + k] * sk + y[k] * y[3 * z + k] * ck
+    ddot = -((vkx - vjx) * nx + (vky - vjy) * ny + (vkz - vjz) * nz)
+    if delta <= 0.0:
+        if ddot > 0.0:
+            f = 6.0 * np.pi * p[P.P_ETA0] * (0.25 * d) ** 2 * ddot / max(-delta, p[P.P_H0])
+            return f * nx, f * ny, f * nz, 0.0, 0.0, 0.0, f * ddot
+        return zero
+    v_in = aux[j] if aux[j] > 0.0 else max(ddot, 1e-9)
+    f = hertz_damped(delta, ddot, v_in, p[P.P_KB], p[P.P_CHI])
+    p_diss = (f - p[P.P_KB] * delta * math.sqrt(delta)) * ddot
+    fx, fy, fz = f * nx, f * ny, f * nz
+    mx = my = mz = 0.0
+    if p[P.P_F_TRAC] > 0.5:
+        ojx, ojy, ojz = y[4 * z + j], y[b + 2 * z + j], y[b + 3 * z + j]
+        okx, oky, okz = y[4 * z + k], y[b + 2 * z + k], y[b + 3 * z + k]
+        sx, sy, sz = _cross(ojx + okx, ojy + oky, ojz + okz, half * nx, half * ny, half * nz)
+        ux, uy, uz = vjx - vkx + sx, vjy - vky + sy, vjz - vkz + sz  # surface of j against k
+        un = ux * nx + uy * ny + uz * nz
+        ux, uy, uz = ux - un * nx, uy - un * ny, uz - un * nz
+        us = math.sqrt(ux * ux + uy * uy + uz * uz)
+        if us > 0.0:
+            rx, ry, rz = _cross(ojx - okx, ojy - oky, ojz - okz, nx, ny, nz)
+            u_r = 0.25 * d * math.sqrt(rx * rx + ry * ry + rz * rz)
+            g = P._tangential(us, u_r, f, p) / us  # friction on j is -g u
+            p_diss += g * us * us
+            fx, fy, fz = fx + g * ux, fy + g * uy, fz + g * uz  # on k: +g u
+            mx, my, mz = _cross(half * nx, half * ny, half * nz, -g * ux, -g * uy, -g * uz)
+    return fx, fy, fz, mx, my, mz, p_diss
+
+
+@numba.njit(cache=True)
+def spatial_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
+    z = int(p[P.P_Z])
+    b = 5 * z + 6
+    d, m, inertia, m_ring, g = p[P.P_D], p[P.P_M], p[P.P_I], p[P.P_MR], p[P.P_G]
+    grav = g if p[P.P_F_GRAV] > 0.5 else 0.0
+    ramp = p[P.P_RAMP]
+    w_i = p[P.P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
+    rot = _tilt(p)
+    trig = aux.shape[0] - 2 * z  # scratch: cos and sin of every ball's angle, once per call
+    for i in range(dydt.shape[0]):
+        dydt[i] = 0.0
+    for j in range(z):
+        aux[trig + j] = math.cos(y[z + j])
+        aux[trig + z + j] = math.sin(y[z + j])
+    # accumulators: force (x in the axial slot, y and z in the planar acceleration slots), moments in spin slots
+    for j in range(z):
+        dydt[3 * z + j] = -m * grav
+    rfx, rfy, rfz = p[P_FA], 0.0, -p[P.P_FR] - m_ring * grav
+    power_in = power = 0.0
+    if p[P.P_F_RACE] > 0.5:
+        for j in range(z):
+            for inner in (False, True):
+                fx, fy, fz, mx, my, mz, pin, pd, _ = _race(y, p, j, z, inner, w_i, rot, aux[trig + j], aux[trig + z + j])
+                dydt[b + z + j] += fx
+                dydt[2 * z + j] += fy
+                dydt[3 * z + j] += fz
+                dydt[4 * z + j] += mx
+                dydt[b + 2 * z + j] += my
+                dydt[b + 3 * z + j] += mz
+                if inner:
+                    rfx, rfy, rfz = rfx - fx, rfy - fy, rfz - fz
+                power_in += pin
+                power += pd
+    if p[P.P_F_BB] > 0.5:
+        for j in range(z):
+            k = j + 1 if j + 1 < z else 0
+            fx, fy, fz, mx, my, mz, pd = _pair(y, p, aux, j, k, z, aux[trig + j], aux[trig + z + j], aux[trig + k],
+                                               aux[trig + z + k])
+            dydt[b + z + j] -= fx
+            dydt[2 * z + j] -= fy
+            dydt[3 * z + j] -= fz
+            dydt[b + z + k] += fx
+            dydt[2 * z + k] += fy
+            dydt[3 * z + k] += fz
+            for o, mo in ((4 * z, mx), (b + 2 * z, my), (b + 3 * z, mz)):
+                dydt[o + j] += mo
+                dydt[o + k] += mo
+            power += pd
+    drag = 0.5 * p[P.P_CD] * p[P.P_RHO_MIX] * 0.25 * np.pi * d * d if p[P.P_F_DRAG] > 0.5 else 0.0
+    for j in range(z):
+        r, rd, thd = y[j], y[2 * z + j], y[3 * z + j]
+        c, s = aux[trig + j], aux[trig + z + j]
+        fy, fz = dydt[2 * z + j], dydt[3 * z + j]
+        f_rad, f_tan = fy * c + fz * s, -fy * s + fz * c
+        if drag > 0.0:
+            v = r * thd
+            f_tan -= drag * v * abs(v)
+            power += drag * v * v * abs(v)
+        dydt[j], dydt[z + j] = rd, thd
+        dydt[2 * z + j] = f_rad / m + r * thd * thd
+        dydt[3 * z + j] = (f_tan / m - 2.0 * rd * thd) / r
+        dydt[b + j] = y[b + z + j]
+        dydt[b + z + j] /= m
+        for o in (4 * z, b + 2 * z, b + 3 * z):
+            dydt[o + j] /= inertia
+    dydt[5 * z], dydt[5 * z + 1] = y[5 * z + 2], y[5 * z + 3]
+    dydt[5 * z + 2], dydt[5 * z + 3] = rfy / m_ring, rfz / m_ring
+    dydt[5 * z + 4], dydt[5 * z + 5] = power_in, power
+    dydt[b + 4 * z], dydt[b + 4 * z + 1] = y[b + 4 * z + 1], rfx / m_ring
+
+
+@numba.njit(cache=True)
+def spatial_signature(y, p):  # pragma: no cover - compiled
+    """Which contacts are closed, as a number (see :func:`simulation.models.planar.planar_signature`)."""
+    z = int(p[P.P_Z])
+    b = 5 * z + 6
+    rot = _tilt(p)
+    sig = 0.0
+    for j in range(z):
+        c, s = math.cos(y[z + j]), math.sin(y[z + j])
+        for idx, inner in ((0, False), (1, True)):
+            if _race(y, p, j, z, inner, 0.0, rot, c, s)[8] > 0.0:
+                sig += 1.0 + idx * z + j
+        k = j + 1 if j + 1 < z else 0
+        dx = y[b + k] - y[b + j]
+        dy = y[k] * math.cos(y[z + k]) - y[j] * math.cos(y[z + j])
+        dz = y[k] * math.sin(y[z + k]) - y[j] * math.sin(y[z + j])
+        if p[P.P_D] ** 2 - (dx * dx + dy * dy + dz * dz) > 0.0:
+            sig += 1.0 + 2 * z + j
+    return sig * (sig + 1.0)
+
+
+def spatial_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLike, ring0: tuple[float, float],
+                    radial_load_n: float, axial_load_n: float = 0.0, misalignment_rad: tuple[float, float] = (0.0, 0.0),
+                    strips: int = 5, axial0: npt.ArrayLike | None = None, ring_axial0: float = 0.0,
+                    **kw: object) -> Problem:
+    """The spatial model from a given state; keyword arguments as :func:`~simulation.models.planar.planar_problem`.
+
+    ``strips`` is the number m of strips across each race contact ellipse (an accuracy knob; 1 is a
+    point contact). ``misalignment_rad`` tilts the inner ring about y and z.
+    """
+    if not (isinstance(strips, int) and 1 <= strips <= 101):
+        raise P.ParameterError("strips", "must be a whole number in 1..101", strips)
+    flat = P.planar_problem(bearing, theta0, radius0, ring0, radial_load_n, **kw)  # type: ignore[arg-type]
+    g = bearing.geometry
+    z = g.n_balls
+    lay = SpatialLayout(z)
+    sl = lay.slices()
+    y0 = np.zeros(lay.size)
+    y0[: 5 * z + 6] = flat.y0
+    if axial0 is not None:
+        y0[sl["axial"]] = axial0
+    y0[sl["ring_axial"]] = (ring_axial0, 0.0)
+    atol = np.empty(lay.size)
+    atol[: 5 * z + 6] = flat.atol
+    scale = flat.atol[0] / 1e-10
+    atol[sl["axial"]] = 1e-10 * scale
+    atol[sl["axial_dot"]] = 1e-7 * scale
+    atol[sl["spin_y"]] = atol[sl["spin_z"]] = flat.atol[4 * z]
+    atol[sl["ring_axial"]] = (1e-10 * scale, 1e-7 * scale)
+    p = np.zeros(N_PARAMS)
+    p[: P.N_PARAMS] = flat.params
+    eta = compliance(bearing.material)
+    rc = race_curvatures(g)
+    p[P_RGI] = g.inner_curvature_factor * g.ball_diameter_m
+    p[P_RGO] = g.outer_curvature_factor * g.ball_diameter_m
+    p[P_FA], (p[P_TILT_Y], p[P_TILT_Z]), p[P_STRIPS] = axial_load_n, misalignment_rad, strips
+    p[P_AI] = hertz_contact(*rc["inner"], eta).a_coeff
+    p[P_AO] = hertz_contact(*rc["outer"], eta).a_coeff
+    return Problem(model_id=MODEL_ID, params=p, aux=flat.aux, y0=y0, t0=0.0, atol=atol,
+                   name="spatial cageless bearing", onset_step=flat.onset_step)
+
+
+def race_geometry(problem: Problem, y: npt.NDArray[np.float64]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """(overlap in m, contact angle in rad) of the inner and outer race contacts along samples y (T, n).
+
+    The contact angle is atan(axial / radial component of the normal). The ring's prescribed tilt is
+    left out here (it is below a milliradian in practice); the dynamics include it.
+    """
+    p = problem.params
+    z = int(p[P.P_Z])
+    b = 5 * z + 6
+    r, th, ax = y[:, :z], y[:, z:2 * z], y[:, b:b + z]
+    half = 0.5 * p[P.P_D]
+    out = {}
+    for race, rho, rg, c_ax, cy, cz in (
+            ("outer", 0.5 * p[P.P_DO] - p[P_RGO], p[P_RGO], 0.0, 0.0, 0.0),
+            ("inner", 0.5 * p[P.P_DI] + p[P_RGI], p[P_RGI], y[:, b + 4 * z][:, None], y[:, 5 * z][:, None],
+             y[:, 5 * z + 1][:, None])):
+        er = np.hypot(r * np.cos(th) - cy, r * np.sin(th) - cz) - rho
+        ex = ax - c_ax
+        out[race] = (np.clip(np.hypot(ex, er) - (rg - half), 0.0, None), np.arctan2(ex, np.abs(er)))
+    return out
+
+
+def spatial_energy(problem: Problem, y: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    """Total mechanical energy (J) along samples y (T, n): kinetic (translation and spin), Hertz, gravity and
+    load potentials. With the dissipated energy added and the drive's input work taken away it is conserved
+    (the ring's prescribed tilt is left out of the Hertz part, as in :func:`race_geometry`)."""
+    p = problem.params
+    z = int(p[P.P_Z])
+    b = 5 * z + 6
+    m, m_ring, g, d = p[P.P_M], p[P.P_MR], p[P.P_G] * (p[P.P_F_GRAV] > 0.5), p[P.P_D]
+    r, th, rd, thd = y[:, :z], y[:, z:2 * z], y[:, 2 * z:3 * z], y[:, 3 * z:4 * z]
+    ax, axd = y[:, b:b + z], y[:, b + z:b + 2 * z]
+    spin2 = y[:, 4 * z:5 * z] ** 2 + y[:, b + 2 * z:b + 3 * z] ** 2 + y[:, b + 3 * z:b + 4 * z] ** 2
+    cvy, cvz, cvx = y[:, 5 * z + 2], y[:, 5 * z + 3], y[:, b + 4 * z + 1]
+    ke = (0.5 * m * np.sum(rd**2 + (r * thd) ** 2 + axd**2, axis=1) + 0.5 * p[P.P_I] * np.sum(spin2, axis=1)
+          + 0.5 * m_ring * (cvx**2 + cvy**2 + cvz**2))
+    pe = m * g * np.sum(r * np.sin(th), axis=1) + (m_ring * g + p[P.P_FR]) * y[:, 5 * z + 1] - p[P_FA] * y[:, b + 4 * z]
+    if p[P.P_F_RACE] > 0.5:
+        for race, (overlap, _) in race_geometry(problem, y).items():
+            pe += 0.4 * (p[P.P_KI] if race == "inner" else p[P.P_KO]) * np.sum(overlap**2.5, axis=1)
+    if p[P.P_F_BB] > 0.5:
+        x, zz = r * np.cos(th), r * np.sin(th)
+        gap = np.sqrt((np.roll(x, -1, axis=1) - x) ** 2 + (np.roll(zz, -1, axis=1) - zz) ** 2
+                      + (np.roll(ax, -1, axis=1) - ax) ** 2)
+        pe += 0.4 * p[P.P_KB] * np.sum(np.clip(d - gap, 0, None) ** 2.5, axis=1)
+    return ke + pe
