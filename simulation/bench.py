@@ -32,12 +32,14 @@ from cageless.kinematics import theoretical_cage_speed
 from simulation.effects import choose_model
 from simulation.models.planar_reference import reference_rhs
 from simulation.problem import Problem
-from simulation.run import initial_state
 from simulation.models import planar as P
+
+from simulation.parameters import ModelParameters
+from simulation.run import build_problem
 from simulation.scene import Scene
 from simulation.solve import solve, step_scipy
 
-__all__ = ["accuracy_study", "format_accuracy", "plot_accuracy"]
+__all__ = ["accuracy_study", "format_accuracy", "plot_accuracy", "model_study", "format_models"]
 
 CANDIDATES: tuple[tuple[str, float], ...] = (
     ("dp5", 1e-4), ("dp5", 1e-5), ("dp5", 1e-6), ("dp5", 1e-7), ("dp5", 1e-8),
@@ -45,12 +47,10 @@ CANDIDATES: tuple[tuple[str, float], ...] = (
 )
 
 
-def _settled_problem(rpm: float, load_n: float, settle_s: float) -> tuple[Problem, float]:
-    scene = Scene(conditions=OperatingConditions(rpm, load_n))
-    choice = choose_model(scene)
-    theta, radius, ring = initial_state(scene)
-    pr = P.planar_problem(scene.bearing, theta, radius, ring, load_n, inner_speed_rad_s=scene.conditions.speed_rad_s,
-                          effects={e.name: e.on for e in choice.effects})
+def _settled_problem(rpm: float, load_n: float, settle_s: float, axial_n: float = 0.0, level: str | None = None,
+                     strips: int = 5) -> tuple[Problem, float]:
+    scene = Scene(conditions=OperatingConditions(rpm, load_n, axial_n))
+    pr = build_problem(scene, choose_model(scene, level=level), ModelParameters(strips=strips))
     sol = solve(pr, np.array([settle_s]), rtol=1e-8, max_step=1e-6)
     y0 = sol.y[-1].copy()
     y0[-2:] = 0.0  # restart the work and dissipation counters
@@ -136,3 +136,53 @@ def plot_accuracy(result: dict[str, Any], path: str) -> None:
         fig.tight_layout()
         fig.savefig(path, dpi=120)
         plt.close(fig)
+
+
+def model_study(window_s: float = 0.005, settle_s: float = 0.03) -> dict[str, Any]:
+    """What model fidelity costs: planar against spatial, and the strip count m of the spatial model.
+
+    * Pure radial load (3000 rpm, 500 N), where the planar model is exact: planar and spatial (m = 1, 5)
+      against a planar rtol 1e-10 reference.
+    * Combined load (3000 rpm, 500 N radial, 400 N axial), where only the spatial model applies: m = 1, 5,
+      11, 21 against a spatial m = 21, rtol 1e-9 reference.
+
+    All at rtol 1e-6 from the same settled state; wall seconds per simulated second and the ratio to the
+    planar run measured in the same process.
+    """
+    t = np.linspace(0.0, window_s, 51)
+    rows = []
+    for scene_name, axial, level, ref_strips, cases in (
+            ("pure radial", 0.0, "planar", 1, (("planar", 1), ("spatial", 1), ("spatial", 5))),
+            ("500 N + 400 N axial", 400.0, "spatial", 21, (("spatial", 1), ("spatial", 5), ("spatial", 11),
+                                                           ("spatial", 21)))):
+        base, cage = _settled_problem(3000.0, 500.0, settle_s, axial, level, ref_strips)
+        ref = solve(base, t, rtol=1e-9 if axial else 1e-10, max_step=5e-7)
+        scene = Scene(conditions=OperatingConditions(3000.0, 500.0, axial))
+        for lvl, m in cases:
+            pr = build_problem(scene, choose_model(scene, level=lvl, force=True), ModelParameters(strips=m))
+            n = len(pr.y0)  # the planar state is the first 5 Z + 6 entries of the spatial one
+            y0 = np.concatenate([base.y0, np.zeros(max(0, n - len(base.y0)))])[:n]
+            pr = replace(pr, y0=y0, aux=base.aux.copy())
+            sol = solve(pr, t, rtol=1e-6, max_step=2e-6)
+            z = int(pr.params[P.P_Z])
+            slip_pp, pos_um = _errors(sol.y[:, :5 * z + 6], ref.y[:, :5 * z + 6], z, cage, float(np.mean(pr.y0[:z])))
+            rows.append({"scene": scene_name, "model": lvl if lvl == "planar" else f"spatial, m = {m}",
+                         "wall_s_per_sim_s": sol.wall_s / window_s, "slip_error_pp": slip_pp,
+                         "position_error_um": pos_um, "ok": sol.success})
+    base_time = rows[0]["wall_s_per_sim_s"]
+    for r in rows:
+        r["time_ratio"] = r["wall_s_per_sim_s"] / base_time
+    return {"window_s": window_s, "settle_s": settle_s, "rows": rows}
+
+
+def format_models(result: dict[str, Any]) -> str:
+    """The model-fidelity study as a Markdown table."""
+    lines = [f"Model fidelity against cost, 3000 rpm, {1e3 * result['window_s']:g} ms window after "
+             f"{1e3 * result['settle_s']:g} ms, rtol 1e-6", "",
+             "| scene | model | wall s / sim s | x planar | slip error (pp) | position error (um) |",
+             "|---|---|---|---|---|---|"]
+    for r in result["rows"]:
+        flag = "" if r["ok"] else " (failed)"
+        lines.append(f"| {r['scene']} | {r['model']}{flag} | {r['wall_s_per_sim_s']:.1f} | {r['time_ratio']:.2f} | "
+                     f"{r['slip_error_pp']:.3g} | {r['position_error_um']:.3g} |")
+    return "\n".join(lines)

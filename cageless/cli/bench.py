@@ -23,7 +23,8 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
         "bench", parents=[parent], help="accuracy-versus-time studies (tables)",
         description="Measure what accuracy costs in time. 'tracking': end-to-end frames/s on full-size "
         "footage, detector and smoothing-window trade-offs, trackpy on the same frames, peak memory. "
-        "'accuracy': the simulator's work-precision table (solvers x tolerances against a tight reference).",
+        "'accuracy': the simulator's work-precision table (solvers x tolerances against a tight reference) "
+        "and what model fidelity costs (planar against spatial, strip counts).",
         epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("study", choices=("tracking", "accuracy"), help="which study to run")
@@ -38,10 +39,14 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Run the study and print its tables."""
     if args.study == "accuracy":
-        from simulation.bench import accuracy_study, format_accuracy, plot_accuracy
+        from simulation.bench import accuracy_study, format_accuracy, format_models, model_study, plot_accuracy
 
         result = accuracy_study(window_s=args.window)
         print(format_accuracy(result))
+        models = model_study(window_s=args.window)
+        print()
+        print(format_models(models))
+        result["models"] = models
         if args.plot:
             plot_accuracy(result, args.plot)
     else:

@@ -16,3 +16,16 @@ def test_accuracy_study_table_and_plot(tmp_path):
     assert "| dp5 (compiled RHS) | 1e-06 |" in text and "LSODA (numpy RHS)" in text
     plot_accuracy(result, str(tmp_path / "wp.png"))
     assert (tmp_path / "wp.png").stat().st_size > 1000
+
+
+def test_model_fidelity_study_table():
+    from simulation.bench import format_models, model_study
+
+    result = model_study(window_s=0.001, settle_s=0.01)
+    rows = result["rows"]
+    assert [r["model"] for r in rows] == ["planar", "spatial, m = 1", "spatial, m = 5", "spatial, m = 1",
+                                          "spatial, m = 5", "spatial, m = 11", "spatial, m = 21"]
+    assert all(r["ok"] for r in rows)
+    # under pure radial load the spatial model is the planar one: same answer whatever m
+    assert all(r["slip_error_pp"] < 0.05 for r in rows[:3])
+    assert "| 500 N + 400 N axial | spatial, m = 21 |" in format_models(result)
