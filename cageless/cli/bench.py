@@ -14,6 +14,7 @@ examples:
   cageless bench tracking                       render 2400 full-size frames once, then measure
   cageless bench tracking --frames 600 --json bench.json
   cageless bench accuracy --plot work_precision.png   simulator: error against wall time per solver/tolerance
+  cageless bench effects --speed-rpm 1800                each optional effect removed in turn: change and saving
 """
 
 
@@ -24,10 +25,14 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
         description="Measure what accuracy costs in time. 'tracking': end-to-end frames/s on full-size "
         "footage, detector and smoothing-window trade-offs, trackpy on the same frames, peak memory. "
         "'accuracy': the simulator's work-precision table (solvers x tolerances against a tight reference) "
-        "and what model fidelity costs (planar against spatial, strip counts).",
+        "and what model fidelity costs (planar against spatial, strip counts). 'effects': each optional effect "
+        "removed in turn, with the change in slip and the time saved.",
         epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("study", choices=("tracking", "accuracy"), help="which study to run")
+    p.add_argument("study", choices=("tracking", "accuracy", "effects"), help="which study to run")
+    p.add_argument("--speed-rpm", type=float, default=1800.0, help="effects: scene speed (default 1800)")
+    p.add_argument("--radial-load-n", type=float, default=500.0, help="effects: radial load (default 500 N)")
+    p.add_argument("--axial-load-n", type=float, default=0.0, help="effects: axial load (default 0 N)")
     p.add_argument("--window", type=float, default=0.005, help="accuracy: simulated window (s, default 0.005)")
     p.add_argument("--plot", help="accuracy: write the work-precision diagram to this image")
     p.add_argument("--dir", default="bench_footage", help="where rendered footage is kept (default ./bench_footage)")
@@ -38,7 +43,12 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Run the study and print its tables."""
-    if args.study == "accuracy":
+    if args.study == "effects":
+        from simulation.bench import effects_study, format_effects
+
+        result = effects_study(args.speed_rpm, args.radial_load_n, args.axial_load_n)
+        print(format_effects(result))
+    elif args.study == "accuracy":
         from simulation.bench import accuracy_study, format_accuracy, format_models, model_study, plot_accuracy
 
         result = accuracy_study(window_s=args.window)

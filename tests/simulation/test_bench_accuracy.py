@@ -29,3 +29,15 @@ def test_model_fidelity_study_table():
     # under pure radial load the spatial model is the planar one: same answer whatever m
     assert all(r["slip_error_pp"] < 0.05 for r in rows[:3])
     assert "| 500 N + 400 N axial | spatial, m = 21 |" in format_models(result)
+
+
+def test_effects_ablation_table():
+    from simulation.bench import OPTIONAL_EFFECTS, effects_study, format_effects
+
+    result = effects_study(rpm=6000.0, duration_s=0.02, settle_s=0.01)
+    rows = {r["removed"]: r for r in result["rows"]}
+    assert set(rows) == {"(none: full model)", *OPTIONAL_EFFECTS}
+    assert rows["drag"].get("note") == "off for this scene"  # no oil-air mixture in this scene
+    assert rows["race_traction"]["peak_slip_pct"] > 50  # nothing drives the balls without traction
+    assert rows["ehl_film"]["profile_change_pp"] == 0.0  # the film is an output here, not a force
+    assert "| lubricant_damping |" in format_effects(result)
