@@ -116,3 +116,20 @@ def test_contact_angle_swing_shrinks_with_axial_load():
         angle = np.abs(c["inner_angle"][late])[c["inner_normal"][late] > 1.0]
         swing[fa] = angle.max() - angle.min()
     assert swing[500.0] < 0.9 * swing[300.0]
+
+
+@pytest.mark.parametrize("loads,extra", [
+    ((3000.0, 0.0, 500.0), {}),  # axial load only
+    ((3000.0, 500.0, 2000.0), {}),  # a large axial load
+    ((3000.0, 500.0, 0.0), {"misalignment_rad": 1e-3}),  # a 1 mrad tilted ring
+], ids=["axial-only", "2000N-axial", "1mrad-tilt"])
+def test_spatial_hard_cases_stay_finite(loads, extra):
+    scene = Scene(conditions=OperatingConditions(*loads), duration_s=0.02, **extra)
+    choice = choose_model(scene)
+    assert choice.level == "spatial"
+    res = simulate(scene, choice, progress=False)
+    assert res.solution.success and np.all(np.isfinite(res.trace.slip))
+    assert res.solution.n_rejected < 0.1 * res.solution.n_steps
+    k = res.problem.params
+    c = res.trace.groups["contacts"]
+    assert (np.nanmax(c["inner_normal"]) / k[P.P_KI]) ** (2 / 3) < 0.005 * k[P.P_D]  # overlap below 0.5 % of D
