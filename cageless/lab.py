@@ -3,8 +3,9 @@
 1. Discover the videos and their conditions.
 2. Track each video (``OUT/traces/<video>.trace.h5`` and ``OUT/traces/qc/``).
 3. Simulate the matching scene once per distinct condition (``OUT/simulations/``). The simulated time
-   is the start-up that the comparison leaves out plus the longest video of the condition, and at
-   least one cage revolution, unless ``duration_s`` is given.
+   is the start-up that the comparison leaves out (three cage revolutions, at least 40 ms, unless
+   ``settle_s`` is given) plus the longest video of the condition and at least one cage revolution,
+   unless ``duration_s`` is given.
 4. Compare each video with its condition's simulation.
 5. Write ``OUT/report.html`` and ``OUT/slip_table.{csv,md,tex,html}``.
 
@@ -37,7 +38,7 @@ from cageless.atomic import atomic_write_text
 from cageless.bearing import Bearing, default_bearing
 from cageless.conditions import LabEntry, OperatingConditions, discover_lab
 from cageless.errors import CagelessError
-from cageless.kinematics import theoretical_cage_speed
+from cageless.kinematics import startup_duration, theoretical_cage_speed
 from cageless.provenance import sha256_file
 from cageless.trace import read_trace
 
@@ -51,7 +52,7 @@ class LabOptions:
     """Choices of a lab run (the resolved configuration of the report)."""
 
     duration_s: float | None = None
-    settle_s: float = 0.04
+    settle_s: float | None = None
     bin_deg: float = 1.0
     rtol: float = 1e-6
     workers: int = 2
@@ -164,12 +165,19 @@ def _sim_name(key: tuple[float, float, float]) -> str:
     return f"n{key[0]:g}_Fr{key[1]:g}_Fa{key[2]:g}.sim.trace.h5"
 
 
+def _settle(speed_rpm: float, bearing: Bearing, options: LabOptions) -> float:
+    g = bearing.geometry
+    return options.settle_s if options.settle_s is not None else startup_duration(
+        speed_rpm, g.ball_diameter_m, g.pitch_diameter_m)
+
+
 def _duration(key: tuple[float, float, float], video_s: Iterable[float], bearing: Bearing,
               options: LabOptions) -> float:
+    settle = _settle(key[0], bearing, options)
     if options.duration_s is not None:
-        return options.settle_s + options.duration_s
+        return settle + options.duration_s
     cage = theoretical_cage_speed(bearing.geometry, key[0] * math.pi / 30.0)
-    return options.settle_s + max([*video_s, 2 * math.pi / cage])
+    return settle + max([*video_s, 2 * math.pi / cage])
 
 
 def run_lab(folder: str | Path, out: str | Path, options: LabOptions | None = None, bearing: Bearing | None = None,
@@ -215,7 +223,8 @@ def run_lab(folder: str | Path, out: str | Path, options: LabOptions | None = No
             continue
         try:
             measured, simulated = read_trace(tr), read_trace(sim)
-            c = compare(measured, simulated, options.bin_deg, options.settle_s, options.force, label=e.video.name)
+            settle = _settle(e.resolved.conditions.speed_rpm, bearing, options)
+            c = compare(measured, simulated, options.bin_deg, settle, options.force, label=e.video.name)
             descriptions.append(describe_condition(e.video.name, c, measured, simulated))
         except CagelessError as exc:
             failed.append(_failed_row(e.video.name, e.resolved.conditions, str(exc)))

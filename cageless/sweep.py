@@ -84,26 +84,31 @@ def _run_point(point: dict[str, Any], base: dict[str, Any]) -> dict[str, Any]:
     from simulation.run import peak_unloaded_slip, simulate
     from simulation.scene import Scene
 
+    from cageless.kinematics import startup_duration
+
     scene_kw = {n: point.get(n, base[n]) for n in SCENE_NAMES}
     model = {k: v for k, v in point.items() if k not in SCENE_NAMES and "." not in k and k != "seed"}
     dotted = {k: v for k, v in point.items() if "." in k}
     try:
         bearing = Bearing.from_dict(base["bearing"]).with_overrides(dotted)
+        g = bearing.geometry
+        settle = base["settle_s"] if base["settle_s"] is not None else startup_duration(
+            scene_kw["speed_rpm"], g.ball_diameter_m, g.pitch_diameter_m)
         scene = Scene(conditions=OperatingConditions(**scene_kw), bearing=bearing,
-                      duration_s=base["settle_s"] + base["duration_s"], seed=int(point["seed"]))
+                      duration_s=settle + base["duration_s"], seed=int(point["seed"]))
         res = simulate(scene, choose_model(scene),
                        parameters=ModelParameters().with_overrides({**base["parameters"], **model}),
                        progress=False, config={"command": "sweep"})
     except CagelessError as exc:
         return {**point, "peak_slip_pct": float("nan"), "status": "failed", "message": str(exc), "wall_s": 0.0}
     ok = res.solution.success
-    peak = peak_unloaded_slip(res.trace, settle_s=base["settle_s"]) if ok else float("nan")
+    peak = peak_unloaded_slip(res.trace, settle_s=settle) if ok else float("nan")
     return {**point, "peak_slip_pct": 100 * peak, "status": "ok" if ok else "failed",
             "message": "" if ok else res.trace.status, "wall_s": res.trace.simulation.wall_s}
 
 
 def run_sweep(vary: Mapping[str, Sequence[float]], seeds: int, speed_rpm: float, radial_load_n: float = 0.0,
-              axial_load_n: float = 0.0, duration_s: float = 0.1, settle_s: float = 0.04,
+              axial_load_n: float = 0.0, duration_s: float = 0.1, settle_s: float | None = None,
               parameters: Mapping[str, float] | None = None, bearing: Bearing | None = None, workers: int = 2,
               scheduler: str | None = None, progress: bool = True) -> pd.DataFrame:
     """Run the grid and return one row per run (the varied values, seed, peak slip in %, status)."""

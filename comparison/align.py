@@ -20,18 +20,21 @@ import numpy.typing as npt
 import pandas as pd
 
 from cageless.errors import CagelessError, ParameterError
+from cageless.kinematics import startup_duration
 from cageless.profiles import angle_profile
 from cageless.trace import Trace
 
 __all__ = ["Profiles", "profiles", "TimeAlignment", "align_time", "check_compatible", "MismatchError",
-           "DEFAULT_SETTLE_S"]
-
-#: Simulated time left out of the simulation's profiles: the start from rest and the spreading of the
-#: packed balls (DESIGN §6 "Start").
-DEFAULT_SETTLE_S = 0.04
+           "simulation_settle_s"]
 
 _CONDITIONS = (("speed_rpm", "rpm"), ("radial_load_n", "N"), ("axial_load_n", "N"))
 _GEOMETRY = (("n_balls", ""), ("ball_diameter_m", "m"), ("pitch_diameter_m", "m"))
+
+
+def simulation_settle_s(trace: Trace) -> float:
+    """The start-up a simulation trace's profiles leave out: three cage revolutions, at least 40 ms
+    (:func:`cageless.kinematics.startup_duration`; the packed start takes that long to be forgotten)."""
+    return startup_duration(trace.speed_rpm, trace.ball_diameter_m, trace.pitch_diameter_m)
 
 
 class MismatchError(CagelessError):

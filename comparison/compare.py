@@ -6,7 +6,7 @@ from dataclasses import asdict, dataclass, field
 from typing import Any
 
 from cageless.trace import Trace
-from comparison.align import DEFAULT_SETTLE_S, MismatchError, Profiles, check_compatible, profiles
+from comparison.align import MismatchError, Profiles, check_compatible, profiles, simulation_settle_s
 from comparison.metrics import profile_errors, unloaded_peak
 
 __all__ = ["ComparisonRow", "Comparison", "compare"]
@@ -41,12 +41,15 @@ class Comparison:
     measured: Profiles
     simulated: Profiles
     mismatches: list[str] = field(default_factory=list)
-    settle_s: float = DEFAULT_SETTLE_S
+    settle_s: float = 0.0
 
 
-def compare(measured: Trace, simulated: Trace, bin_deg: float = 1.0, settle_s: float = DEFAULT_SETTLE_S,
+def compare(measured: Trace, simulated: Trace, bin_deg: float = 1.0, settle_s: float | None = None,
             force: bool = False, label: str = "") -> Comparison:
     """Align the traces and compute the row.
+
+    ``settle_s`` is the simulated start-up left out of the simulation's profiles; by default three cage
+    revolutions (:func:`~comparison.align.simulation_settle_s`).
 
     Raises
     ------
@@ -58,6 +61,8 @@ def compare(measured: Trace, simulated: Trace, bin_deg: float = 1.0, settle_s: f
         raise MismatchError("the traces differ: " + "; ".join(mismatches)
                             + ". Compare traces of the same condition, or pass --force to compare anyway "
                             "(the report then shows the mismatch).")
+    if settle_s is None:
+        settle_s = simulation_settle_s(simulated)
     pm = profiles(measured, bin_deg)
     ps = profiles(simulated, bin_deg, settle_s=settle_s)
     err = profile_errors(pm.slip["mean"].to_numpy(), ps.slip["mean"].to_numpy())

@@ -193,8 +193,11 @@ OPTIONAL_EFFECTS = ("lubricant_damping", "race_traction", "ehl_film", "ball_ball
 
 
 def effects_study(rpm: float = 1800.0, radial_load_n: float = 500.0, axial_load_n: float = 0.0,
-                  duration_s: float = 0.15, settle_s: float = 0.04) -> dict[str, Any]:
+                  duration_s: float = 0.15, settle_s: float | None = None) -> dict[str, Any]:
     """Run a scene with every optional effect, then with each one that is on removed in turn.
+
+    Each run lasts ``settle_s`` (default: the start-up of :func:`cageless.kinematics.startup_duration`)
+    plus ``duration_s``, and its statistics come from the part after the start-up.
 
     Each row gives the peak slip in the unloaded zone and how far the slip profile moved (RMS over the
     1-degree bins, percentage points) against the full model, with the wall time and its saving. An effect
@@ -203,7 +206,12 @@ def effects_study(rpm: float = 1800.0, radial_load_n: float = 500.0, axial_load_
     from cageless.profiles import angle_profile
     from simulation.run import peak_unloaded_slip, simulate
 
-    scene = Scene(conditions=OperatingConditions(rpm, radial_load_n, axial_load_n), duration_s=duration_s)
+    from cageless.bearing import default_bearing
+    from cageless.kinematics import startup_duration
+
+    g = default_bearing().geometry
+    settle_s = startup_duration(rpm, g.ball_diameter_m, g.pitch_diameter_m) if settle_s is None else settle_s
+    scene = Scene(conditions=OperatingConditions(rpm, radial_load_n, axial_load_n), duration_s=settle_s + duration_s)
     full = choose_model(scene)
 
     def run(choice: Any) -> tuple[Any, float]:

@@ -28,8 +28,9 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("video_trace", help="trace of a video (source = video)")
     p.add_argument("sim_trace", help="trace of a simulation (source = simulation)")
     p.add_argument("--bin-deg", type=finite_float, default=1.0, help="angle bin width (deg, default 1)")
-    p.add_argument("--settle", type=finite_float, default=0.04,
-                   help="simulated start-up left out of the simulation's profile (s, default 0.04)")
+    p.add_argument("--settle", type=finite_float,
+                   help="simulated start-up left out of the simulation's profile (s; default three cage "
+                   "revolutions, at least 0.04)")
     p.add_argument("--force", action="store_true", help="compare traces of different conditions or bearings")
     p.add_argument("--align-ball", type=int, help="also align this ball's speed in time (cross-correlation)")
     p.add_argument("--figures", help="write the speed, slip, contact and ring figures (SVG) to this folder")

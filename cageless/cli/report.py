@@ -31,8 +31,9 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--duration", type=finite_float,
                    help="simulated time after the start-up (s; default: the longest video, at least one cage "
                    "revolution)")
-    p.add_argument("--settle", type=finite_float, default=0.04,
-                   help="simulated start-up left out of the comparison (s, default 0.04)")
+    p.add_argument("--settle", type=finite_float,
+                   help="simulated start-up left out of the comparison (s; default three cage revolutions, "
+                   "at least 0.04)")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", dest="set_values",
                    help="change an open model parameter (see `cageless simulate --help`)")
     p.add_argument("--rtol", type=finite_float, default=1e-6, help="simulation tolerance (default 1e-6)")

@@ -132,7 +132,10 @@ def _summary_line(trace: Any, sol: Any, out: str) -> str:
     from simulation.run import peak_unloaded_slip
 
     ev = trace.events
-    settle = 0.2 * float(trace.time[-1])
+    from cageless.kinematics import startup_duration
+
+    settle = min(startup_duration(trace.speed_rpm, trace.ball_diameter_m, trace.pitch_diameter_m),
+                 0.5 * float(trace.time[-1]))
     return (f"{trace.status}: {sol.n_steps} steps, {sol.n_rejected} rejected ({sol.n_onset_retries} at contact "
             f"onsets; {sol.n_contact_changes} contact changes), {sol.n_rhs} RHS calls, "
             f"{trace.simulation.wall_s:.2f} s wall for {trace.time[-1]:g} s simulated; contact episodes "

@@ -33,7 +33,8 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
                    help="a parameter and its values: start:stop:count or v1,v2,... (repeatable)")
     p.add_argument("--seeds", type=int, default=1, help="seeds per grid point (default 1)")
     p.add_argument("--duration", type=finite_float, default=0.1, help="simulated time after the start-up (s)")
-    p.add_argument("--settle", type=finite_float, default=0.04, help="start-up left out (s, default 0.04)")
+    p.add_argument("--settle", type=finite_float,
+                   help="start-up left out (s; default three cage revolutions at each point, at least 0.04)")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", dest="set_values",
                    help="fixed model-parameter changes for every run")
     p.add_argument("--workers", type=int, default=2, help="local processes (default 2)")
