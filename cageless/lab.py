@@ -25,9 +25,8 @@ import json
 import math
 import time
 from collections.abc import Callable, Iterable
-from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures import Future
 from dataclasses import dataclass, field, replace
-from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
 
@@ -39,6 +38,7 @@ from cageless.bearing import Bearing, default_bearing
 from cageless.conditions import LabEntry, OperatingConditions, discover_lab
 from cageless.errors import CagelessError
 from cageless.kinematics import startup_duration, theoretical_cage_speed
+from cageless.parallel import job_pool
 from cageless.provenance import sha256_file
 from cageless.trace import read_trace
 
@@ -135,14 +135,6 @@ class _Cache:
 
 # -- executors ------------------------------------------------------------------------------------------
 
-def _executor(options: LabOptions) -> Any:
-    if options.scheduler:
-        from distributed import Client
-
-        return Client(options.scheduler)
-    return ProcessPoolExecutor(max_workers=max(1, options.workers), mp_context=get_context("spawn"))
-
-
 def _run_jobs(pool: Any, jobs: list[tuple[Callable[..., tuple[str, str]], tuple[Any, ...]]], desc: str,
               progress: bool) -> list[tuple[str, str]]:
     futures: list[Future[Any]] = [pool.submit(fn, *args) for fn, args in jobs]
@@ -199,7 +191,7 @@ def run_lab(folder: str | Path, out: str | Path, options: LabOptions | None = No
                             "folders) with their conditions (DESIGN §5).")
     failed: list[ComparisonRow] = [_failed_row(e.video.name, None, str(e.error)) for e in entries if not e.ok]
     good = [e for e in entries if e.ok]
-    with _executor(options) as pool:
+    with job_pool(options.workers, options.scheduler) as pool:
         t0 = time.perf_counter()
         traces, n_skip = _track_all(pool, good, bearing, out, cache, progress)
         skipped += n_skip

@@ -112,24 +112,14 @@ def run_sweep(vary: Mapping[str, Sequence[float]], seeds: int, speed_rpm: float,
               parameters: Mapping[str, float] | None = None, bearing: Bearing | None = None, workers: int = 2,
               scheduler: str | None = None, progress: bool = True) -> pd.DataFrame:
     """Run the grid and return one row per run (the varied values, seed, peak slip in %, status)."""
-    from concurrent.futures import ProcessPoolExecutor
-    from multiprocessing import get_context
-
-    from tqdm.auto import tqdm
+    from cageless.parallel import gather, job_pool
 
     base = {"speed_rpm": speed_rpm, "radial_load_n": radial_load_n, "axial_load_n": axial_load_n,
             "duration_s": duration_s, "settle_s": settle_s, "parameters": dict(parameters or {}),
             "bearing": (bearing or default_bearing()).to_dict()}
     points = sweep_grid(vary, seeds)
-    if scheduler:
-        from distributed import Client
-
-        pool: Any = Client(scheduler)
-    else:
-        pool = ProcessPoolExecutor(max_workers=max(1, workers), mp_context=get_context("spawn"))
-    with pool:
-        futures = [pool.submit(_run_point, p, base) for p in points]
-        rows = [f.result() for f in tqdm(futures, desc="sweep runs", disable=not progress, leave=False)]
+    with job_pool(workers, scheduler) as pool:
+        rows = gather([pool.submit(_run_point, p, base) for p in points], "sweep runs", progress)
     return pd.DataFrame(rows)
 
 

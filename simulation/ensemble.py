@@ -11,13 +11,10 @@ pool does not survive a fork).
 from __future__ import annotations
 
 import dataclasses
-from concurrent.futures import ProcessPoolExecutor
-from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
 
-from tqdm.auto import tqdm
-
+from cageless.parallel import gather, job_pool
 from simulation.effects import ModelChoice
 from simulation.scene import Scene
 
@@ -53,13 +50,6 @@ def run_ensemble(scene: Scene, choice: ModelChoice, n_seeds: int, out: str | Pat
     """
     scenes = [dataclasses.replace(scene, seed=k) for k in range(n_seeds)]
     paths = [str(Path(seed_path(out, k)).resolve()) for k in range(n_seeds)]
-    if scheduler:
-        from distributed import Client
-
-        pool: Any = Client(scheduler)
-    else:
-        pool = ProcessPoolExecutor(max_workers=max(1, min(workers, n_seeds)), mp_context=get_context("spawn"))
-    with pool:
-        futures = [pool.submit(_one, s, choice, p, kw) for s, p in zip(scenes, paths, strict=True)]
-        rows = [f.result() for f in tqdm(futures, desc="seeds", disable=not progress, leave=False)]
-    return rows
+    with job_pool(min(workers, n_seeds), scheduler) as pool:
+        return gather([pool.submit(_one, s, choice, p, kw) for s, p in zip(scenes, paths, strict=True)], "seeds",
+                      progress)

@@ -1,8 +1,8 @@
 """From a scene to a simulation trace: build the model, start it quasi-statically, solve, write.
 
 This release runs the planar and the spatial level with every effect of the
-table (:data:`IMPLEMENTED`); moment loads and a vertical shaft are refused
-before anything compiles. The run is split into chunks of simulated time for the progress bar; the
+table; moment loads and a vertical shaft are refused before anything compiles.
+The run is split into chunks of simulated time for the progress bar; the
 state and the contact bookkeeping carry over between chunks.
 """
 
@@ -36,16 +36,13 @@ from simulation.scene import Scene
 from simulation.problem import Problem
 from simulation.solve import Solution, solve
 
-__all__ = ["IMPLEMENTED", "SimulationResult", "build_problem", "check_supported", "initial_state", "simulate",
+__all__ = ["SimulationResult", "build_problem", "check_supported", "initial_state", "simulate",
            "peak_unloaded_slip",
            "UNLOADED_ZONE_DEG"]
 
 #: The unloaded zone: the upper half of the bearing, opposite the radial load (DESIGN §3, §9).
 UNLOADED_ZONE_DEG = (0.0, 180.0)
 
-#: Effects this release can evaluate (the planar core).
-IMPLEMENTED = frozenset({"race_contact", "lubricant_damping", "race_traction", "ehl_film", "ball_ball_contact",
-                         "ball_ball_film", "gravity", "drag"})
 
 
 @dataclass
@@ -70,18 +67,13 @@ def peak_unloaded_slip(trace: Trace, settle_s: float = 0.0, bin_deg: float = 1.0
     return float(zone.max()) if zone.notna().any() else float("nan")
 
 
-def check_supported(choice: ModelChoice, scene: Scene | None = None) -> None:
-    """Refuse, before any compile or solve, a model this release cannot run."""
-    if scene is not None and scene.moment_load_nm > 0:
+def check_supported(scene: Scene) -> None:
+    """Refuse, before any compile or solve, a scene this release cannot run."""
+    if scene.moment_load_nm > 0:
         raise UsageError("moment loads are not in this release: the spatial model prescribes the ring's tilt "
                          "(--misalignment-rad) instead of solving it. Set the moment load to 0.")
-    if scene is not None and scene.orientation != "horizontal":
+    if scene.orientation != "horizontal":
         raise UsageError("a vertical shaft is not in this release: gravity acts along -z (horizontal shaft).")
-    missing = [e for e in choice.active if e not in IMPLEMENTED]  # pragma: no cover - all planar effects exist
-    if missing:
-        flags = " ".join(f"--effect {e}=off" for e in missing)
-        raise UsageError(f"effects not in this release yet: {', '.join(missing)}. To run without them, add "
-                         f"{flags} --force (the trace records that they were forced off).")
 
 
 def initial_state(scene: Scene) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], tuple[float, float]]:
@@ -239,7 +231,7 @@ def simulate(scene: Scene, choice: ModelChoice, parameters: ModelParameters | No
     A solver failure does not raise: the result's ``solution.success`` is False and the trace's
     ``status`` says ``"incomplete: <why>"``; samples after the failure are NaN.
     """
-    check_supported(choice, scene)
+    check_supported(scene)
     par = parameters or ModelParameters()
     prov = Provenance.start(config={"scene": scene.to_dict(), "model": json.loads(choice.to_json()),
                                     "solver": {"method": method, "rtol": rtol, "max_step": max_step},

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import argparse
 import logging
-import multiprocessing
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -141,8 +139,9 @@ def _map(jobs: list[Any], workers: int, bar: Any) -> list[tuple[str, Any]]:
             out.append(_track_one(job))
             bar.update(1)
         return out
-    # spawn, not fork: numba's thread pool (parallel cine unpacking) does not survive a fork.
-    with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+    from cageless.parallel import job_pool
+
+    with job_pool(workers) as pool:
         out = []
         for res in pool.map(_track_one, jobs):
             out.append(res)
