@@ -32,6 +32,10 @@ class Problem:
     #: Steps longer than this (s) in which a contact opens or closes are rejected and retried shorter
     #: (0: no contact-onset control). See :func:`simulation.kernels.model_signature`.
     onset_step: float = 0.0
+    #: Per-component floor (units of dy/dt) of the force-jump test; > 0 marks the accelerations that are
+    #: checked (None: no force-jump control). The floor is the acceleration a 1 N force gives the body, so
+    #: changes of forces well below 1 N never count as jumps. See :func:`simulation.solve.solve`.
+    jump_floor: FloatArray | None = None
 
     def rhs(self, t: float, y: FloatArray, aux: FloatArray | None = None) -> FloatArray:
         """dy/dt at (t, y), evaluated by the compiled kernel (``aux`` defaults to a copy of the problem's)."""

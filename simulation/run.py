@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -34,7 +34,7 @@ from simulation.parameters import ModelParameters
 from simulation.quasistatic import radial_load_distribution
 from simulation.scene import Scene
 from simulation.problem import Problem
-from simulation.solve import Solution, solve
+from simulation.solve import FORCE_JUMP, Solution, solve
 
 __all__ = ["SimulationResult", "build_problem", "check_supported", "initial_state", "simulate",
            "peak_unloaded_slip",
@@ -193,20 +193,20 @@ def _films(scene: Scene, inner: np.ndarray, outer: np.ndarray, ur_i: np.ndarray,
 
 
 def _solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: str, max_step: float,
-                  chunks: int, progress: bool, max_steps: int) -> Solution:
+                  chunks: int, progress: bool, max_steps: int, force_jump: float) -> Solution:
     edges = np.unique(np.linspace(0, len(t) - 1, chunks + 1).astype(int))
-    ys, steps, rej, rhs, wall, onset, changes = [pr.y0[None, :]], 0, 0, 0, 0.0, 0, 0
+    ys, steps, rej, rhs, wall, onset, changes, jumps = [pr.y0[None, :]], 0, 0, 0, 0.0, 0, 0, 0
     y0, aux, t0 = pr.y0.copy(), pr.aux.copy(), float(t[0])
     sol = None
     with tqdm(total=float(t[-1] - t[0]), desc="simulated s", unit="s", disable=not progress, leave=False) as bar:
         for a, b in zip(edges[:-1], edges[1:], strict=True):
-            part = Problem(model_id=pr.model_id, params=pr.params, aux=aux, y0=y0, t0=t0, atol=pr.atol,
-                           name=pr.name, onset_step=pr.onset_step)
+            part = replace(pr, aux=aux, y0=y0, t0=t0)
             sol = solve(part, t[a + 1:b + 1], method=method, rtol=rtol, max_step=max_step,
-                        max_steps=max(1, max_steps - steps - rej))
+                        max_steps=max(1, max_steps - steps - rej), force_jump=force_jump)
             ys.append(sol.y)
             steps, rej, rhs, wall = steps + sol.n_steps, rej + sol.n_rejected, rhs + sol.n_rhs, wall + sol.wall_s
             onset, changes = onset + sol.n_onset_retries, changes + sol.n_contact_changes
+            jumps += sol.n_force_jump_retries
             bar.update(float(t[b] - t[a]))
             if not sol.success:
                 break
@@ -217,16 +217,17 @@ def _solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: 
     assert sol is not None
     return Solution(t=t, y=y, status=sol.status, message=sol.message, method=method, n_steps=steps,
                     n_rejected=rej, n_rhs=rhs, wall_s=wall, n_onset_retries=onset, n_contact_changes=changes,
-                    extra={"aux": aux})
+                    n_force_jump_retries=jumps, extra={"aux": aux})
 
 
 def simulate(scene: Scene, choice: ModelChoice, parameters: ModelParameters | None = None, rtol: float = 1e-6,
              sample_rate_hz: float = 10_000.0, method: str = "dp5", max_step: float = 2e-6,
              out: str | Path | None = None, progress: bool = True, config: dict[str, Any] | None = None,
-             max_steps: int = 50_000_000) -> SimulationResult:
+             max_steps: int = 50_000_000, force_jump: float = FORCE_JUMP) -> SimulationResult:
     """Run ``scene`` with the model ``choice`` and (with ``out``) write the trace atomically.
 
-    ``max_steps`` bounds the accepted plus rejected steps of the whole run.
+    ``max_steps`` bounds the accepted plus rejected steps of the whole run; ``force_jump`` is the
+    force-jump fraction of :func:`simulation.solve.solve`.
 
     A solver failure does not raise: the result's ``solution.success`` is False and the trace's
     ``status`` says ``"incomplete: <why>"``; samples after the failure are NaN.
@@ -234,16 +235,18 @@ def simulate(scene: Scene, choice: ModelChoice, parameters: ModelParameters | No
     check_supported(scene)
     par = parameters or ModelParameters()
     prov = Provenance.start(config={"scene": scene.to_dict(), "model": json.loads(choice.to_json()),
-                                    "solver": {"method": method, "rtol": rtol, "max_step": max_step},
+                                    "solver": {"method": method, "rtol": rtol, "max_step": max_step,
+                                               "force_jump": force_jump},
                                     "parameters": par.to_dict(), **(config or {})})
     pr = build_problem(scene, choice, par)
     t = np.arange(0.0, scene.duration_s + 0.5 / sample_rate_hz, 1.0 / sample_rate_hz)
     start = time.perf_counter()
-    sol = _solve_chunks(pr, t, rtol, method, max_step, min(50, len(t) - 1), progress, max_steps)
+    sol = _solve_chunks(pr, t, rtol, method, max_step, min(50, len(t) - 1), progress, max_steps, force_jump)
     wall = time.perf_counter() - start
     provenance = prov.finish().to_dict()
     provenance["solver_stats"] = {"n_steps": sol.n_steps, "n_rejected": sol.n_rejected, "n_rhs": sol.n_rhs,
                                   "n_onset_retries": sol.n_onset_retries, "n_contact_changes": sol.n_contact_changes,
+                                  "n_force_jump_retries": sol.n_force_jump_retries,
                                   "onset_step_s": pr.onset_step, "wall_s": wall}
     trace = _to_trace(scene, choice, pr, sol, rtol, wall, provenance)
     if out is not None:

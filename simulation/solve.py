@@ -3,10 +3,13 @@
 :func:`solve` runs a :class:`Problem` with the method named in :data:`METHODS`:
 
 * ``"dp5"``: Dormand-Prince 5(4) with its whole loop compiled (the default); it rejects and retries
-  any step longer than ``Problem.onset_step`` in which a contact opens or closes, and counts them;
+  any step longer than ``Problem.onset_step`` in which a contact opens or closes, or across which a
+  force jumps by more than the fraction ``force_jump`` (see :func:`solve`), and counts both;
 * ``"RK45"``, ``"DOP853"``, ``"LSODA"``, ``"BDF"``, ``"Radau"``: scipy's ``solve_ivp`` steppers on the
   same compiled right-hand side, as references, stepped here so the accepted-step bookkeeping
-  (contact episodes) runs after every step as it does in the compiled loop.
+  (contact episodes) runs after every step as it does in the compiled loop. scipy's steppers cannot
+  take a step back, so they have neither the onset nor the force-jump control: only their error
+  control and ``max_step`` resolve contacts.
 
 It returns a :class:`Solution` carrying the status, a message, and the solver
 statistics; a failure is a result with ``success = False``, never an exception.
@@ -28,10 +31,13 @@ from simulation.integrators.dp5 import STATUS_OK, dp5_integrate
 from simulation.kernels import model_post, model_rhs
 from simulation.problem import Problem
 
-__all__ = ["Problem", "Solution", "METHODS", "solve", "step_scipy"]
+__all__ = ["FORCE_JUMP", "Problem", "Solution", "METHODS", "solve", "step_scipy"]
 
 FloatArray = npt.NDArray[np.float64]
 _SCIPY = {"RK45": RK45, "DOP853": DOP853, "LSODA": LSODA, "BDF": BDF, "Radau": Radau}
+#: Default force-jump fraction (see :func:`solve`): a step across which a contact force more than
+#: doubles or halves (a change above half its larger value) is retried shorter.
+FORCE_JUMP = 0.5
 _MESSAGES = {0: "reached the end", 1: "too many steps", 2: "step size underflow", 3: "the state became non-finite"}
 
 
@@ -50,6 +56,7 @@ class Solution:
     wall_s: float = 0.0
     n_onset_retries: int = 0
     n_contact_changes: int = 0
+    n_force_jump_retries: int = 0
     extra: dict[str, Any] = field(default_factory=dict)
 
     @property
@@ -61,19 +68,20 @@ class Solution:
 def _compiled(name: str, integrate: Callable[..., int]) -> Callable[..., Solution]:
     """A registry entry for an integrator whose whole loop is compiled (same signature as dp5_integrate)."""
     def run(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float, first_step: float | None,
-            max_steps: int) -> Solution:
+            max_steps: int, force_jump: float) -> Solution:
         out = np.full((len(t_eval), len(pr.y0)), np.nan)
-        stats = np.zeros(6)
+        stats = np.zeros(7)
+        floor = np.zeros(len(pr.y0)) if pr.jump_floor is None else pr.jump_floor.astype(np.float64)
         aux = pr.aux.copy()
         h0 = first_step or min(max_step, 1e-3 * max(t_eval[-1] - pr.t0, 1e-12))
         t0 = time.perf_counter()
         status = integrate(pr.model_id, pr.params, aux, pr.y0.astype(np.float64), float(pr.t0), t_eval, float(rtol),
                            pr.atol.astype(np.float64), float(h0), float(max_step), int(max_steps), out, stats,
-                           float(pr.onset_step))
+                           float(pr.onset_step), floor, float(force_jump if pr.jump_floor is not None else 0.0))
         return Solution(t=t_eval, y=out, status=int(status), message=_MESSAGES[int(status)], method=name,
                         n_steps=int(stats[0]), n_rejected=int(stats[1]), n_rhs=int(stats[2]),
                         wall_s=time.perf_counter() - t0, n_onset_retries=int(stats[4]),
-                        n_contact_changes=int(stats[5]), extra={"aux": aux, "last_h": float(stats[3])})
+                        n_contact_changes=int(stats[5]), n_force_jump_retries=int(stats[6]), extra={"aux": aux, "last_h": float(stats[3])})
 
     return run
 
@@ -131,7 +139,7 @@ def step_scipy(pr: Problem, t_eval: FloatArray, method: str, rtol: float, max_st
 
 def _scipy(method: str) -> Callable[..., Solution]:
     def run(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float, first_step: float | None,
-            max_steps: int) -> Solution:
+            max_steps: int, force_jump: float) -> Solution:
         return step_scipy(pr, t_eval, method, rtol, max_step, first_step, max_steps)
 
     return run
@@ -144,8 +152,32 @@ METHODS: dict[str, Callable[..., Solution]] = {
 
 
 def solve(problem: Problem, t_eval: npt.ArrayLike, method: str = "dp5", rtol: float = 1e-6,
-          max_step: float = np.inf, first_step: float | None = None, max_steps: int = 50_000_000) -> Solution:
+          max_step: float = np.inf, first_step: float | None = None, max_steps: int = 50_000_000,
+          force_jump: float = FORCE_JUMP) -> Solution:
     """Integrate ``problem`` and sample it at ``t_eval``.
+
+    Parameters
+    ----------
+    problem
+        The initial-value problem.
+    t_eval
+        Increasing sample times (s), the first at or after ``problem.t0``.
+    method
+        A key of :data:`METHODS`.
+    rtol
+        Relative tolerance; the absolute tolerances are the problem's, per state.
+    max_step
+        Largest step (s).
+    first_step
+        First trial step (s); default 1e-3 of the span, at most ``max_step``.
+    max_steps
+        Bound on accepted plus rejected steps.
+    force_jump
+        Compiled methods reject a step longer than ``problem.onset_step`` across which an acceleration
+        flagged by ``problem.jump_floor`` changes by more than this fraction of its size (plus its
+        floor), and retry it at half the length, so a force that rises steeply inside a contact is
+        resolved even when the error estimate passes (the role of the contact-force-change trigger of
+        Gupta's GSTIFF integrator, paper §2.6). 0 turns it off.
 
     Raises
     ------
@@ -157,6 +189,8 @@ def solve(problem: Problem, t_eval: npt.ArrayLike, method: str = "dp5", rtol: fl
                              method)
     if not (0 < rtol < 1):
         raise ParameterError("rtol", "must lie in (0, 1)", rtol)
+    if not (0 <= force_jump < np.inf):
+        raise ParameterError("force_jump", "must be a fraction >= 0 (0 turns the force-jump control off)", force_jump)
     if not (max_step > 0):
         raise ParameterError("max_step", "must be > 0", max_step)
     t = np.asarray(t_eval, dtype=np.float64)
@@ -164,4 +198,4 @@ def solve(problem: Problem, t_eval: npt.ArrayLike, method: str = "dp5", rtol: fl
         raise ParameterError("t_eval", f"must be increasing times >= t0 = {problem.t0}")
     if problem.atol.shape != problem.y0.shape or np.any(problem.atol <= 0):
         raise ParameterError("atol", "must be positive, one per state")
-    return METHODS[method](problem, t, rtol, float(max_step), first_step, int(max_steps))
+    return METHODS[method](problem, t, rtol, float(max_step), first_step, int(max_steps), float(force_jump))

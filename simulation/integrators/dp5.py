@@ -44,12 +44,17 @@ E1, E3, E4, E5, E6, E7 = 71 / 57600, -71 / 16695, 71 / 1920, -17253 / 339200, 22
 
 
 @numba.njit(cache=True)
-def dp5_integrate(model_id, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, max_steps, out, stats, h_onset=0.0):
+def dp5_integrate(model_id, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, max_steps, out, stats, h_onset,
+                  jump_floor, force_jump):
     """Integrate from ``t0`` and write ``y`` at each ``t_out[k]`` (increasing, >= t0) into ``out[k]``.
 
     A step longer than ``h_onset`` during which a contact opens or closes (the model's signature
     changes) is rejected and retried at most ``h_onset`` long, so contact onsets are never stepped over.
-    ``stats`` receives [n_steps, n_rejected, n_rhs, last_h, n_onset_retries, n_contact_changes].
+    A step longer than ``h_onset`` across which a force jumps is rejected and retried at half the
+    length (never below ``h_onset``): for each component i with ``jump_floor[i] > 0`` (the
+    accelerations), |f_i(end) - f_i(start)| > ``force_jump`` (max(|f_i(start)|, |f_i(end)|) + floor_i).
+    ``stats`` receives [n_steps, n_rejected, n_rhs, last_h, n_onset_retries, n_contact_changes,
+    n_force_jump_retries].
     Returns a status code:
     0 ok, 1 too many steps, 2 step-size underflow, 3 non-finite state.
     """  # noqa: D401
@@ -68,6 +73,7 @@ def dp5_integrate(model_id, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, max_st
     model_rhs(model_id, t, y, p, aux, k1)
     sig = model_signature(model_id, y, p) if h_onset > 0.0 else 0.0
     n_onset = 0
+    n_jumps = 0
     n_changes = 0
     n_rhs = 1
     n_steps = 0
@@ -140,6 +146,12 @@ def dp5_integrate(model_id, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, max_st
                     continue
                 n_changes += 1
                 sig = sig_new
+        if err <= 1.0 and force_jump > 0.0 and h > h_onset:
+            if _force_jumped(k1, k7, jump_floor, force_jump):
+                n_jumps += 1
+                n_rej += 1
+                h = max(0.5 * h, h_onset)
+                continue
         if err <= 1.0:
             fac = fac11 / err_old ** 0.04
             fac = max(0.1, min(5.0, fac / 0.9))
@@ -164,7 +176,18 @@ def dp5_integrate(model_id, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, max_st
     stats[3] = h
     stats[4] = n_onset
     stats[5] = n_changes
+    stats[6] = n_jumps
     return status
+
+
+@numba.njit(cache=True, inline="always")
+def _force_jumped(f0, f1, floor, fraction):  # pragma: no cover - compiled
+    for i in range(f0.shape[0]):
+        if floor[i] > 0.0:
+            a, b = f0[i], f1[i]
+            if abs(b - a) > fraction * (max(abs(a), abs(b)) + floor[i]):
+                return True
+    return False
 
 
 @numba.njit(cache=True, inline="always")

@@ -450,7 +450,20 @@ def planar_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLi
     # An impact at 1 m/s approach lasts t_H; contact onsets are resolved to t_H / ONSET_RESOLUTION.
     onset = hertz_impact_duration(1.0, 0.5 * p[P_M], p[P_KB]) / ONSET_RESOLUTION
     return Problem(model_id=MODEL_ID, params=p, aux=aux, y0=y0, t0=0.0, atol=atol, name="planar cageless bearing",
-                   onset_step=onset)
+                   onset_step=onset, jump_floor=planar_jump_floor(p, lay))
+
+
+def planar_jump_floor(p: npt.NDArray[np.float64], lay: PlanarLayout) -> npt.NDArray[np.float64]:
+    """The accelerations a 1 N force (or a 1 N force at the ball's surface) gives each body: the floor of
+    the force-jump test on every velocity state, zero on the rest (see :class:`~simulation.problem.Problem`)."""
+    sl = lay.slices()
+    z = lay.n_balls
+    floor = np.zeros(lay.size)
+    floor[sl["r_dot"]] = 1.0 / p[P_M]
+    floor[sl["theta_dot"]] = 1.0 / (p[P_M] * 0.25 * (p[P_DI] + p[P_DO]))
+    floor[sl["spin"]] = 0.5 * p[P_D] / p[P_I]
+    floor[5 * z + 2:5 * z + 4] = 1.0 / p[P_MR]
+    return floor
 
 
 def contact_events(problem: Problem, aux: npt.NDArray[np.float64], t_end: float) -> pd.DataFrame:

@@ -354,8 +354,13 @@ def spatial_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayL
     p[P_FA], (p[P_TILT_Y], p[P_TILT_Z]), p[P_STRIPS] = axial_load_n, misalignment_rad, strips
     p[P_AI] = hertz_contact(*rc["inner"], eta).a_coeff
     p[P_AO] = hertz_contact(*rc["outer"], eta).a_coeff
+    floor = np.zeros(lay.size)
+    floor[: 5 * z + 6] = P.planar_jump_floor(flat.params, P.PlanarLayout(z))
+    floor[sl["axial_dot"]] = floor[sl["r_dot"]]
+    floor[sl["spin_y"]] = floor[sl["spin_z"]] = floor[sl["spin"]]
+    floor[sl["ring_axial"]] = (0.0, floor[5 * z + 2])
     return Problem(model_id=MODEL_ID, params=p, aux=flat.aux, y0=y0, t0=0.0, atol=atol,
-                   name="spatial cageless bearing", onset_step=flat.onset_step)
+                   name="spatial cageless bearing", onset_step=flat.onset_step, jump_floor=floor)
 
 
 def race_geometry(problem: Problem, y: npt.NDArray[np.float64]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
