@@ -26,7 +26,7 @@ from scipy.integrate import solve_ivp
 
 from cageless.errors import ParameterError
 
-__all__ = ["hertz_damped", "hertz_impact_duration", "damping_factor", "rebound"]
+__all__ = ["PLASTIC_CHI", "hertz_damped", "hertz_impact_duration", "damping_factor", "rebound"]
 
 
 @numba.njit(cache=True, inline="always")
@@ -69,13 +69,27 @@ def rebound(chi: float) -> float:
     return 0.0
 
 
+#: Damping factor standing for R = 0. A perfectly plastic impact is the limit chi -> infinity of this
+#: law: the clamped force vanishes once the overlap recedes faster than v_in / chi, so the rebound is at
+#: most 1 / chi of the approach speed (measured with :func:`rebound`: 0.1 at chi = 10, 0.01 at 100).
+#: chi = 1000 keeps the rebound below 0.1 % while the contact stays resolvable (its duration is about
+#: (1000 / 0.4)^-0.4, 1/23, of the elastic Hertz time).
+PLASTIC_CHI = 1000.0
+
+
 @lru_cache(maxsize=64)
 def damping_factor(restitution: float) -> float:
-    """Damping factor chi for which a free impact rebounds with ``restitution`` (0 < R <= 1)."""
-    if not 0.0 < restitution <= 1.0:
-        raise ParameterError("restitution", "must lie in (0, 1]", restitution)
+    """Damping factor chi for which a free impact rebounds with ``restitution`` (0 <= R <= 1).
+
+    R = 0 (perfectly plastic, the lower end of the paper's range 0 <= R < 1) is represented by
+    :data:`PLASTIC_CHI`, a rebound below 0.1 % of the approach speed.
+    """
+    if not 0.0 <= restitution <= 1.0:
+        raise ParameterError("restitution", "must lie in [0, 1]", restitution)
     if restitution == 1.0:
         return 0.0
+    if restitution <= 1.0 / PLASTIC_CHI:
+        return PLASTIC_CHI
     guess = 8.0 * (1.0 - restitution) / (5.0 * restitution)
     hi = guess
     while rebound(hi) > restitution:

@@ -85,7 +85,7 @@ def initial_state(scene: Scene) -> tuple[npt.NDArray[np.float64], npt.NDArray[np
     """
     b = scene.bearing
     g = b.geometry
-    theta = P.packed_start(b, seed=scene.seed)
+    theta = P.packed_start(b, seed=scene.seed, spread=scene.initial_gap_fraction)
     radius = np.full(g.n_balls, 0.5 * g.pitch_diameter_m)
     load = scene.conditions.radial_load_n + b.masses.ring_translational_mass_kg * scene.gravity_m_s2
     if load <= 0:
@@ -150,10 +150,11 @@ def _observables(pr: Problem, y: npt.NDArray[np.float64], scene: Scene,
         axial = y[:, sl["axial"]]
         spin[:, :, 1], spin[:, :, 2] = y[:, sl["spin_y"]], y[:, sl["spin_z"]]
         ring[:, 0] = y[:, sl["ring_axial"]][:, 0]
-        for race, (overlap, angle) in S.race_geometry(pr, y).items():
+        for race, (overlap, angle, point) in S.race_geometry(pr, y).items():
             k_n = p[P.P_KI] if race == "inner" else p[P.P_KO]
             contacts[f"{race}_normal"] = k_n * overlap**1.5
             contacts[f"{race}_angle"] = angle
+            contacts[f"{race}_point"] = point
     return {
         "balls": {"radius": r, "axial": axial, "spin": spin},
         "contacts": contacts,

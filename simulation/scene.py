@@ -46,6 +46,10 @@ class Scene:
         Time for the inner ring to reach its speed from rest (s), >= 0 (0: instantaneous start).
     seed
         Perturbs the initial gaps between balls.
+    initial_gap_fraction
+        Share of the free arc (the circumference the balls do not fill) spread between neighbours at the
+        start, in [0, 1); the rest is the one gap at the top. 0 starts every ball in contact with its
+        neighbours (DESIGN §6 "Start"); the default 0.05 keeps them a few micrometres apart.
     """
 
     conditions: OperatingConditions
@@ -58,8 +62,11 @@ class Scene:
     duration_s: float = 0.05
     speed_ramp_s: float = 0.0
     seed: int = 0
+    initial_gap_fraction: float = 0.05
 
     def __post_init__(self) -> None:
+        if not (isinstance(self.initial_gap_fraction, int | float) and 0 <= self.initial_gap_fraction < 1):
+            raise ParameterError("scene.initial_gap_fraction", "must lie in [0, 1)", self.initial_gap_fraction)
         for name in ("gravity_m_s2", "misalignment_rad", "moment_load_nm", "speed_ramp_s"):
             value = getattr(self, name)
             if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):

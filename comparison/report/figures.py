@@ -18,7 +18,7 @@ from comparison.report.describe import ConditionDescription
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
 
-__all__ = ["speed_figure", "slip_figure", "contact_polar_figure", "ring_figure"]
+__all__ = ["speed_figure", "slip_figure", "contact_polar_figure", "ring_figure", "contact_track_figure"]
 
 _STYLE = {"font.size": 8, "axes.grid": True, "grid.alpha": 0.3, "svg.fonttype": "none"}
 
@@ -101,4 +101,23 @@ def ring_figure(d: ConditionDescription) -> str:
         if pc is not None and len(pc):
             a2.scatter(1e6 * pc[:, 0], 1e6 * pc[:, 1], s=6, color="C3")
         a2.set(xlabel="y (um)", ylabel="z (um)", title="Poincare section (per shaft revolution)")
+    return _svg(draw, size=(6.4, 2.9))
+
+
+def contact_track_figure(d: ConditionDescription) -> str:
+    """Contact trajectory on the raceways (the paper's figure 13): contact angle against orbital angle, and
+    the inner contact points projected on the axial-vertical (X-Z) plane. Spatial simulations only."""
+    tr = d.contact_track
+    assert tr is not None
+
+    def draw(fig: Any) -> None:
+        a1, a2 = fig.subplots(1, 2)
+        deg = np.degrees(tr["orbital_angle"])
+        a1.scatter(deg, np.degrees(tr["inner_angle"]), s=1, color="C0", label="inner race")
+        a1.scatter(deg, np.degrees(tr["outer_angle"]), s=1, color="C3", label="outer race")
+        a1.set(xlabel="orbital angle (deg)", ylabel="contact angle (deg)", xlim=(0, 360), title="contact angle")
+        a1.legend(fontsize=7, markerscale=5)
+        pt = tr["inner_point"]
+        a2.scatter(1e3 * pt[:, 0], 1e3 * pt[:, 2], s=1, color="C0")
+        a2.set(xlabel="axial x (mm)", ylabel="z (mm)", title="inner contact points (X-Z)")
     return _svg(draw, size=(6.4, 2.9))

@@ -40,6 +40,9 @@ def _section(d: ConditionDescription) -> dict[str, Any]:
              "svg": figures.contact_polar_figure(d)},
             {"caption": "Inner-ring centre orbit and Poincare section (simulated)", "svg": figures.ring_figure(d)},
         ]
+        if d.contact_track is not None:
+            section["figures"].append({"caption": "Contact trajectory on the raceways (simulated, spatial model; "
+                                                  "the paper's figure 13)", "svg": figures.contact_track_figure(d)})
         section["facts"] += [("settling time left out of the simulation", f"{d.comparison.settle_s:g} s")]
     return section
 

@@ -63,8 +63,8 @@ P_Z, P_D, P_M, P_I, P_MR, P_DI, P_DO, P_KI, P_KO, P_KB, P_CHI, P_G, P_FR, P_WI =
 P_F_RACE, P_F_BB, P_F_GRAV, P_F_LUB, P_CHO = 14, 15, 16, 17, 18
 P_F_TRAC, P_F_FILM, P_F_BBFILM, P_F_DRAG, P_DRY = 19, 20, 21, 22, 23
 P_ETA0, P_H0, P_TA, P_TB, P_TC, P_TD = range(24, 30)
-P_MU_DRY, P_V_REG, P_CD, P_RHO_MIX, P_RAMP, P_U_FLOOR = range(30, 36)
-N_PARAMS = 36
+P_MU_DRY, P_V_REG, P_CD, P_RHO_MIX, P_RAMP, P_U_FLOOR, P_V_IN_MIN = range(30, 37)
+N_PARAMS = 37
 
 #: Lubricant damping coefficient at the race contacts (N s/m): the middle of the paper's 2500-7500 range.
 DEFAULT_CHO_N_S_M = ModelParameters().cho_n_s_m
@@ -180,7 +180,8 @@ def _pair_forces(y, p, aux, j, k, z, cj, sj, ck, sk):  # pragma: no cover - comp
         return 0.0, 0.0, 0.0, 0.0
     # approach speed at onset: recorded after the first accepted step in contact (planar_post); until
     # then the current approach speed, so the force depends on no trial stage of any step
-    v_in = aux[j] if aux[j] > 0.0 else max(delta_dot, 1e-9)
+    # (floored: see ModelParameters.min_approach_speed_m_s)
+    v_in = max(aux[j] if aux[j] > 0.0 else delta_dot, p[P_V_IN_MIN])
     f = hertz_damped(delta, delta_dot, v_in, p[P_KB], p[P_CHI])
     p_diss = (f - p[P_KB] * delta * np.sqrt(delta)) * delta_dot
     f_t = torque = 0.0
@@ -388,6 +389,7 @@ def _params(bearing: Bearing, radial_load_n: float, gravity_m_s2: float, inner_s
     p[P_CHO], p[P_H0] = par.cho_n_s_m, par.film_thickness_m
     p[P_TA], p[P_TB], p[P_TC], p[P_TD] = par.traction_coefficients
     p[P_V_REG], p[P_U_FLOOR], p[P_CD] = par.slip_regularisation_m_s, par.min_entrainment_m_s, par.drag_coefficient
+    p[P_V_IN_MIN] = par.min_approach_speed_m_s
     if p[P_F_TRAC] and not lubricated:
         if par.dry_friction_coefficient is None:
             raise ParameterError("dry_friction_coefficient", "a dry scene needs the Coulomb friction of the bare "

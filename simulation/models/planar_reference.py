@@ -117,7 +117,8 @@ def _pairs(y: np.ndarray, p: np.ndarray, aux: np.ndarray, fy: np.ndarray, fz: np
     nx, nz = dx / ln, dz / ln
     ddot = -((vx[k] - vx) * nx + (vz[k] - vz) * nz)
     touching = delta > 0
-    speeds = np.where(aux[:z] > 0, aux[:z], np.maximum(ddot, 1e-9))  # recorded onset speed, else the current one
+    # recorded onset speed, else the current one; floored (ModelParameters.min_approach_speed_m_s)
+    speeds = np.maximum(np.where(aux[:z] > 0, aux[:z], ddot), p[P.P_V_IN_MIN])
     chi = p[P.P_CHI]
     el = p[P.P_KB] * np.clip(delta, 0, None) ** 1.5
     f = np.where(touching, np.maximum(el * (1 + (chi * ddot / np.where(speeds > 0, speeds, 1.0) if chi > 0 else 0)),

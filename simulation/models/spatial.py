@@ -201,7 +201,7 @@ def _pair(y, p, aux, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
             f = 6.0 * np.pi * p[P.P_ETA0] * (0.25 * d) ** 2 * ddot / max(-delta, p[P.P_H0])
             return f * nx, f * ny, f * nz, 0.0, 0.0, 0.0, f * ddot
         return zero
-    v_in = aux[j] if aux[j] > 0.0 else max(ddot, 1e-9)
+    v_in = max(aux[j] if aux[j] > 0.0 else ddot, p[P.P_V_IN_MIN])
     f = hertz_damped(delta, ddot, v_in, p[P.P_KB], p[P.P_CHI])
     p_diss = (f - p[P.P_KB] * delta * math.sqrt(delta)) * ddot
     fx, fy, fz = f * nx, f * ny, f * nz
@@ -363,11 +363,15 @@ def spatial_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayL
                    name="spatial cageless bearing", onset_step=flat.onset_step, jump_floor=floor)
 
 
-def race_geometry(problem: Problem, y: npt.NDArray[np.float64]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """(overlap in m, contact angle in rad) of the inner and outer race contacts along samples y (T, n).
+def race_geometry(problem: Problem,
+                  y: npt.NDArray[np.float64]) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """(overlap in m, contact angle in rad, contact point) of the inner and outer race contacts along samples
+    y (T, n).
 
-    The contact angle is atan(axial / radial component of the normal). The ring's prescribed tilt is
-    left out here (it is below a milliradian in practice); the dynamics include it.
+    The contact angle is atan(axial / radial component of the normal). The contact point (T, Z, 3: axial
+    x, y, z in m, bearing frame) lies on the raceway, the groove radius from its curvature centre along the
+    line through the ball centre: its path is the contact trajectory of the paper's figure 13. The ring's
+    prescribed tilt is left out here (it is below a milliradian in practice); the dynamics include it.
     """
     p = problem.params
     z = int(p[P.P_Z])
@@ -379,9 +383,14 @@ def race_geometry(problem: Problem, y: npt.NDArray[np.float64]) -> dict[str, tup
             ("outer", 0.5 * p[P.P_DO] - p[P_RGO], p[P_RGO], 0.0, 0.0, 0.0),
             ("inner", 0.5 * p[P.P_DI] + p[P_RGI], p[P_RGI], y[:, b + 4 * z][:, None], y[:, 5 * z][:, None],
              y[:, 5 * z + 1][:, None])):
-        er = np.hypot(r * np.cos(th) - cy, r * np.sin(th) - cz) - rho
+        dy, dz = r * np.cos(th) - cy, r * np.sin(th) - cz
+        dist = np.hypot(dy, dz)
+        er = dist - rho
         ex = ax - c_ax
-        out[race] = (np.clip(np.hypot(ex, er) - (rg - half), 0.0, None), np.arctan2(ex, np.abs(er)))
+        length = np.hypot(ex, er)
+        radial = rho + rg * er / length  # distance of the contact point from the ring's axis
+        point = np.stack([c_ax + rg * ex / length + 0 * r, cy + radial * dy / dist, cz + radial * dz / dist], axis=-1)
+        out[race] = (np.clip(length - (rg - half), 0.0, None), np.arctan2(ex, np.abs(er)), point)
     return out
 
 
@@ -401,7 +410,7 @@ def spatial_energy(problem: Problem, y: npt.NDArray[np.float64]) -> npt.NDArray[
           + 0.5 * m_ring * (cvx**2 + cvy**2 + cvz**2))
     pe = m * g * np.sum(r * np.sin(th), axis=1) + (m_ring * g + p[P.P_FR]) * y[:, 5 * z + 1] - p[P_FA] * y[:, b + 4 * z]
     if p[P.P_F_RACE] > 0.5:
-        for race, (overlap, _) in race_geometry(problem, y).items():
+        for race, (overlap, _, _) in race_geometry(problem, y).items():
             pe += 0.4 * (p[P.P_KI] if race == "inner" else p[P.P_KO]) * np.sum(overlap**2.5, axis=1)
     if p[P.P_F_BB] > 0.5:
         x, zz = r * np.cos(th), r * np.sin(th)

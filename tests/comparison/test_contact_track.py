@@ -1,0 +1,60 @@
+"""The contact trajectory of spatial traces (the paper's figure 13): trace field, description and figure.
+
+The contact point lies on the raceway, so it lies on the ball's surface less the Hertz overlap
+delta = (Q / K)^(2/3) (Harris & Kotzalas, *Essential Concepts*, 5th ed., sect. 6.4): its distance from
+the ball centre is D/2 - delta, and the line from the ball centre to it makes the reported contact angle
+with the radial plane.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from cageless.conditions import OperatingConditions
+from comparison.report.describe import contact_track
+from simulation.effects import choose_model
+from simulation.run import simulate
+from simulation.scene import Scene
+
+
+@pytest.fixture(scope="module")
+def spatial():
+    scene = Scene(conditions=OperatingConditions(3000.0, 500.0, 400.0), duration_s=0.01)
+    return simulate(scene, choose_model(scene), progress=False)
+
+
+def test_contact_points_lie_on_the_ball_surface_at_the_contact_angle(spatial):
+    tr, pr = spatial.trace, spatial.problem
+    k, d = pr.params, pr.params[1]
+    c, balls = tr.groups["contacts"], tr.groups["balls"]
+    centre = np.stack([balls["axial"], balls["radius"] * np.cos(tr.angle), balls["radius"] * np.sin(tr.angle)], -1)
+    for race, stiffness in (("inner", k[7]), ("outer", k[8])):
+        arm = c[f"{race}_point"] - centre
+        loaded = c[f"{race}_normal"] > 1.0
+        assert loaded.mean() > 0.3  # the axial load presses many balls on both races
+        overlap = (c[f"{race}_normal"] / stiffness) ** (2 / 3)
+        length = np.linalg.norm(arm, axis=-1)
+        assert np.allclose(length[loaded], 0.5 * d - overlap[loaded], atol=1e-8)
+        radial = np.hypot(arm[..., 1], arm[..., 2])
+        angle = np.arctan2(arm[..., 0], radial)  # the arm points along the normal, away from the groove centre
+        assert np.allclose(angle[loaded], c[f"{race}_angle"][loaded], atol=1e-6)
+        assert np.degrees(np.median(np.abs(c[f"{race}_angle"][loaded]))) > 5  # a real contact angle
+
+
+def test_contact_track_is_described_and_drawn(spatial):
+    from comparison.report.describe import ConditionDescription
+    from comparison.report.figures import contact_track_figure
+
+    track = contact_track(spatial.trace, 0.005, max_points=500)
+    assert track is not None and len(track["orbital_angle"]) <= 500
+    assert track["inner_point"].shape == (len(track["orbital_angle"]), 3)
+    assert np.all((track["orbital_angle"] >= 0) & (track["orbital_angle"] < 2 * np.pi))
+    svg = contact_track_figure(ConditionDescription(label="x", row=None, contact_track=track))  # type: ignore[arg-type]
+    assert svg.startswith("<svg") and "contact angle" in svg
+
+
+def test_planar_traces_have_no_contact_track():
+    scene = Scene(conditions=OperatingConditions(3000.0, 500.0), duration_s=0.002)
+    tr = simulate(scene, choose_model(scene), progress=False).trace
+    assert "inner_point" not in tr.groups["contacts"] and contact_track(tr, 0.0) is None
