@@ -26,7 +26,7 @@ from scipy.integrate import solve_ivp
 
 from cageless.errors import ParameterError
 
-__all__ = ["PLASTIC_CHI", "hertz_damped", "hertz_impact_duration", "damping_factor", "rebound"]
+__all__ = ["FASTMATH", "PLASTIC_CHI", "hertz_damped", "hertz_impact_duration", "damping_factor", "rebound"]
 
 
 @numba.njit(cache=True, inline="always")
@@ -68,6 +68,12 @@ def rebound(chi: float) -> float:
         return float(-res.y_events[0][0][1])
     return 0.0
 
+
+#: LLVM fast-math flags of the model right-hand sides: fused multiply-add, reassociation, reciprocals and
+#: signed zeros, but not "nnan"/"ninf", so a non-finite state still propagates to the integrator's check.
+#: They change results only at round-off (measured: 5e-7 relative on an acceleration that is the small sum
+#: of 100 N contact forces) and cut the spatial right-hand side from 9.2 to 6.3 us.
+FASTMATH = {"nsz", "arcp", "contract", "reassoc"}
 
 #: Damping factor standing for R = 0. A perfectly plastic impact is the limit chi -> infinity of this
 #: law: the clamped force vanishes once the overlap recedes faster than v_in / chi, so the rebound is at

@@ -44,7 +44,7 @@ import pandas as pd
 
 from cageless.bearing import Bearing
 from cageless.errors import ParameterError
-from simulation.forces import damping_factor, hertz_damped, hertz_impact_duration
+from simulation.forces import FASTMATH, damping_factor, hertz_damped, hertz_impact_duration
 from simulation.hertz import ball_ball_contact, compliance, hertz_contact, race_curvatures
 from simulation.parameters import ModelParameters
 from simulation.problem import Problem
@@ -97,7 +97,7 @@ def _tangential(u_s, u_r, q, p):  # pragma: no cover - compiled
     return regression_traction(u_s, u_r, q, p[P_TA], p[P_TB], p[P_TC], p[P_TD], p[P_U_FLOOR])
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, fastmath=FASTMATH)
 def _race_forces(y, p, j, z, w_i, c, s):  # pragma: no cover - compiled
     """Race forces on ball j: (f_y, f_z, spin torque, ring f_y, ring f_z, input power, dissipated power)."""
     d = p[P_D]
@@ -154,7 +154,7 @@ def _race_forces(y, p, j, z, w_i, c, s):  # pragma: no cover - compiled
     return fy, fz, torque, ry, rz, p_in, p_diss
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, fastmath=FASTMATH)
 def _pair_forces(y, p, aux, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
     """Forces between balls j and k: (f_y on k, f_z on k, spin torque on both, dissipated power)."""
     d = p[P_D]
@@ -197,7 +197,7 @@ def _pair_forces(y, p, aux, j, k, z, cj, sj, ck, sk):  # pragma: no cover - comp
     return f * nx, f * nz, torque, p_diss
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, fastmath=FASTMATH)
 def planar_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     z = int(p[P_Z])
     d, m, inertia, m_ring, g = p[P_D], p[P_M], p[P_I], p[P_MR], p[P_G]

@@ -35,7 +35,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cageless.bearing import Bearing
-from simulation.forces import hertz_damped
+from simulation.forces import FASTMATH, hertz_damped
 from simulation.hertz import compliance, hertz_contact, race_curvatures
 from simulation.models import planar as P
 from simulation.problem import Problem
@@ -77,37 +77,51 @@ def _tilt(p):  # pragma: no cover - compiled
     return (cg * cb, -sg, cg * sb, sg * cb, cg, sg * sb, -sb, 0.0, cb)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
+def _groove(y, p, j, z, inner, rot, c, s):  # pragma: no cover - compiled
+    """Ball j against one race's groove: its centre in the ring frame (radius rq, direction cq, sq), the offset
+    (ex, er) from the groove's curvature centre, its length ln, the overlap, and the groove's rho and r_g."""
+    b = 5 * z + 6
+    r = y[j]
+    px, py, pz = y[b + j], r * c, r * s
+    if inner:
+        cx, cy, cz = y[b + 4 * z], y[5 * z], y[5 * z + 1]
+        rho, rg = 0.5 * p[P.P_DI] + p[P_RGI], p[P_RGI]
+        dx, dy, dz = px - cx, py - cy, pz - cz
+        # ball centre in the ring frame (R^T (P - C))
+        qx = rot[0] * dx + rot[3] * dy + rot[6] * dz
+        qy = rot[1] * dx + rot[4] * dy + rot[7] * dz
+        qz = rot[2] * dx + rot[5] * dy + rot[8] * dz
+    else:
+        rho, rg = 0.5 * p[P.P_DO] - p[P_RGO], p[P_RGO]
+        qx, qy, qz = px, py, pz
+    rq = math.sqrt(qy * qy + qz * qz)
+    ex, er = qx, rq - rho  # from the groove centre to the ball centre, in the (x, radial) plane of the ring
+    ln = math.sqrt(ex * ex + er * er)
+    return rq, qy / rq, qz / rq, ex, er, ln, ln - (rg - 0.5 * p[P.P_D]), rho, rg
+
+
+@numba.njit(cache=True, fastmath=FASTMATH)
 def _race(y, p, j, z, inner, w_i, rot, c, s):  # pragma: no cover - compiled
     """One race contact of ball j: force (3), torque (3) on the ball, input and dissipated power, overlap."""
     d = p[P.P_D]
     half = 0.5 * d
     b = 5 * z + 6
-    r, rd, thd = y[j], y[2 * z + j], y[3 * z + j]
-    px, py, pz = y[b + j], r * c, r * s
-    vx, vy, vz = y[b + z + j], rd * c - r * thd * s, rd * s + r * thd * c
-    ox, oy, oz = y[4 * z + j], y[b + 2 * z + j], y[b + 3 * z + j]
-    if inner:
-        cx, cy, cz = y[b + 4 * z], y[5 * z], y[5 * z + 1]
-        vcx, vcy, vcz = y[b + 4 * z + 1], y[5 * z + 2], y[5 * z + 3]
-        rho, rg, k_n, a_c = 0.5 * p[P.P_DI] + p[P_RGI], p[P_RGI], p[P.P_KI], p[P_AI]
-    else:
-        cx = cy = cz = vcx = vcy = vcz = 0.0
-        rho, rg, k_n, a_c = 0.5 * p[P.P_DO] - p[P_RGO], p[P_RGO], p[P.P_KO], p[P_AO]
+    if not inner:
         rot = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
-    # ball centre in the ring frame (R^T (P - C))
-    dx, dy, dz = px - cx, py - cy, pz - cz
-    qx = rot[0] * dx + rot[3] * dy + rot[6] * dz
-    qy = rot[1] * dx + rot[4] * dy + rot[7] * dz
-    qz = rot[2] * dx + rot[5] * dy + rot[8] * dz
-    rq = math.sqrt(qy * qy + qz * qz)
-    cq, sq = qy / rq, qz / rq
-    ex, er = qx, rq - rho  # from the groove centre to the ball centre, in the (x, radial) plane of the ring
-    ln = math.sqrt(ex * ex + er * er)
-    delta = ln - (rg - half)
+    rq, cq, sq, ex, er, ln, delta, rho, rg = _groove(y, p, j, z, inner, rot, c, s)
     zero = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     if delta <= 0.0:
         return zero
+    r, rd, thd = y[j], y[2 * z + j], y[3 * z + j]
+    vx, vy, vz = y[b + z + j], rd * c - r * thd * s, rd * s + r * thd * c
+    ox, oy, oz = y[4 * z + j], y[b + 2 * z + j], y[b + 3 * z + j]
+    if inner:
+        vcx, vcy, vcz = y[b + 4 * z + 1], y[5 * z + 2], y[5 * z + 3]
+        k_n, a_c = p[P.P_KI], p[P_AI]
+    else:
+        vcx = vcy = vcz = 0.0
+        k_n, a_c = p[P.P_KO], p[P_AO]
     nrx, nrr = ex / ln, er / ln
     # normal, radial and azimuthal directions in the fixed frame
     nx0, ny0, nz0 = nrx, nrr * cq, nrr * sq
@@ -137,7 +151,7 @@ def _race(y, p, j, z, inner, w_i, rot, c, s):  # pragma: no cover - compiled
         xrz = (rot[6] * rg * nrx + rot[7] * r_c * cq + rot[8] * r_c * sq)
         # major axis of the ellipse: across the rolling direction, in the contact plane
         ax_, ay_, az_ = _cross(nx, ny, nz, tx, ty, tz)
-        a = a_c * q ** (1.0 / 3.0)
+        a = a_c * np.cbrt(q)
         bsx, bsy, bsz = _cross(ox, oy, oz, half * nx, half * ny, half * nz)
         rsx, rsy, rsz = _cross(wx, wy, wz, xrx, xry, xrz)
         vt = rvx * tx + rvy * ty + rvz * tz
@@ -173,7 +187,7 @@ def _race(y, p, j, z, inner, w_i, rot, c, s):  # pragma: no cover - compiled
     return fx, fy, fz, mx, my, mz, p_in, p_diss, delta
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, fastmath=FASTMATH)
 def _pair(y, p, aux, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
     """Ball j against ball k along the 3-D line of centres: force on k (3), moment on both (3), dissipated power."""
     d = p[P.P_D]
@@ -224,7 +238,7 @@ def _pair(y, p, aux, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
     return fx, fy, fz, mx, my, mz, p_diss
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, fastmath=FASTMATH)
 def spatial_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     z = int(p[P.P_Z])
     b = 5 * z + 6
@@ -305,9 +319,10 @@ def spatial_signature(y, p):  # pragma: no cover - compiled
     sig = 0.0
     for j in range(z):
         c, s = math.cos(y[z + j]), math.sin(y[z + j])
-        for idx, inner in ((0, False), (1, True)):
-            if _race(y, p, j, z, inner, 0.0, rot, c, s)[8] > 0.0:
-                sig += 1.0 + idx * z + j
+        if _groove(y, p, j, z, False, rot, c, s)[6] > 0.0:
+            sig += 1.0 + j
+        if _groove(y, p, j, z, True, rot, c, s)[6] > 0.0:
+            sig += 1.0 + z + j
         k = j + 1 if j + 1 < z else 0
         dx = y[b + k] - y[b + j]
         dy = y[k] * math.cos(y[z + k]) - y[j] * math.cos(y[z + j])

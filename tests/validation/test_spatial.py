@@ -55,10 +55,12 @@ def _profile(trace):
     return angle_profile(trace.angle, trace.slip, 1.0, valid=keep)["mean"].to_numpy()
 
 
-@pytest.mark.parametrize("rpm,duration", [(1800, 0.22), (3000, 0.15), (6000, 0.1)])
+@pytest.mark.parametrize("rpm,duration", [pytest.param(1800, 0.65, marks=pytest.mark.slow), (3000, 0.15), (6000, 0.1)])
 def test_spatial_matches_planar_under_pure_radial_load(rpm, duration):
-    """Measured: RMS 0.08 / 0.03 / 0.002 pp and peak differences 0.10 / 0.009 / 0.001 pp at 1800 / 3000 /
-    6000 rpm (1800 rpm is the chaotic case: its largest single-bin difference is 0.32 pp)."""
+    """Measured: RMS 0.03 / 0.03 / 0.002 pp and peak differences 0.04 / 0.009 / 0.001 pp at 1800 / 3000 /
+    6000 rpm. 1800 rpm is chaotic: the two models part at round-off within 2 ms of the start, so only
+    statistics compare, and they need the longer run (over 0.22 s the RMS is 0.08-0.22 pp depending on
+    round-off; over 0.65 s it is 0.03 pp, against 0.05 pp between two planar runs at rtol 1e-6 and 1e-7)."""
     scene = Scene(conditions=OperatingConditions(rpm, 500.0), duration_s=duration)
     flat = simulate(scene, choose_model(scene), progress=False).trace
     full = simulate(scene, choose_model(scene, level="spatial"), progress=False).trace
