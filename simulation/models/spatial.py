@@ -383,10 +383,10 @@ def race_geometry(problem: Problem,
     """(overlap in m, contact angle in rad, contact point) of the inner and outer race contacts along samples
     y (T, n).
 
-    The contact angle is atan(axial / radial component of the normal). The contact point (T, Z, 3: axial
-    x, y, z in m, bearing frame) lies on the raceway, the groove radius from its curvature centre along the
-    line through the ball centre: its path is the contact trajectory of the paper's figure 13. The ring's
-    prescribed tilt is left out here (it is below a milliradian in practice); the dynamics include it.
+    The contact angle is atan(axial / radial component of the normal), in the frame of the race (the inner
+    ring's frame carries its prescribed tilt). The contact point (T, Z, 3: axial x, y, z in m, bearing frame)
+    lies on the raceway, the groove radius from its curvature centre along the line through the ball centre:
+    its path is the contact trajectory of the paper's figure 13.
     """
     p = problem.params
     z = int(p[P.P_Z])
@@ -394,25 +394,26 @@ def race_geometry(problem: Problem,
     r, th, ax = y[:, :z], y[:, z:2 * z], y[:, b:b + z]
     half = 0.5 * p[P.P_D]
     out = {}
-    for race, rho, rg, c_ax, cy, cz in (
-            ("outer", 0.5 * p[P.P_DO] - p[P_RGO], p[P_RGO], 0.0, 0.0, 0.0),
-            ("inner", 0.5 * p[P.P_DI] + p[P_RGI], p[P_RGI], y[:, b + 4 * z][:, None], y[:, 5 * z][:, None],
-             y[:, 5 * z + 1][:, None])):
-        dy, dz = r * np.cos(th) - cy, r * np.sin(th) - cz
-        dist = np.hypot(dy, dz)
-        er = dist - rho
-        ex = ax - c_ax
+    rot = np.array(_tilt(p)).reshape(3, 3)
+    ball = np.stack([ax, r * np.cos(th), r * np.sin(th)], axis=-1)  # (T, Z, 3) in the fixed frame
+    for race, rho, rg, centre, frame in (
+            ("outer", 0.5 * p[P.P_DO] - p[P_RGO], p[P_RGO], np.zeros((len(y), 1, 3)), np.eye(3)),
+            ("inner", 0.5 * p[P.P_DI] + p[P_RGI], p[P_RGI],
+             np.stack([y[:, b + 4 * z], y[:, 5 * z], y[:, 5 * z + 1]], axis=-1)[:, None, :], rot)):
+        q = (ball - centre) @ frame  # R^T (P - C): the ball centre in the race's frame
+        rq = np.hypot(q[..., 1], q[..., 2])
+        ex, er = q[..., 0], rq - rho
         length = np.hypot(ex, er)
         radial = rho + rg * er / length  # distance of the contact point from the ring's axis
-        point = np.stack([c_ax + rg * ex / length + 0 * r, cy + radial * dy / dist, cz + radial * dz / dist], axis=-1)
-        out[race] = (np.clip(length - (rg - half), 0.0, None), np.arctan2(ex, np.abs(er)), point)
+        local = np.stack([rg * ex / length, radial * q[..., 1] / rq, radial * q[..., 2] / rq], axis=-1)
+        out[race] = (np.clip(length - (rg - half), 0.0, None), np.arctan2(ex, np.abs(er)),
+                     centre + local @ frame.T)
     return out
 
 
 def spatial_energy(problem: Problem, y: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     """Total mechanical energy (J) along samples y (T, n): kinetic (translation and spin), Hertz, gravity and
-    load potentials. With the dissipated energy added and the drive's input work taken away it is conserved
-    (the ring's prescribed tilt is left out of the Hertz part, as in :func:`race_geometry`)."""
+    load potentials. With the dissipated energy added and the drive's input work taken away it is conserved."""
     p = problem.params
     z = int(p[P.P_Z])
     b = 5 * z + 6
