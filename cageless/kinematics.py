@@ -35,6 +35,7 @@ __all__ = [
     "startup_duration",
     "STARTUP_REVOLUTIONS",
     "slip_rate",
+    "rereference_slip",
     "centrifugal_force",
 ]
 
@@ -196,6 +197,21 @@ def slip_rate(
             "cage_speed_rad_s", "must be finite and non-zero to define a slip rate", cage_speed_rad_s
         )
     return 1.0 - np.asarray(orbital_speed_rad_s, dtype=np.float64) / cage_speed_rad_s
+
+
+def rereference_slip(slip: npt.ArrayLike, ball_diameter_m: float, pitch_diameter_m: float,
+                     from_angle_rad: float, to_angle_rad: float) -> npt.NDArray[np.float64]:
+    """Slip rates referred to the cage speed of another contact angle.
+
+    A slip rate s = 1 - theta_dot / omega_c(alpha) depends on alpha through omega_c (DESIGN §3); with
+    gamma = D / d_m, omega_c(a) / omega_c(b) = (1 - gamma cos a) / (1 - gamma cos b), so the same orbital
+    speeds give 1 - (1 - s) omega_c(from) / omega_c(to).
+    """
+    _check_angle(from_angle_rad)
+    _check_angle(to_angle_rad)
+    gamma = ball_diameter_m / pitch_diameter_m
+    ratio = (1.0 - gamma * math.cos(from_angle_rad)) / (1.0 - gamma * math.cos(to_angle_rad))
+    return 1.0 - (1.0 - np.asarray(slip, dtype=np.float64)) * ratio
 
 
 def centrifugal_force(masses: Masses, geometry: Geometry, cage_speed_rad_s: float) -> float:

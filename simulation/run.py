@@ -149,17 +149,47 @@ def _observables(pr: Problem, y: npt.NDArray[np.float64], scene: Scene,
         sl = S.SpatialLayout(z).slices()
         axial = y[:, sl["axial"]]
         spin[:, :, 1], spin[:, :, 2] = y[:, sl["spin_y"]], y[:, sl["spin_z"]]
+        bb = p[P.P_KB] * np.clip(d - _centre_gap(r, th, axial), 0, None) ** 1.5
+        contacts["ball_ball_normal"] = bb
         ring[:, 0] = y[:, sl["ring_axial"]][:, 0]
         for race, (overlap, angle, point) in S.race_geometry(pr, y).items():
             k_n = p[P.P_KI] if race == "inner" else p[P.P_KO]
             contacts[f"{race}_normal"] = k_n * overlap**1.5
             contacts[f"{race}_angle"] = angle
             contacts[f"{race}_point"] = point
+    if p[P.P_F_TRAC] > 0.5:
+        contacts["ball_ball_traction"] = _ball_ball_traction(p, r, th, rd, thd, axial, spin, y, pr, bb)
     return {
         "balls": {"radius": r, "axial": axial, "spin": spin},
         "contacts": contacts,
         "inner_ring": {"position": ring, "tilt": np.zeros((len(y), 2))},
     }
+
+
+def _centre_gap(r: np.ndarray, th: np.ndarray, axial: np.ndarray) -> np.ndarray:
+    """Distance (m) between the centres of ball j and ball j+1 (T, Z)."""
+    pos = np.stack([axial, r * np.cos(th), r * np.sin(th)], axis=-1)
+    return np.linalg.norm(np.roll(pos, -1, axis=1) - pos, axis=-1)
+
+
+def _ball_ball_traction(p: np.ndarray, r: np.ndarray, th: np.ndarray, rd: np.ndarray, thd: np.ndarray,
+                        axial: np.ndarray, spin: np.ndarray, y: np.ndarray, pr: Problem,
+                        normal: np.ndarray) -> np.ndarray:
+    """Magnitude (N) of the friction between ball j and ball j+1 (T, Z), from the sliding of their surfaces
+    along the contact plane, as in the models' pair forces (elastic normal force; 0 where apart)."""
+    z = r.shape[1]
+    half = 0.5 * p[P.P_D]
+    axial_dot = y[:, S.SpatialLayout(z).slices()["axial_dot"]] if pr.model_id == S.MODEL_ID else np.zeros_like(r)
+    pos = np.stack([axial, r * np.cos(th), r * np.sin(th)], axis=-1)
+    vel = np.stack([axial_dot, rd * np.cos(th) - r * thd * np.sin(th), rd * np.sin(th) + r * thd * np.cos(th)], -1)
+    k = np.roll(np.arange(z), -1)
+    n = pos[:, k] - pos
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    u = vel - vel[:, k] + np.cross(spin + spin[:, k], half * n)  # surface of j against j+1
+    u -= np.sum(u * n, axis=-1, keepdims=True) * n
+    u_s = np.linalg.norm(u, axis=-1)
+    u_r = 0.5 * half * np.linalg.norm(np.cross(spin - spin[:, k], n), axis=-1)
+    return np.abs(tangential_force(u_s, u_r, normal, p))
 
 
 def nominal_contact_angle(scene: Scene, groups: dict[str, dict[str, np.ndarray]]) -> float:

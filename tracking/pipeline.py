@@ -269,6 +269,7 @@ def _finish(path: Path, video: FrameSource, table: pd.DataFrame, loc: BearingLoc
         speed_rpm=conditions.speed_rpm, radial_load_n=conditions.radial_load_n, axial_load_n=conditions.axial_load_n,
         ball_diameter_m=g.ball_diameter_m, pitch_diameter_m=g.pitch_diameter_m, direction=direction,
         config={"tracking": options.to_dict(), "conditions": conditions.to_dict(), "bearing": bearing.to_dict(),
+                "slip_contact_angle_rad": 0.0,
                 "video": meta.to_dict() | {"extra": {}}},
         video=VideoInfo(fps=float(fps), px_per_mm=float(px_per_mm), centre_px=orbit.centre,
                         camera_roll_rad=roll, input_file=path.name, input_sha256=prov.finish().inputs[0].sha256),

@@ -83,3 +83,21 @@ def test_solver_failure_is_an_incomplete_trace(tmp_path):
     with pytest.raises(UsageError):
         moment = Scene(conditions=OperatingConditions(3000.0, 500.0), moment_load_nm=1.0)
         simulate(moment, choose_model(moment), progress=False)
+
+
+@pytest.mark.parametrize("axial", [0.0, 400.0])
+def test_ball_ball_friction_is_in_the_trace(axial):
+    """Ball-ball friction (magnitude, N) where neighbours touch: zero where apart, never above the peak of the
+    traction curve times the normal force (simulation.parameters: peak 0.06), and present in the packed start."""
+    from simulation.effects import choose_model
+    from simulation.parameters import ModelParameters
+    from simulation.run import simulate
+    from simulation.scene import Scene
+    from cageless.conditions import OperatingConditions
+
+    scene = Scene(conditions=OperatingConditions(3000.0, 500.0, axial), duration_s=0.01, initial_gap_fraction=0.0)
+    c = simulate(scene, choose_model(scene), progress=False).trace.groups["contacts"]
+    f, q = c["ball_ball_traction"], c["ball_ball_normal"]
+    assert np.all(f >= 0) and np.all(f[q == 0] == 0)
+    assert np.all(f <= ModelParameters().traction_peak_coefficient * q + 1e-12)
+    assert np.sum(f > 0.01) > 10  # the packed balls rub at the start

@@ -44,6 +44,9 @@ from simulation.scene import Scene
 
 #: "a few times the static Hertz deflection"
 OVERLAP_FACTOR = 8.0
+#: Window of the convergence statistics after the start-up (s). At 10 N the ring is chaotic enough that a
+#: 150 ms window moved the peak by 0.51 pp between the two tolerances; the statistics need longer.
+STATISTICS_S = 0.3
 
 CASES = {
     "1800rpm-bunching": (1800, 500, {}, {}),
@@ -108,12 +111,12 @@ def test_hard_case_is_stable(name):
 @pytest.mark.slow
 @pytest.mark.parametrize("name", list(CASES))
 def test_hard_case_statistics_converge(name):
-    """Settled runs (start-up plus 150 ms): rtol 1e-6 -> 1e-7 with the largest step halved moves the peak slip
+    """Settled runs (start-up plus STATISTICS_S): rtol 1e-6 -> 1e-7 with the largest step halved moves the peak slip
     in the unloaded zone by < 0.5 pp and the mean |change| of the 1-degree slip profile by < 0.5 pp (DESIGN §7)."""
     g = default_bearing().geometry
     rpm = CASES[name][0]
     settle = startup_duration(rpm, g.ball_diameter_m, g.pitch_diameter_m)
-    scene, par = _scene(name, settle + 0.15)
+    scene, par = _scene(name, settle + STATISTICS_S)
     profiles, peaks = [], []
     for rtol, max_step in ((1e-6, 2e-6), (1e-7, 1e-6)):
         tr = simulate(scene, choose_model(scene), parameters=par, rtol=rtol, max_step=max_step, progress=False).trace
