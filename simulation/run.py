@@ -11,15 +11,14 @@ from __future__ import annotations
 import json
 import math
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
-from tqdm.auto import tqdm
 
-from cageless.errors import UsageError
+from cageless.errors import ParameterError, UsageError, suggest
 from cageless.kinematics import slip_rate, theoretical_cage_speed
 from cageless.profiles import angle_profile
 from cageless.provenance import Provenance
@@ -34,7 +33,8 @@ from simulation.parameters import ModelParameters
 from simulation.quasistatic import radial_load_distribution
 from simulation.scene import Scene
 from simulation.problem import Problem
-from simulation.solve import FORCE_JUMP, Solution, solve
+from simulation.chunks import solve_chunks
+from simulation.solve import FORCE_JUMP, METHODS, Solution
 
 __all__ = ["SimulationResult", "build_problem", "check_supported", "initial_state", "simulate",
            "peak_unloaded_slip",
@@ -223,47 +223,24 @@ def _films(scene: Scene, inner: np.ndarray, outer: np.ndarray, ur_i: np.ndarray,
     return out
 
 
-def _solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: str, max_step: float,
-                  chunks: int, progress: bool, max_steps: int, force_jump: float) -> Solution:
-    edges = np.unique(np.linspace(0, len(t) - 1, chunks + 1).astype(int))
-    ys, steps, rej, rhs, wall, onset, changes, jumps = [pr.y0[None, :]], 0, 0, 0, 0.0, 0, 0, 0
-    y0, aux, t0 = pr.y0.copy(), pr.aux.copy(), float(t[0])
-    sol = None
-    with tqdm(total=float(t[-1] - t[0]), desc="simulated s", unit="s", disable=not progress, leave=False) as bar:
-        for a, b in zip(edges[:-1], edges[1:], strict=True):
-            part = replace(pr, aux=aux, y0=y0, t0=t0)
-            sol = solve(part, t[a + 1:b + 1], method=method, rtol=rtol, max_step=max_step,
-                        max_steps=max(1, max_steps - steps - rej), force_jump=force_jump)
-            ys.append(sol.y)
-            steps, rej, rhs, wall = steps + sol.n_steps, rej + sol.n_rejected, rhs + sol.n_rhs, wall + sol.wall_s
-            onset, changes = onset + sol.n_onset_retries, changes + sol.n_contact_changes
-            jumps += sol.n_force_jump_retries
-            bar.update(float(t[b] - t[a]))
-            if not sol.success:
-                break
-            y0, aux, t0 = sol.y[-1].copy(), sol.extra.get("aux", aux), float(t[b])
-    y = np.concatenate(ys)
-    if len(y) < len(t):
-        y = np.vstack([y, np.full((len(t) - len(y), y.shape[1]), np.nan)])
-    assert sol is not None
-    return Solution(t=t, y=y, status=sol.status, message=sol.message, method=method, n_steps=steps,
-                    n_rejected=rej, n_rhs=rhs, wall_s=wall, n_onset_retries=onset, n_contact_changes=changes,
-                    n_force_jump_retries=jumps, extra={"aux": aux})
-
-
 def simulate(scene: Scene, choice: ModelChoice, parameters: ModelParameters | None = None, rtol: float = 1e-6,
-             sample_rate_hz: float = 10_000.0, method: str = "dp5", max_step: float = 2e-6,
+             sample_rate_hz: float = 10_000.0, method: str = "auto", max_step: float = 2e-6,
              out: str | Path | None = None, progress: bool = True, config: dict[str, Any] | None = None,
              max_steps: int = 50_000_000, force_jump: float = FORCE_JUMP) -> SimulationResult:
     """Run ``scene`` with the model ``choice`` and (with ``out``) write the trace atomically.
 
-    ``max_steps`` bounds the accepted plus rejected steps of the whole run; ``force_jump`` is the
-    force-jump fraction of :func:`simulation.solve.solve`.
+    ``method`` is ``"auto"`` (compiled DP5, switching to a stiff solver when that pays: see
+    :mod:`simulation.chunks`) or a key of :data:`simulation.solve.METHODS`. ``max_steps`` bounds the
+    accepted plus rejected steps of the whole run; ``force_jump`` is the force-jump fraction of
+    :func:`simulation.solve.solve`.
 
     A solver failure does not raise: the result's ``solution.success`` is False and the trace's
     ``status`` says ``"incomplete: <why>"``; samples after the failure are NaN.
     """
     check_supported(scene)
+    if method != "auto" and method not in METHODS:
+        raise ParameterError("method", "is not a solver" + (suggest(method, [*METHODS, "auto"]) or
+                                                            f"; use auto or one of {list(METHODS)}"), method)
     par = parameters or ModelParameters()
     prov = Provenance.start(config={"scene": scene.to_dict(), "model": json.loads(choice.to_json()),
                                     "solver": {"method": method, "rtol": rtol, "max_step": max_step,
@@ -272,12 +249,14 @@ def simulate(scene: Scene, choice: ModelChoice, parameters: ModelParameters | No
     pr = build_problem(scene, choice, par)
     t = np.arange(0.0, scene.duration_s + 0.5 / sample_rate_hz, 1.0 / sample_rate_hz)
     start = time.perf_counter()
-    sol = _solve_chunks(pr, t, rtol, method, max_step, min(50, len(t) - 1), progress, max_steps, force_jump)
+    sol = solve_chunks(pr, t, rtol, method, max_step, min(50, len(t) - 1), progress, max_steps, force_jump)
     wall = time.perf_counter() - start
     provenance = prov.finish().to_dict()
     provenance["solver_stats"] = {"n_steps": sol.n_steps, "n_rejected": sol.n_rejected, "n_rhs": sol.n_rhs,
                                   "n_onset_retries": sol.n_onset_retries, "n_contact_changes": sol.n_contact_changes,
                                   "n_force_jump_retries": sol.n_force_jump_retries,
+                                  "n_stiff_steps": sol.n_stiff_steps, "method": sol.method,
+                                  "switch_probes": sol.extra.get("switches", []),
                                   "onset_step_s": pr.onset_step, "wall_s": wall}
     trace = _to_trace(scene, choice, pr, sol, rtol, wall, provenance)
     if out is not None:

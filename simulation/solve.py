@@ -57,6 +57,9 @@ class Solution:
     n_onset_retries: int = 0
     n_contact_changes: int = 0
     n_force_jump_retries: int = 0
+    #: Accepted steps at the edge of the explicit method's stability region (compiled methods only): when
+    #: most steps are, the step size is set by stiffness, not accuracy.
+    n_stiff_steps: int = 0
     extra: dict[str, Any] = field(default_factory=dict)
 
     @property
@@ -70,7 +73,7 @@ def _compiled(name: str, integrate: Callable[..., int]) -> Callable[..., Solutio
     def run(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float, first_step: float | None,
             max_steps: int, force_jump: float) -> Solution:
         out = np.full((len(t_eval), len(pr.y0)), np.nan)
-        stats = np.zeros(7)
+        stats = np.zeros(8)
         floor = np.zeros(len(pr.y0)) if pr.jump_floor is None else pr.jump_floor.astype(np.float64)
         aux = pr.aux.copy()
         h0 = first_step or min(max_step, 1e-3 * max(t_eval[-1] - pr.t0, 1e-12))
@@ -81,7 +84,8 @@ def _compiled(name: str, integrate: Callable[..., int]) -> Callable[..., Solutio
         return Solution(t=t_eval, y=out, status=int(status), message=_MESSAGES[int(status)], method=name,
                         n_steps=int(stats[0]), n_rejected=int(stats[1]), n_rhs=int(stats[2]),
                         wall_s=time.perf_counter() - t0, n_onset_retries=int(stats[4]),
-                        n_contact_changes=int(stats[5]), n_force_jump_retries=int(stats[6]), extra={"aux": aux, "last_h": float(stats[3])})
+                        n_contact_changes=int(stats[5]), n_force_jump_retries=int(stats[6]),
+                        n_stiff_steps=int(stats[7]), extra={"aux": aux, "last_h": float(stats[3])})
 
     return run
 

@@ -54,7 +54,9 @@ def dp5_integrate(model_id, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, max_st
     length (never below ``h_onset``): for each component i with ``jump_floor[i] > 0`` (the
     accelerations), |f_i(end) - f_i(start)| > ``force_jump`` (max(|f_i(start)|, |f_i(end)|) + floor_i).
     ``stats`` receives [n_steps, n_rejected, n_rhs, last_h, n_onset_retries, n_contact_changes,
-    n_force_jump_retries].
+    n_force_jump_retries, n_stiff_steps]. A stiff step is an accepted step at the edge of the method's
+    stability region: h |lambda| > 3.25, with |lambda| estimated as ||f(y1) - f(y_6)|| / ||y1 - y_6|| from
+    the last two stages (Hairer & Wanner, *Solving ODEs II*, sect. IV.2, the test of their DOPRI5 code).
     Returns a status code:
     0 ok, 1 too many steps, 2 step-size underflow, 3 non-finite state.
     """  # noqa: D401
@@ -74,6 +76,7 @@ def dp5_integrate(model_id, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, max_st
     sig = model_signature(model_id, y, p) if h_onset > 0.0 else 0.0
     n_onset = 0
     n_jumps = 0
+    n_stiff = 0
     n_changes = 0
     n_rhs = 1
     n_steps = 0
@@ -153,6 +156,13 @@ def dp5_integrate(model_id, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, max_st
                 h = max(0.5 * h, h_onset)
                 continue
         if err <= 1.0:
+            num = 0.0
+            den = 0.0
+            for i in range(n):
+                num += (k7[i] - k6[i]) ** 2
+                den += (ynew[i] - yt[i]) ** 2
+            if den > 0.0 and h * h * num > 3.25 * 3.25 * den:
+                n_stiff += 1
             fac = fac11 / err_old ** 0.04
             fac = max(0.1, min(5.0, fac / 0.9))
             t_new = t + h
@@ -177,6 +187,7 @@ def dp5_integrate(model_id, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, max_st
     stats[4] = n_onset
     stats[5] = n_changes
     stats[6] = n_jumps
+    stats[7] = n_stiff
     return status
 
 
