@@ -72,7 +72,7 @@ EFFECTS: tuple[EffectSpec, ...] = (
                "and friction from the surface sliding speed", _always("no cage: neighbours meet")),
     EffectSpec("ball_ball_film", "squeeze film between neighbouring balls", _lubricated, needs_lubricant=True),
     EffectSpec("gravity", "m g on balls and ring", _gravity),
-    EffectSpec("drag", "1/2 C_D rho A V^2 on the orbit and a churning moment on the spin", _drag),
+    EffectSpec("drag", "1/2 C_D rho A V^2 against the orbital motion (no churning moment on the spin)", _drag),
 )
 _BY_NAME = {e.name: e for e in EFFECTS}
 

@@ -69,9 +69,6 @@ def peak_unloaded_slip(trace: Trace, settle_s: float = 0.0, bin_deg: float = 1.0
 
 def check_supported(scene: Scene) -> None:
     """Refuse, before any compile or solve, a scene this release cannot run."""
-    if scene.moment_load_nm > 0:
-        raise UsageError("moment loads are not in this release: the spatial model prescribes the ring's tilt "
-                         "(--misalignment-rad) instead of solving it. Set the moment load to 0.")
     if scene.orientation != "horizontal":
         raise UsageError("a vertical shaft is not in this release: gravity acts along -z (horizontal shaft).")
 
@@ -109,7 +106,8 @@ def build_problem(scene: Scene, choice: ModelChoice, parameters: ModelParameters
     if choice.level == "spatial":
         return S.spatial_problem(scene.bearing, theta, radius, ring, scene.conditions.radial_load_n,
                                  axial_load_n=scene.conditions.axial_load_n,
-                                 misalignment_rad=(scene.misalignment_rad, 0.0), strips=parameters.strips, **kw)
+                                 misalignment_rad=(scene.misalignment_rad, 0.0), strips=parameters.strips,
+                                 moment_load_nm=scene.moment_load_nm, **kw)
     return P.planar_problem(scene.bearing, theta, radius, ring, scene.conditions.radial_load_n, **kw)
 
 
@@ -145,7 +143,9 @@ def _observables(pr: Problem, y: npt.NDArray[np.float64], scene: Scene,
     spin[:, :, 0] = om
     ring = np.column_stack([np.zeros(len(y)), cy[:, 0], cz[:, 0]])
     axial = np.zeros_like(r)
+    tilt = np.zeros((len(y), 2))
     if pr.model_id == S.MODEL_ID:
+        tilt = y[:, -4:-2] + pr.params[[S.P_TILT_Y, S.P_TILT_Z]]  # about y and z: misalignment plus the free tilt
         sl = S.SpatialLayout(z).slices()
         axial = y[:, sl["axial"]]
         spin[:, :, 1], spin[:, :, 2] = y[:, sl["spin_y"]], y[:, sl["spin_z"]]
@@ -162,7 +162,7 @@ def _observables(pr: Problem, y: npt.NDArray[np.float64], scene: Scene,
     return {
         "balls": {"radius": r, "axial": axial, "spin": spin},
         "contacts": contacts,
-        "inner_ring": {"position": ring, "tilt": np.zeros((len(y), 2))},
+        "inner_ring": {"position": ring, "tilt": tilt},
     }
 
 

@@ -43,7 +43,10 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--duration", type=finite_float, default=0.05, help="simulated time (s, default 0.05)")
     p.add_argument("--gravity", type=finite_float, default=9.81, help="gravity (m/s^2, default 9.81; 0 for none)")
     p.add_argument("--orientation", choices=("horizontal", "vertical"), default="horizontal", help="shaft orientation")
-    p.add_argument("--misalignment-rad", type=finite_float, default=0.0, help="inner-ring tilt (rad)")
+    p.add_argument("--misalignment-rad", type=finite_float, default=0.0,
+                   help="prescribed inner-ring tilt about y (rad); the ring tilts further under the contacts")
+    p.add_argument("--moment-load-nm", type=finite_float, default=0.0,
+                   help="moment load on the inner ring about y (N m); selects the spatial level")
     p.add_argument("--oil-air-density", type=finite_float, help="oil-air mixture density (kg/m^3); enables drag")
     p.add_argument("--dry", action="store_true", help="no lubricant")
     p.add_argument("--seed", type=int, default=0, help="perturbs the initial gaps")
@@ -82,7 +85,8 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
         bearing = dataclasses.replace(bearing, lubricant=None)
     scene = Scene(conditions=OperatingConditions(args.speed_rpm, args.radial_load_n, args.axial_load_n),
                   bearing=bearing, gravity_m_s2=args.gravity, orientation=args.orientation,
-                  misalignment_rad=args.misalignment_rad, oil_air_density_kg_m3=args.oil_air_density,
+                  misalignment_rad=args.misalignment_rad, moment_load_nm=args.moment_load_nm,
+                  oil_air_density_kg_m3=args.oil_air_density,
                   duration_s=args.duration, speed_ramp_s=args.speed_ramp, seed=args.seed)
     choice = choose_model(scene, args.level, parse_effect_overrides(args.effect), args.force)
     if args.explain:

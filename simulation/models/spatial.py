@@ -1,19 +1,25 @@
 """The spatial cageless-bearing model (DESIGN §6): axial positions, full spin vectors, contact angles.
 
-States (n = 9 Z + 8). The first 5 Z + 6 are laid out exactly as in the planar
+States (n = 9 Z + 12). The first 5 Z + 6 are laid out exactly as in the planar
 model (r, theta, their rates, spin about the shaft axis x, the ring centre
 (y, z) and its velocity, input work, dissipated energy), so everything that
 reads a planar state reads the planar part of a spatial one. Then, per ball,
-the axial position x and its rate and the spin components about y and z; last
-the ring's axial position and rate.
+the axial position x and its rate and the spin components about y and z; then
+the ring's axial position and rate; last the ring's tilt (beta_y, beta_z) about
+the prescribed misalignment and its rates.
 
 Contacts follow the groove-curvature-centre geometry: the inner (outer) groove
 centre lies on a circle of radius rho_i = d_i/2 + f_i D (rho_o = d_o/2 - f_o D)
 in the ring's mid-plane; a ball touches when its centre is farther than
 (f - 1/2) D from the groove centre, along the normal through both, so contact
 angles come out of the positions. The inner ring translates in x, y and z under
-the radial and axial loads and gravity; its tilt (misalignment) is prescribed,
-not a degree of freedom. Race traction is integrated over ``m`` strips across
+the radial and axial loads and gravity, and tilts about y and z under the
+moments of the inner contacts and a moment load, as the paper's
+I_r theta_ry'' = sum M_y, I_r theta_rz'' = sum M_z (§3.1; Lagrange's form with the
+kinetic energy I_r (beta_y'^2 + beta_z'^2) / 2, no gyroscopic term for the ring,
+as in the paper); a prescribed misalignment is the tilt it starts from and
+swings about. The ring's tilting moves its raceway, so the contact velocities
+include it. Race traction is integrated over ``m`` strips across
 the major axis of the contact ellipse, each carrying its share of the Hertz load
 (proportional to 1 - xi^2), so spin about the contact normal and differential
 slip produce forces and moments; ``m = 1`` is a point contact. Ball-ball contact
@@ -43,25 +49,27 @@ from simulation.problem import Problem
 __all__ = ["MODEL_ID", "SpatialLayout", "spatial_problem", "spatial_rhs", "spatial_signature", "race_geometry", "spatial_energy"]
 
 MODEL_ID = 4
-P_RGI, P_RGO, P_FA, P_TILT_Y, P_TILT_Z, P_STRIPS, P_AI, P_AO = range(P.N_PARAMS, P.N_PARAMS + 8)
-N_PARAMS = P.N_PARAMS + 8
+P_RGI, P_RGO, P_FA, P_TILT_Y, P_TILT_Z, P_STRIPS, P_AI, P_AO, P_IR, P_MY = range(P.N_PARAMS, P.N_PARAMS + 10)
+N_PARAMS = P.N_PARAMS + 10
 
 
 class SpatialLayout(P.PlanarLayout):
-    """State layout: the planar one, then x, x', omega_y, omega_z per ball and the ring's (x, x')."""
+    """State layout: the planar one, then x, x', omega_y, omega_z per ball, the ring's (x, x') and its tilt
+    (beta_y, beta_z, beta_y', beta_z') about the prescribed misalignment."""
 
     @property
     def size(self) -> int:
-        """Number of states, 9 Z + 8."""
-        return 9 * self.n_balls + 8
+        """Number of states, 9 Z + 12."""
+        return 9 * self.n_balls + 12
 
     def slices(self) -> dict[str, slice]:
-        """The planar slices plus axial, axial_dot, spin_y, spin_z and ring_axial."""
+        """The planar slices plus axial, axial_dot, spin_y, spin_z, ring_axial and ring_tilt."""
         z = self.n_balls
         s = super().slices()
         b = 5 * z + 6
         s.update({"axial": slice(b, b + z), "axial_dot": slice(b + z, b + 2 * z), "spin_y": slice(b + 2 * z, b + 3 * z),
-                  "spin_z": slice(b + 3 * z, b + 4 * z), "ring_axial": slice(b + 4 * z, b + 4 * z + 2)})
+                  "spin_z": slice(b + 3 * z, b + 4 * z), "ring_axial": slice(b + 4 * z, b + 4 * z + 2),
+                  "ring_tilt": slice(b + 4 * z + 2, b + 4 * z + 6)})
         return s
 
 
@@ -71,9 +79,12 @@ def _cross(a0, a1, a2, b0, b1, b2):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _tilt(p):  # pragma: no cover - compiled
-    """Rotation R = Rz(bz) Ry(by) of the inner ring, as 9 numbers (row-major)."""
-    cb, sb, cg, sg = math.cos(p[P_TILT_Y]), math.sin(p[P_TILT_Y]), math.cos(p[P_TILT_Z]), math.sin(p[P_TILT_Z])
+def _tilt(y, p):  # pragma: no cover - compiled
+    """Rotation R = Rz(bz) Ry(by) of the inner ring, as 9 numbers (row-major): the prescribed misalignment
+    plus the ring's tilt states."""
+    t = y.shape[0] - 4
+    by, bz = p[P_TILT_Y] + y[t], p[P_TILT_Z] + y[t + 1]
+    cb, sb, cg, sg = math.cos(by), math.sin(by), math.cos(bz), math.sin(bz)
     return (cg * cb, -sg, cg * sb, sg * cb, cg, sg * sb, -sb, 0.0, cb)
 
 
@@ -102,15 +113,16 @@ def _groove(y, p, j, z, inner, rot, c, s):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, fastmath=FASTMATH)
-def _race(y, p, j, z, inner, w_i, rot, c, s):  # pragma: no cover - compiled
-    """One race contact of ball j: force (3), torque (3) on the ball, input and dissipated power, overlap."""
+def _race(y, p, j, z, inner, w_i, rot, c, s, wt):  # pragma: no cover - compiled
+    """One race contact of ball j: force (3), torque (3) on the ball, input and dissipated power, overlap, and
+    the moment (3) on the inner ring about its centre. ``wt`` is the ring's tilting angular velocity (3)."""
     d = p[P.P_D]
     half = 0.5 * d
     b = 5 * z + 6
     if not inner:
         rot = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
     rq, cq, sq, ex, er, ln, delta, rho, rg = _groove(y, p, j, z, inner, rot, c, s)
-    zero = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    zero = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     if delta <= 0.0:
         return zero
     r, rd, thd = y[j], y[2 * z + j], y[3 * z + j]
@@ -132,6 +144,14 @@ def _race(y, p, j, z, inner, w_i, rot, c, s):  # pragma: no cover - compiled
     ty = rot[4] * -sq + rot[5] * cq
     tz = rot[7] * -sq + rot[8] * cq
     q = k_n * delta * math.sqrt(delta)
+    # race surface point along the normal (relative to the ring centre, fixed frame) and its radius
+    r_c = rho + rg * nrr
+    xrx = (rot[0] * rg * nrx + rot[1] * r_c * cq + rot[2] * r_c * sq)
+    xry = (rot[3] * rg * nrx + rot[4] * r_c * cq + rot[5] * r_c * sq)
+    xrz = (rot[6] * rg * nrx + rot[7] * r_c * cq + rot[8] * r_c * sq)
+    if inner:  # the ring's surface moves with its centre and its tilting
+        ttx, tty, ttz = _cross(wt[0], wt[1], wt[2], xrx, xry, xrz)
+        vcx, vcy, vcz = vcx + ttx, vcy + tty, vcz + ttz
     rvx, rvy, rvz = vx - vcx, vy - vcy, vz - vcz
     p_diss = 0.0
     if p[P.P_F_LUB] > 0.5:
@@ -141,14 +161,12 @@ def _race(y, p, j, z, inner, w_i, rot, c, s):  # pragma: no cover - compiled
         q = q_d
     fx, fy, fz = -q * nx, -q * ny, -q * nz
     mx = my = mz = 0.0
+    t2x = t2y = t2z = 0.0
     p_in = 0.0
     if p[P.P_F_TRAC] > 0.5 and q > 0.0:
-        # race surface point along the normal, its radius about the ring axis, the ring's spin vector
-        r_c = rho + rg * nrr
+        # the ring's spin vector (the drive), and its whole angular velocity
         wx, wy, wz = (w_i * rot[0], w_i * rot[3], w_i * rot[6]) if inner else (0.0, 0.0, 0.0)
-        xrx = (rot[0] * rg * nrx + rot[1] * r_c * cq + rot[2] * r_c * sq)
-        xry = (rot[3] * rg * nrx + rot[4] * r_c * cq + rot[5] * r_c * sq)
-        xrz = (rot[6] * rg * nrx + rot[7] * r_c * cq + rot[8] * r_c * sq)
+        awx, awy, awz = (wx + wt[0], wy + wt[1], wz + wt[2]) if inner else (0.0, 0.0, 0.0)
         # major axis of the ellipse: across the rolling direction, in the contact plane
         ax_, ay_, az_ = _cross(nx, ny, nz, tx, ty, tz)
         a = a_c * np.cbrt(q)
@@ -157,7 +175,7 @@ def _race(y, p, j, z, inner, w_i, rot, c, s):  # pragma: no cover - compiled
         vt = rvx * tx + rvy * ty + rvz * tz
         u_r = 0.5 * abs(vt * (1.0 - 2.0 * r_c / rq) + bsx * tx + bsy * ty + bsz * tz + rsx * tx + rsy * ty + rsz * tz)
         # relative spin across the strips: slip grows linearly with the strip's offset xi along the major axis
-        wax, way, waz = _cross(ox - wx, oy - wy, oz - wz, ax_, ay_, az_)
+        wax, way, waz = _cross(ox - awx, oy - awy, oz - awz, ax_, ay_, az_)
         u0x, u0y, u0z = rvx + bsx - rsx, rvy + bsy - rsy, rvz + bsz - rsz
         gsx = gsy = gsz = 0.0  # traction on the ball, summed over the strips
         hx = hy = hz = 0.0  # its first moment along the major axis, sum of xi g
@@ -184,7 +202,11 @@ def _race(y, p, j, z, inner, w_i, rot, c, s):  # pragma: no cover - compiled
             # drive power: the ring's spin times the moment of the ball's traction on it
             c1x, c1y, c1z = _cross(xrx, xry, xrz, gsx, gsy, gsz)
             p_in = (c1x + t2x) * wx + (c1y + t2y) * wy + (c1z + t2z) * wz
-    return fx, fy, fz, mx, my, mz, p_in, p_diss, delta
+    rmx = rmy = rmz = 0.0
+    if inner:  # reaction on the ring: -F at the contact point, and -t2
+        rmx, rmy, rmz = _cross(xrx, xry, xrz, -fx, -fy, -fz)
+        rmx, rmy, rmz = rmx - t2x, rmy - t2y, rmz - t2z
+    return fx, fy, fz, mx, my, mz, p_in, p_diss, delta, rmx, rmy, rmz
 
 
 @numba.njit(cache=True, fastmath=FASTMATH)
@@ -246,7 +268,11 @@ def spatial_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     grav = g if p[P.P_F_GRAV] > 0.5 else 0.0
     ramp = p[P.P_RAMP]
     w_i = p[P.P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
-    rot = _tilt(p)
+    rot = _tilt(y, p)
+    tb = y.shape[0] - 4  # tilt states: beta_y, beta_z, their rates
+    s_bz, c_bz = math.sin(p[P_TILT_Z] + y[tb + 1]), math.cos(p[P_TILT_Z] + y[tb + 1])
+    wt = (-s_bz * y[tb + 2], c_bz * y[tb + 2], y[tb + 3])  # angular velocity of the tilting: bz' z + by' Rz y
+    rmx = rmy = rmz = 0.0
     trig = aux.shape[0] - 2 * z  # scratch: cos and sin of every ball's angle, once per call
     for i in range(dydt.shape[0]):
         dydt[i] = 0.0
@@ -261,7 +287,8 @@ def spatial_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     if p[P.P_F_RACE] > 0.5:
         for j in range(z):
             for inner in (False, True):
-                fx, fy, fz, mx, my, mz, pin, pd, _ = _race(y, p, j, z, inner, w_i, rot, aux[trig + j], aux[trig + z + j])
+                fx, fy, fz, mx, my, mz, pin, pd, _, qx, qy, qz = _race(y, p, j, z, inner, w_i, rot, aux[trig + j],
+                                                                       aux[trig + z + j], wt)
                 dydt[b + z + j] += fx
                 dydt[2 * z + j] += fy
                 dydt[3 * z + j] += fz
@@ -270,6 +297,7 @@ def spatial_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
                 dydt[b + 3 * z + j] += mz
                 if inner:
                     rfx, rfy, rfz = rfx - fx, rfy - fy, rfz - fz
+                    rmx, rmy, rmz = rmx + qx, rmy + qy, rmz + qz
                 power_in += pin
                 power += pd
     if p[P.P_F_BB] > 0.5:
@@ -308,6 +336,11 @@ def spatial_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     dydt[5 * z + 2], dydt[5 * z + 3] = rfy / m_ring, rfz / m_ring
     dydt[5 * z + 4], dydt[5 * z + 5] = power_in, power
     dydt[b + 4 * z], dydt[b + 4 * z + 1] = y[b + 4 * z + 1], rfx / m_ring
+    # tilt (Lagrange, kinetic energy I_r (by'^2 + bz'^2) / 2): generalised moments M . d(omega)/d(beta'),
+    # the moment load acting on beta_y (the paper's I_r theta_ry'' = sum M_y, I_r theta_rz'' = sum M_z)
+    dydt[tb], dydt[tb + 1] = y[tb + 2], y[tb + 3]
+    dydt[tb + 2] = (-s_bz * rmx + c_bz * rmy + p[P_MY]) / p[P_IR]
+    dydt[tb + 3] = rmz / p[P_IR]
 
 
 @numba.njit(cache=True)
@@ -315,7 +348,7 @@ def spatial_signature(y, p):  # pragma: no cover - compiled
     """Which contacts are closed, as a number (see :func:`simulation.models.planar.planar_signature`)."""
     z = int(p[P.P_Z])
     b = 5 * z + 6
-    rot = _tilt(p)
+    rot = _tilt(y, p)
     sig = 0.0
     for j in range(z):
         c, s = math.cos(y[z + j]), math.sin(y[z + j])
@@ -335,11 +368,14 @@ def spatial_signature(y, p):  # pragma: no cover - compiled
 def spatial_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLike, ring0: tuple[float, float],
                     radial_load_n: float, axial_load_n: float = 0.0, misalignment_rad: tuple[float, float] = (0.0, 0.0),
                     strips: int = 5, axial0: npt.ArrayLike | None = None, ring_axial0: float = 0.0,
+                    moment_load_nm: float = 0.0, ring_tilt_inertia_kg_m2: float | None = None,
                     **kw: object) -> Problem:
     """The spatial model from a given state; keyword arguments as :func:`~simulation.models.planar.planar_problem`.
 
     ``strips`` is the number m of strips across each race contact ellipse (an accuracy knob; 1 is a
-    point contact). ``misalignment_rad`` tilts the inner ring about y and z.
+    point contact). ``misalignment_rad`` tilts the inner ring about y and z; the ring then tilts further
+    under the contact moments and ``moment_load_nm`` (about y), with the diametral moment of inertia
+    ``ring_tilt_inertia_kg_m2`` (default :func:`ring_tilt_inertia`).
     """
     if not (isinstance(strips, int) and 1 <= strips <= 101):
         raise P.ParameterError("strips", "must be a whole number in 1..101", strips)
@@ -369,13 +405,25 @@ def spatial_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayL
     p[P_FA], (p[P_TILT_Y], p[P_TILT_Z]), p[P_STRIPS] = axial_load_n, misalignment_rad, strips
     p[P_AI] = hertz_contact(*rc["inner"], eta).a_coeff
     p[P_AO] = hertz_contact(*rc["outer"], eta).a_coeff
+    p[P_MY] = moment_load_nm
+    p[P_IR] = ring_tilt_inertia(bearing) if ring_tilt_inertia_kg_m2 is None else ring_tilt_inertia_kg_m2
+    r_i = 0.5 * g.inner_race_diameter_m
+    atol[sl["ring_tilt"]] = (1e-10 * scale / r_i, 1e-10 * scale / r_i, 1e-7 * scale / r_i, 1e-7 * scale / r_i)
     floor = np.zeros(lay.size)
     floor[: 5 * z + 6] = P.planar_jump_floor(flat.params, P.PlanarLayout(z))
     floor[sl["axial_dot"]] = floor[sl["r_dot"]]
     floor[sl["spin_y"]] = floor[sl["spin_z"]] = floor[sl["spin"]]
     floor[sl["ring_axial"]] = (0.0, floor[5 * z + 2])
+    floor[sl["ring_tilt"]] = (0.0, 0.0, r_i / p[P_IR], r_i / p[P_IR])  # 1 N at the race
     return Problem(model_id=MODEL_ID, params=p, aux=flat.aux, y0=y0, t0=0.0, atol=atol,
                    name="spatial cageless bearing", onset_step=flat.onset_step, jump_floor=floor)
+
+
+def ring_tilt_inertia(bearing: Bearing) -> float:
+    """Diametral moment of inertia (kg m^2) of the inner ring for its tilt: a thin hoop of the ring's mass
+    at the inner race radius, m (D_i / 2)^2 / 2 (the paper's I_r, whose value it does not print; its
+    tilt equations, §3.1, carry the inner ring alone, not the shaft)."""
+    return 0.5 * bearing.masses.inner_ring_mass_kg * (0.5 * bearing.geometry.inner_race_diameter_m) ** 2
 
 
 def race_geometry(problem: Problem,
@@ -394,26 +442,36 @@ def race_geometry(problem: Problem,
     r, th, ax = y[:, :z], y[:, z:2 * z], y[:, b:b + z]
     half = 0.5 * p[P.P_D]
     out = {}
-    rot = np.array(_tilt(p)).reshape(3, 3)
     ball = np.stack([ax, r * np.cos(th), r * np.sin(th)], axis=-1)  # (T, Z, 3) in the fixed frame
     for race, rho, rg, centre, frame in (
-            ("outer", 0.5 * p[P.P_DO] - p[P_RGO], p[P_RGO], np.zeros((len(y), 1, 3)), np.eye(3)),
+            ("outer", 0.5 * p[P.P_DO] - p[P_RGO], p[P_RGO], np.zeros((len(y), 1, 3)), np.broadcast_to(np.eye(3), (len(y), 3, 3))),
             ("inner", 0.5 * p[P.P_DI] + p[P_RGI], p[P_RGI],
-             np.stack([y[:, b + 4 * z], y[:, 5 * z], y[:, 5 * z + 1]], axis=-1)[:, None, :], rot)):
-        q = (ball - centre) @ frame  # R^T (P - C): the ball centre in the race's frame
+             np.stack([y[:, b + 4 * z], y[:, 5 * z], y[:, 5 * z + 1]], axis=-1)[:, None, :], ring_rotations(problem, y))):
+        q = np.einsum("tzi,tij->tzj", ball - centre, frame)  # R^T (P - C): the ball centre in the race's frame
         rq = np.hypot(q[..., 1], q[..., 2])
         ex, er = q[..., 0], rq - rho
         length = np.hypot(ex, er)
         radial = rho + rg * er / length  # distance of the contact point from the ring's axis
         local = np.stack([rg * ex / length, radial * q[..., 1] / rq, radial * q[..., 2] / rq], axis=-1)
         out[race] = (np.clip(length - (rg - half), 0.0, None), np.arctan2(ex, np.abs(er)),
-                     centre + local @ frame.T)
+                     centre + np.einsum("tzj,tij->tzi", local, frame))
     return out
+
+
+def ring_rotations(problem: Problem, y: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    """The inner ring's rotation matrices R = Rz(beta_z) Ry(beta_y) along samples y (T, 3, 3): the prescribed
+    misalignment plus the tilt states."""
+    p = problem.params
+    by, bz = p[P_TILT_Y] + y[:, -4], p[P_TILT_Z] + y[:, -3]
+    cb, sb, cg, sg = np.cos(by), np.sin(by), np.cos(bz), np.sin(bz)
+    zero = np.zeros_like(by)
+    return np.stack([cg * cb, -sg, cg * sb, sg * cb, cg, sg * sb, -sb, zero, cb], axis=-1).reshape(-1, 3, 3)
 
 
 def spatial_energy(problem: Problem, y: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     """Total mechanical energy (J) along samples y (T, n): kinetic (translation and spin), Hertz, gravity and
-    load potentials. With the dissipated energy added and the drive's input work taken away it is conserved."""
+    load potentials, the ring's tilt. With the dissipated energy added and the drive's input work taken away it
+    is conserved."""
     p = problem.params
     z = int(p[P.P_Z])
     b = 5 * z + 6
@@ -423,8 +481,9 @@ def spatial_energy(problem: Problem, y: npt.NDArray[np.float64]) -> npt.NDArray[
     spin2 = y[:, 4 * z:5 * z] ** 2 + y[:, b + 2 * z:b + 3 * z] ** 2 + y[:, b + 3 * z:b + 4 * z] ** 2
     cvy, cvz, cvx = y[:, 5 * z + 2], y[:, 5 * z + 3], y[:, b + 4 * z + 1]
     ke = (0.5 * m * np.sum(rd**2 + (r * thd) ** 2 + axd**2, axis=1) + 0.5 * p[P.P_I] * np.sum(spin2, axis=1)
-          + 0.5 * m_ring * (cvx**2 + cvy**2 + cvz**2))
+          + 0.5 * m_ring * (cvx**2 + cvy**2 + cvz**2) + 0.5 * p[P_IR] * (y[:, -2] ** 2 + y[:, -1] ** 2))
     pe = m * g * np.sum(r * np.sin(th), axis=1) + (m_ring * g + p[P.P_FR]) * y[:, 5 * z + 1] - p[P_FA] * y[:, b + 4 * z]
+    pe -= p[P_MY] * y[:, -4]  # the moment load's work on the tilt beta_y
     if p[P.P_F_RACE] > 0.5:
         for race, (overlap, _, _) in race_geometry(problem, y).items():
             pe += 0.4 * (p[P.P_KI] if race == "inner" else p[P.P_KO]) * np.sum(overlap**2.5, axis=1)

@@ -80,9 +80,9 @@ def test_solver_failure_is_an_incomplete_trace(tmp_path):
     tr = read_trace(out)
     assert tr.status.startswith("incomplete: ")
     assert not tr.valid[-1].any()
-    with pytest.raises(UsageError):
-        moment = Scene(conditions=OperatingConditions(3000.0, 500.0), moment_load_nm=1.0)
-        simulate(moment, choose_model(moment), progress=False)
+    with pytest.raises(UsageError, match="vertical shaft"):  # refused before anything runs
+        vertical = Scene(conditions=OperatingConditions(3000.0, 500.0), orientation="vertical")
+        simulate(vertical, choose_model(vertical), progress=False)
 
 
 @pytest.mark.parametrize("axial", [0.0, 400.0])
