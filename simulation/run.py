@@ -67,10 +67,11 @@ def peak_unloaded_slip(trace: Trace, settle_s: float = 0.0, bin_deg: float = 1.0
     return float(zone.max()) if zone.notna().any() else float("nan")
 
 
-def check_supported(scene: Scene) -> None:
-    """Refuse, before any compile or solve, a scene this release cannot run."""
-    if scene.orientation != "horizontal":
-        raise UsageError("a vertical shaft is not in this release: gravity acts along -z (horizontal shaft).")
+def check_supported(scene: Scene, choice: ModelChoice | None = None) -> None:
+    """Refuse, before any compile or solve, a scene this release cannot run with ``choice``."""
+    if scene.orientation == "vertical" and choice is not None and choice.level == "planar" and scene.gravity_m_s2 > 0:
+        raise UsageError("a vertical shaft puts gravity along the shaft, which the planar level cannot carry: "
+                         "let the scene choose the spatial level (drop --level planar).")
 
 
 def initial_state(scene: Scene) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], tuple[float, float]]:
@@ -84,7 +85,8 @@ def initial_state(scene: Scene) -> tuple[npt.NDArray[np.float64], npt.NDArray[np
     g = b.geometry
     theta = P.packed_start(b, seed=scene.seed, spread=scene.initial_gap_fraction)
     radius = np.full(g.n_balls, 0.5 * g.pitch_diameter_m)
-    load = scene.conditions.radial_load_n + b.masses.ring_translational_mass_kg * scene.gravity_m_s2
+    weight = b.masses.ring_translational_mass_kg * scene.gravity_m_s2 if scene.orientation == "horizontal" else 0.0
+    load = scene.conditions.radial_load_n + weight
     if load <= 0:
         return theta, radius, (0.0, 0.0)
     e = radial_load_distribution(g, b.material, load, theta).displacement_m
@@ -100,14 +102,17 @@ def build_problem(scene: Scene, choice: ModelChoice, parameters: ModelParameters
     """The planar or spatial problem of ``choice`` for ``scene``, from the quasi-static start."""
     theta, radius, ring = initial_state(scene)
     effects = {e.name: e.on for e in choice.effects}
-    kw = {"gravity_m_s2": scene.gravity_m_s2 if effects.get("gravity") else 0.0,
+    gravity = scene.gravity_m_s2 if effects.get("gravity") else 0.0
+    vertical = scene.orientation == "vertical"
+    kw = {"gravity_m_s2": 0.0 if vertical else gravity,
           "inner_speed_rad_s": scene.conditions.speed_rad_s, "effects": effects, "parameters": parameters,
           "speed_ramp_s": scene.speed_ramp_s, "oil_air_density_kg_m3": scene.oil_air_density_kg_m3}
     if choice.level == "spatial":
         return S.spatial_problem(scene.bearing, theta, radius, ring, scene.conditions.radial_load_n,
                                  axial_load_n=scene.conditions.axial_load_n,
                                  misalignment_rad=(scene.misalignment_rad, 0.0), strips=parameters.strips,
-                                 moment_load_nm=scene.moment_load_nm, **kw)
+                                 moment_load_nm=scene.moment_load_nm, axial_gravity_m_s2=gravity if vertical else 0.0,
+                                 **kw)
     return P.planar_problem(scene.bearing, theta, radius, ring, scene.conditions.radial_load_n, **kw)
 
 
@@ -237,7 +242,7 @@ def simulate(scene: Scene, choice: ModelChoice, parameters: ModelParameters | No
     A solver failure does not raise: the result's ``solution.success`` is False and the trace's
     ``status`` says ``"incomplete: <why>"``; samples after the failure are NaN.
     """
-    check_supported(scene)
+    check_supported(scene, choice)
     if method != "auto" and method not in METHODS:
         raise ParameterError("method", "is not a solver" + (suggest(method, [*METHODS, "auto"]) or
                                                             f"; use auto or one of {list(METHODS)}"), method)

@@ -49,8 +49,8 @@ from simulation.problem import Problem
 __all__ = ["MODEL_ID", "SpatialLayout", "spatial_problem", "spatial_rhs", "spatial_signature", "race_geometry", "spatial_energy"]
 
 MODEL_ID = 4
-P_RGI, P_RGO, P_FA, P_TILT_Y, P_TILT_Z, P_STRIPS, P_AI, P_AO, P_IR, P_MY = range(P.N_PARAMS, P.N_PARAMS + 10)
-N_PARAMS = P.N_PARAMS + 10
+P_RGI, P_RGO, P_FA, P_TILT_Y, P_TILT_Z, P_STRIPS, P_AI, P_AO, P_IR, P_MY, P_GAX = range(P.N_PARAMS, P.N_PARAMS + 11)
+N_PARAMS = P.N_PARAMS + 11
 
 
 class SpatialLayout(P.PlanarLayout):
@@ -282,7 +282,8 @@ def spatial_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     # accumulators: force (x in the axial slot, y and z in the planar acceleration slots), moments in spin slots
     for j in range(z):
         dydt[3 * z + j] = -m * grav
-    rfx, rfy, rfz = p[P_FA], 0.0, -p[P.P_FR] - m_ring * grav
+        dydt[b + z + j] = -m * p[P_GAX]  # gravity along the shaft (vertical shaft)
+    rfx, rfy, rfz = p[P_FA] - m_ring * p[P_GAX], 0.0, -p[P.P_FR] - m_ring * grav
     power_in = power = 0.0
     if p[P.P_F_RACE] > 0.5:
         for j in range(z):
@@ -369,13 +370,14 @@ def spatial_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayL
                     radial_load_n: float, axial_load_n: float = 0.0, misalignment_rad: tuple[float, float] = (0.0, 0.0),
                     strips: int = 5, axial0: npt.ArrayLike | None = None, ring_axial0: float = 0.0,
                     moment_load_nm: float = 0.0, ring_tilt_inertia_kg_m2: float | None = None,
-                    **kw: object) -> Problem:
+                    axial_gravity_m_s2: float = 0.0, **kw: object) -> Problem:
     """The spatial model from a given state; keyword arguments as :func:`~simulation.models.planar.planar_problem`.
 
     ``strips`` is the number m of strips across each race contact ellipse (an accuracy knob; 1 is a
     point contact). ``misalignment_rad`` tilts the inner ring about y and z; the ring then tilts further
     under the contact moments and ``moment_load_nm`` (about y), with the diametral moment of inertia
-    ``ring_tilt_inertia_kg_m2`` (default :func:`ring_tilt_inertia`).
+    ``ring_tilt_inertia_kg_m2`` (default :func:`ring_tilt_inertia`). ``axial_gravity_m_s2`` is gravity
+    along -x (a vertical shaft); ``gravity_m_s2`` (keyword of the planar problem) acts along -z.
     """
     if not (isinstance(strips, int) and 1 <= strips <= 101):
         raise P.ParameterError("strips", "must be a whole number in 1..101", strips)
@@ -405,7 +407,7 @@ def spatial_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayL
     p[P_FA], (p[P_TILT_Y], p[P_TILT_Z]), p[P_STRIPS] = axial_load_n, misalignment_rad, strips
     p[P_AI] = hertz_contact(*rc["inner"], eta).a_coeff
     p[P_AO] = hertz_contact(*rc["outer"], eta).a_coeff
-    p[P_MY] = moment_load_nm
+    p[P_MY], p[P_GAX] = moment_load_nm, axial_gravity_m_s2
     p[P_IR] = ring_tilt_inertia(bearing) if ring_tilt_inertia_kg_m2 is None else ring_tilt_inertia_kg_m2
     r_i = 0.5 * g.inner_race_diameter_m
     atol[sl["ring_tilt"]] = (1e-10 * scale / r_i, 1e-10 * scale / r_i, 1e-7 * scale / r_i, 1e-7 * scale / r_i)
@@ -484,6 +486,7 @@ def spatial_energy(problem: Problem, y: npt.NDArray[np.float64]) -> npt.NDArray[
           + 0.5 * m_ring * (cvx**2 + cvy**2 + cvz**2) + 0.5 * p[P_IR] * (y[:, -2] ** 2 + y[:, -1] ** 2))
     pe = m * g * np.sum(r * np.sin(th), axis=1) + (m_ring * g + p[P.P_FR]) * y[:, 5 * z + 1] - p[P_FA] * y[:, b + 4 * z]
     pe -= p[P_MY] * y[:, -4]  # the moment load's work on the tilt beta_y
+    pe += p[P_GAX] * (m * np.sum(ax, axis=1) + m_ring * y[:, b + 4 * z])  # gravity along the shaft
     if p[P.P_F_RACE] > 0.5:
         for race, (overlap, _, _) in race_geometry(problem, y).items():
             pe += 0.4 * (p[P.P_KI] if race == "inner" else p[P.P_KO]) * np.sum(overlap**2.5, axis=1)
