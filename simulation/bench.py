@@ -54,7 +54,8 @@ def _settled_problem(rpm: float, load_n: float, settle_s: float, axial_n: float 
     pr = build_problem(scene, choose_model(scene, level=level), ModelParameters(strips=strips))
     sol = solve(pr, np.array([settle_s]), rtol=1e-8, max_step=1e-6)
     y0 = sol.y[-1].copy()
-    y0[-2:] = 0.0  # restart the work and dissipation counters
+    z = scene.bearing.geometry.n_balls
+    y0[5 * z + 4:5 * z + 6] = 0.0  # restart the work and dissipation counters (same slots in both layouts)
     cage = theoretical_cage_speed(scene.bearing.geometry, scene.conditions.speed_rad_s)
     return replace(pr, y0=y0, aux=sol.extra["aux"], t0=0.0), cage
 

@@ -108,7 +108,7 @@ def _run(args: argparse.Namespace, scene: Any, choice: Any, config: dict[str, An
     from cageless.errors import UsageError
     from simulation.run import check_supported
 
-    check_supported(scene)
+    check_supported(scene, choice)
     par = _parameters(args)  # validated before anything compiles
     if args.ensemble < 1:
         raise UsageError(f"--ensemble must be >= 1, got {args.ensemble}")

@@ -20,8 +20,9 @@ FORCE_OFF = ["--effect", "race_traction=off", "--effect", "ehl_film=off", "--eff
 
 def test_unsupported_scenes_are_refused_with_the_way_out(tmp_path, capsys):
     out = tmp_path / "x.h5"
-    assert main(["simulate", "--speed-rpm", "3000", "--orientation", "vertical", "-o", str(out)]) == 2
-    assert "vertical shaft is not in this release" in capsys.readouterr().err
+    assert main(["simulate", "--speed-rpm", "3000", "--orientation", "vertical", "--level", "planar", "--force",
+                 "-o", str(out)]) == 2
+    assert "the planar level cannot carry" in capsys.readouterr().err
     assert main(["simulate", "--speed-rpm", "3000", "--dry", "-o", str(out)]) == 2  # no cited dry friction
     assert "--set dry_friction_coefficient=" in capsys.readouterr().err
     assert main(["simulate", "--speed-rpm", "3000", "--set", "restitution=1.5", "-o", str(out)]) == 2
@@ -82,7 +83,7 @@ def test_solver_failure_is_an_incomplete_trace(tmp_path):
     assert not tr.valid[-1].any()
     with pytest.raises(UsageError, match="vertical shaft"):  # refused before anything runs
         vertical = Scene(conditions=OperatingConditions(3000.0, 500.0), orientation="vertical")
-        simulate(vertical, choose_model(vertical), progress=False)
+        simulate(vertical, choose_model(vertical, level="planar", force=True), progress=False)
 
 
 @pytest.mark.parametrize("axial", [0.0, 400.0])
