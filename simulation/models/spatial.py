@@ -177,23 +177,34 @@ def _race(y, p, j, z, inner, w_i, rot, c, s, wt):  # pragma: no cover - compiled
         # relative spin across the strips: slip grows linearly with the strip's offset xi along the major axis
         wax, way, waz = _cross(ox - awx, oy - awy, oz - awz, ax_, ay_, az_)
         u0x, u0y, u0z = rvx + bsx - rsx, rvy + bsy - rsy, rvz + bsz - rsz
-        gsx = gsy = gsz = 0.0  # traction on the ball, summed over the strips
-        hx = hy = hz = 0.0  # its first moment along the major axis, sum of xi g
+        # A strip at offset xi slides at u0 + xi wa, projected on the contact plane. The projection is linear, so
+        # u0 and wa are projected once, |u|^2 is a quadratic in xi, and the strip forces -f_k u_k sum through
+        # the moments S_j = sum f_k xi_k^j (f_k: traction per unit sliding speed of strip k).
+        un = u0x * nx + u0y * ny + u0z * nz
+        u0x, u0y, u0z = u0x - un * nx, u0y - un * ny, u0z - un * nz
+        wn = wax * nx + way * ny + waz * nz
+        wax, way, waz = wax - wn * nx, way - wn * ny, waz - wn * nz
+        c0 = u0x * u0x + u0y * u0y + u0z * u0z
+        c1 = 2.0 * (u0x * wax + u0y * way + u0z * waz)
+        c2 = wax * wax + way * way + waz * waz
+        s0 = s1 = s2 = 0.0
         m = int(p[P_STRIPS])
         for k in range(m):
             xi0, xi1 = -1.0 + 2.0 * k / m, -1.0 + 2.0 * (k + 1) / m
             w = 0.75 * ((xi1 - xi1**3 / 3.0) - (xi0 - xi0**3 / 3.0))  # share of the Hertz load on the strip
             xi = 0.5 * (xi0 + xi1) * a
-            ux, uy, uz = u0x + xi * wax, u0y + xi * way, u0z + xi * waz
-            un = ux * nx + uy * ny + uz * nz
-            ux, uy, uz = ux - un * nx, uy - un * ny, uz - un * nz
-            us = math.sqrt(ux * ux + uy * uy + uz * uz)
-            if us == 0.0:
+            us2 = c0 + xi * (c1 + xi * c2)
+            if us2 <= 0.0:
                 continue
+            us = math.sqrt(us2)
             f = P._tangential(us, u_r, w * q, p) / us
-            gsx, gsy, gsz = gsx - f * ux, gsy - f * uy, gsz - f * uz
-            hx, hy, hz = hx - xi * f * ux, hy - xi * f * uy, hz - xi * f * uz
-            p_diss += f * us * us
+            s0 += f
+            s1 += f * xi
+            s2 += f * xi * xi
+            p_diss += f * us2
+        # traction on the ball, and its first moment along the major axis (sum of xi g)
+        gsx, gsy, gsz = -(s0 * u0x + s1 * wax), -(s0 * u0y + s1 * way), -(s0 * u0z + s1 * waz)
+        hx, hy, hz = -(s1 * u0x + s2 * wax), -(s1 * u0y + s2 * way), -(s1 * u0z + s2 * waz)
         fx, fy, fz = fx + gsx, fy + gsy, fz + gsz
         t1x, t1y, t1z = _cross(half * nx, half * ny, half * nz, gsx, gsy, gsz)
         t2x, t2y, t2z = _cross(ax_, ay_, az_, hx, hy, hz)
