@@ -146,7 +146,17 @@ def plot_accuracy(result: dict[str, Any], path: str) -> None:
         plt.close(fig)
 
 
-def model_study(window_s: float = 0.005, settle_s: float = 0.03) -> dict[str, Any]:
+def _best_wall(run: Any, repeats: int) -> tuple[Any, float]:
+    """The result of ``run()`` and its shortest wall time over ``repeats`` runs (the machine's noise only
+    ever adds time)."""
+    sol = run()
+    best = sol.wall_s
+    for _ in range(repeats - 1):
+        best = min(best, run().wall_s)
+    return sol, best
+
+
+def model_study(window_s: float = 0.005, settle_s: float = 0.03, repeats: int = 1) -> dict[str, Any]:
     """What model fidelity costs: planar against spatial, and the strip count m of the spatial model.
 
     * Pure radial load (3000 rpm, 500 N), where the planar model is exact: planar and spatial (m = 1, 5)
@@ -154,8 +164,9 @@ def model_study(window_s: float = 0.005, settle_s: float = 0.03) -> dict[str, An
     * Combined load (3000 rpm, 500 N radial, 400 N axial), where only the spatial model applies: m = 1, 5,
       11, 21 against a spatial m = 21, rtol 1e-9 reference.
 
-    All at rtol 1e-6 from the same settled state; wall seconds per simulated second and the ratio to the
-    planar run measured in the same process.
+    All at rtol 1e-6 from the same settled state; wall seconds per simulated second (the best of
+    ``repeats`` runs: this shared machine's noise only ever adds time) and the ratio to the planar run
+    measured in the same process.
     """
     t = np.linspace(0.0, window_s, 51)
     rows = []
@@ -171,11 +182,11 @@ def model_study(window_s: float = 0.005, settle_s: float = 0.03) -> dict[str, An
             n = len(pr.y0)  # the planar state is the first 5 Z + 6 entries of the spatial one
             y0 = np.concatenate([base.y0, np.zeros(max(0, n - len(base.y0)))])[:n]
             pr = replace(pr, y0=y0, aux=base.aux.copy())
-            sol = solve(pr, t, rtol=1e-6, max_step=2e-6)
+            sol, wall = _best_wall(lambda pr=pr: solve(pr, t, rtol=1e-6, max_step=2e-6), repeats)
             z = int(pr.params[P.P_Z])
             slip_pp, pos_um = _errors(sol.y[:, :5 * z + 6], ref.y[:, :5 * z + 6], z, cage, float(np.mean(pr.y0[:z])))
             rows.append({"scene": scene_name, "model": lvl if lvl == "planar" else f"spatial, m = {m}",
-                         "wall_s_per_sim_s": sol.wall_s / window_s, "slip_error_pp": slip_pp,
+                         "wall_s_per_sim_s": wall / window_s, "slip_error_pp": slip_pp,
                          "position_error_um": pos_um, "ok": sol.success})
     base_time = rows[0]["wall_s_per_sim_s"]
     for r in rows:
