@@ -68,7 +68,7 @@ def describe_condition(label: str, comparison: Comparison, measured: Trace, simu
         simulation_info=info, contact_track=track)
 
 
-def contact_track(trace: Trace, settle_s: float, max_points: int = 20_000) -> dict[str, npt.NDArray[np.float64]] | None:
+def contact_track(trace: Trace, settle_s: float, max_points: int = 4_000) -> dict[str, npt.NDArray[np.float64]] | None:
     """The contact trajectory of a spatial trace (the paper's figure 13) after ``settle_s``, loaded contacts
     only (inner force above 1 N), at most ``max_points`` points (evenly thinned); None for planar traces."""
     c = trace.groups.get("contacts", {})
