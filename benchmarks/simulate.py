@@ -24,8 +24,9 @@ def main() -> None:
     ap.add_argument("--window", type=float, default=0.005, help="simulated seconds (default 0.005)")
     ap.add_argument("--plot", type=Path)
     ap.add_argument("--json", type=Path)
+    ap.add_argument("--repeats", type=int, default=3, help="timing repeats per candidate, best taken (default 3)")
     args = ap.parse_args()
-    result = accuracy_study(window_s=args.window)
+    result = accuracy_study(window_s=args.window, repeats=args.repeats)
     print(format_accuracy(result))
     if args.plot:
         plot_accuracy(result, str(args.plot))

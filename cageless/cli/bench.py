@@ -38,7 +38,7 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--dir", default="bench_footage", help="where rendered footage is kept (default ./bench_footage)")
     p.add_argument("--frames", type=int, default=2400, help="frames of full-size footage (default 2400, 4.9 GB)")
     p.add_argument("--repeats", type=int, default=3,
-                   help="timing repeats, best taken (default 3; tracking, and the accuracy study's model table)")
+                   help="timing repeats, best taken (default 3)")
     p.add_argument("--json", help="also write the results as JSON")
 
 
@@ -52,7 +52,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     elif args.study == "accuracy":
         from simulation.bench import accuracy_study, format_accuracy, format_models, model_study, plot_accuracy
 
-        result = accuracy_study(window_s=args.window)
+        result = accuracy_study(window_s=args.window, repeats=args.repeats)
         print(format_accuracy(result))
         models = model_study(window_s=args.window, repeats=args.repeats)
         print()
