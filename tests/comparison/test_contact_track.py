@@ -61,3 +61,25 @@ def test_planar_traces_have_no_contact_track():
     scene = Scene(conditions=OperatingConditions(3000.0, 500.0), duration_s=0.002)
     tr = simulate(scene, choose_model(scene), progress=False).trace
     assert "inner_point" not in tr.groups["contacts"] and contact_track(tr, 0.0) is None
+
+
+def test_the_report_of_a_spatial_condition_shows_the_contact_trajectory(spatial, tmp_path):
+    """A combined-load condition through compare -> describe -> structure -> HTML: the contact-trajectory
+    figure is in the self-contained report, and the row says the measured slip was referred to the model's
+    contact angle."""
+    from dataclasses import replace
+
+    from cageless.trace import VideoInfo
+    from comparison.compare import compare
+    from comparison.report.describe import describe_condition
+    from comparison.report.render import write_report
+    from comparison.report.structure import build_report
+
+    sim = spatial.trace
+    video = replace(sim, source="video", simulation=None, groups={}, events=None, config={"slip_contact_angle_rad": 0.0},
+                    video=VideoInfo(fps=10000.0, px_per_mm=12.5, centre_px=(640.0, 400.0), camera_roll_rad=0.0,
+                                    input_file="combined.cine", input_sha256="ab" * 32))
+    c = compare(video, sim, settle_s=0.005)
+    assert "contact angle" in c.row.message and c.row.status == "ok"
+    html = write_report(build_report([describe_condition("combined", c, video, sim)]), tmp_path / "r.html").read_text()
+    assert "Contact trajectory on the raceways" in html and html.count("data:image/svg+xml;base64,") >= 5
