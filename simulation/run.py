@@ -36,7 +36,8 @@ from simulation.problem import Problem
 from simulation.chunks import solve_chunks
 from simulation.solve import FORCE_JUMP, METHODS, Solution
 
-__all__ = ["SimulationResult", "build_problem", "check_supported", "initial_state", "simulate",
+__all__ = ["SimulationResult", "EnergyBalance", "build_problem", "check_supported", "energy_balance", "initial_state",
+           "simulate",
            "peak_unloaded_slip",
            "UNLOADED_ZONE_DEG"]
 
@@ -129,9 +130,10 @@ def _observables(pr: Problem, y: npt.NDArray[np.float64], scene: Scene,
     sx, sz = r * np.cos(th) - cy, r * np.sin(th) - cz
     ln = np.hypot(sx, sz)
     inner = p[P.P_KI] * np.clip(0.5 * p[P.P_DI] + half - ln, 0, None) ** 1.5
-    x, zz = r * np.cos(th), r * np.sin(th)
-    gap = np.hypot(np.roll(x, -1, axis=1) - x, np.roll(zz, -1, axis=1) - zz)
-    bb = p[P.P_KB] * np.clip(d - gap, 0, None) ** 1.5
+    spatial = pr.model_id == S.MODEL_ID
+    axial, axial_dot = ((y[:, S.SpatialLayout(z).slices()[k]] for k in ("axial", "axial_dot")) if spatial
+                        else (np.zeros_like(r), np.zeros_like(r)))
+    bb = p[P.P_KB] * np.clip(d - _centre_gap(r, th, axial), 0, None) ** 1.5
     u_o = r * thd + half * om
     ur_o = 0.5 * np.abs(u_o - p[P.P_DO] * thd)
     vt = (rd * np.sin(th) + r * thd * np.cos(th) - cvz) * sx / ln - (rd * np.cos(th) - r * thd * np.sin(th) - cvy) * sz / ln
@@ -147,15 +149,11 @@ def _observables(pr: Problem, y: npt.NDArray[np.float64], scene: Scene,
     spin = np.zeros((len(y), z, 3))
     spin[:, :, 0] = om
     ring = np.column_stack([np.zeros(len(y)), cy[:, 0], cz[:, 0]])
-    axial = np.zeros_like(r)
     tilt = np.zeros((len(y), 2))
-    if pr.model_id == S.MODEL_ID:
+    if spatial:
         tilt = y[:, -4:-2] + pr.params[[S.P_TILT_Y, S.P_TILT_Z]]  # about y and z: misalignment plus the free tilt
         sl = S.SpatialLayout(z).slices()
-        axial = y[:, sl["axial"]]
         spin[:, :, 1], spin[:, :, 2] = y[:, sl["spin_y"]], y[:, sl["spin_z"]]
-        bb = p[P.P_KB] * np.clip(d - _centre_gap(r, th, axial), 0, None) ** 1.5
-        contacts["ball_ball_normal"] = bb
         ring[:, 0] = y[:, sl["ring_axial"]][:, 0]
         for race, (overlap, angle, point) in S.race_geometry(pr, y).items():
             k_n = p[P.P_KI] if race == "inner" else p[P.P_KO]
@@ -163,7 +161,7 @@ def _observables(pr: Problem, y: npt.NDArray[np.float64], scene: Scene,
             contacts[f"{race}_angle"] = angle
             contacts[f"{race}_point"] = point
     if p[P.P_F_TRAC] > 0.5:
-        contacts["ball_ball_traction"] = _ball_ball_traction(p, r, th, rd, thd, axial, spin, y, pr, bb)
+        contacts["ball_ball_traction"] = _ball_ball_traction(p, r, th, rd, thd, axial, axial_dot, spin, bb)
     return {
         "balls": {"radius": r, "axial": axial, "spin": spin},
         "contacts": contacts,
@@ -178,13 +176,11 @@ def _centre_gap(r: np.ndarray, th: np.ndarray, axial: np.ndarray) -> np.ndarray:
 
 
 def _ball_ball_traction(p: np.ndarray, r: np.ndarray, th: np.ndarray, rd: np.ndarray, thd: np.ndarray,
-                        axial: np.ndarray, spin: np.ndarray, y: np.ndarray, pr: Problem,
-                        normal: np.ndarray) -> np.ndarray:
+                        axial: np.ndarray, axial_dot: np.ndarray, spin: np.ndarray, normal: np.ndarray) -> np.ndarray:
     """Magnitude (N) of the friction between ball j and ball j+1 (T, Z), from the sliding of their surfaces
     along the contact plane, as in the models' pair forces (elastic normal force; 0 where apart)."""
     z = r.shape[1]
     half = 0.5 * p[P.P_D]
-    axial_dot = y[:, S.SpatialLayout(z).slices()["axial_dot"]] if pr.model_id == S.MODEL_ID else np.zeros_like(r)
     pos = np.stack([axial, r * np.cos(th), r * np.sin(th)], axis=-1)
     vel = np.stack([axial_dot, rd * np.cos(th) - r * thd * np.sin(th), rd * np.sin(th) + r * thd * np.cos(th)], -1)
     k = np.roll(np.arange(z), -1)
@@ -195,6 +191,30 @@ def _ball_ball_traction(p: np.ndarray, r: np.ndarray, th: np.ndarray, rd: np.nda
     u_s = np.linalg.norm(u, axis=-1)
     u_r = 0.5 * half * np.linalg.norm(np.cross(spin - spin[:, k], n), axis=-1)
     return np.abs(tangential_force(u_s, u_r, normal, p))
+
+
+@dataclass(frozen=True)
+class EnergyBalance:
+    """The energy account along a solution's samples (J): the drive's input work, the energy dissipated, and
+    ``balance`` = mechanical energy + dissipated - input, constant when the balance closes (DESIGN §7)."""
+
+    balance: npt.NDArray[np.float64]
+    input_work: npt.NDArray[np.float64]
+    dissipated: npt.NDArray[np.float64]
+
+    @property
+    def drift(self) -> float:
+        """Largest change of the balance from its start (J)."""
+        return float(np.max(np.abs(self.balance - self.balance[0])))
+
+
+def energy_balance(problem: Problem, y: npt.NDArray[np.float64]) -> EnergyBalance:
+    """The energy account of ``problem`` along samples ``y`` (T, n), planar or spatial."""
+    z = int(problem.params[P.P_Z])
+    sl = P.PlanarLayout(z).slices()  # the counters sit at the same slots in the spatial layout
+    work, lost = y[:, sl["input_work"]][:, 0], y[:, sl["dissipated"]][:, 0]
+    energy = S.spatial_energy(problem, y) if problem.model_id == S.MODEL_ID else P.planar_energy(problem, y)
+    return EnergyBalance(balance=energy + lost - work, input_work=work, dissipated=lost)
 
 
 def nominal_contact_angle(scene: Scene, groups: dict[str, dict[str, np.ndarray]]) -> float:

@@ -474,11 +474,7 @@ def race_geometry(problem: Problem,
 def ring_rotations(problem: Problem, y: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     """The inner ring's rotation matrices R = Rz(beta_z) Ry(beta_y) along samples y (T, 3, 3): the prescribed
     misalignment plus the tilt states."""
-    p = problem.params
-    by, bz = p[P_TILT_Y] + y[:, -4], p[P_TILT_Z] + y[:, -3]
-    cb, sb, cg, sg = np.cos(by), np.sin(by), np.cos(bz), np.sin(bz)
-    zero = np.zeros_like(by)
-    return np.stack([cg * cb, -sg, cg * sb, sg * cb, cg, sg * sb, -sb, zero, cb], axis=-1).reshape(-1, 3, 3)
+    return np.array([_tilt(row, problem.params) for row in y]).reshape(-1, 3, 3)
 
 
 def spatial_energy(problem: Problem, y: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:

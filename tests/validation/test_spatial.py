@@ -18,7 +18,7 @@ from cageless.profiles import angle_profile
 from simulation.effects import choose_model
 from simulation.models import planar as P
 from simulation.models import spatial as S
-from simulation.run import build_problem, initial_state, simulate
+from simulation.run import build_problem, energy_balance, initial_state, simulate
 from simulation.parameters import ModelParameters
 from simulation.scene import Scene
 from simulation.solve import solve
@@ -98,14 +98,9 @@ def test_spatial_energy_balance_with_axial_load_and_strips():
     pr = build_problem(scene, choose_model(scene), ModelParameters(strips=5))
     sol = solve(pr, np.linspace(0, 2e-3, 21), rtol=1e-10, max_step=5e-7)
     assert sol.success
-    z = 14
-    sl = S.SpatialLayout(z).slices()
-    y = sol.y
-    work, lost = y[:, sl["input_work"]][:, 0], y[:, sl["dissipated"]][:, 0]
-    energy = S.spatial_energy(pr, y)
-    balance = energy + lost - work
-    assert work[-1] > 1e-4
-    assert np.max(np.abs(balance - balance[0])) < 1e-6 * max(work[-1], lost[-1])
+    energy = energy_balance(pr, sol.y)
+    assert energy.input_work[-1] > 1e-4
+    assert energy.drift < 1e-6 * max(energy.input_work[-1], energy.dissipated[-1])
 
 
 @pytest.fixture(scope="module")
@@ -180,10 +175,8 @@ def test_spatial_hard_cases_are_stable(name):
     k = res.problem.params
     c = res.trace.groups["contacts"]
     assert (np.nanmax(c["inner_normal"]) / k[P.P_KI]) ** (2 / 3) < 0.005 * k[P.P_D]  # overlap below 0.5 % of D
-    sl = S.SpatialLayout(14).slices()
-    work, lost = sol.y[:, sl["input_work"]][:, 0], sol.y[:, sl["dissipated"]][:, 0]
-    balance = S.spatial_energy(res.problem, sol.y) + lost - work
-    assert np.max(np.abs(balance - balance[0])) < 1e-5 * work[-1]
+    energy = energy_balance(res.problem, sol.y)
+    assert energy.drift < 1e-5 * energy.input_work[-1]
 
 
 @pytest.mark.slow
@@ -226,10 +219,8 @@ def test_a_moment_load_tilts_the_ring_until_the_contacts_balance_it():
         late = tr.time > 0.03
         assert moment_y[late].mean() == pytest.approx(-moment, rel=0.02)
         tilts.append(tr.groups["inner_ring"]["tilt"][late, 0].mean())
-        sl = S.SpatialLayout(14).slices()
-        work, lost = y[:, sl["input_work"]][:, 0], y[:, sl["dissipated"]][:, 0]
-        balance = S.spatial_energy(res.problem, y) + lost - work
-        assert np.max(np.abs(balance - balance[0])) < 1e-5 * work[-1]
+        energy = energy_balance(res.problem, y)
+        assert energy.drift < 1e-5 * energy.input_work[-1]
     assert 0 < tilts[0] < tilts[1] < 0.01
 
 
@@ -250,9 +241,7 @@ def test_a_vertical_shaft_carries_the_ring_weight_axially():
     carried = np.sum(c["inner_normal"][late] * np.sin(np.abs(c["inner_angle"][late])), axis=1)
     assert carried.mean() == pytest.approx(weight, rel=0.03)
     assert tr.groups["inner_ring"]["position"][-1, 0] < -5e-6  # the ring sinks along -x
-    sl = S.SpatialLayout(14).slices()
-    work, lost = y[:, sl["input_work"]][:, 0], y[:, sl["dissipated"]][:, 0]
-    balance = S.spatial_energy(res.problem, y) + lost - work
-    assert np.max(np.abs(balance - balance[0])) < 1e-5 * work[-1]
+    energy = energy_balance(res.problem, y)
+    assert energy.drift < 1e-5 * energy.input_work[-1]
     with pytest.raises(UsageError, match="vertical shaft"):
         simulate(scene, choose_model(scene, level="planar", force=True), progress=False)
