@@ -69,11 +69,14 @@ def rebound(chi: float) -> float:
     return 0.0
 
 
-#: LLVM fast-math flags of the model right-hand sides: fused multiply-add, reassociation, reciprocals and
-#: signed zeros, but not "nnan"/"ninf", so a non-finite state still propagates to the integrator's check.
-#: They change results only at round-off (measured: 5e-7 relative on an acceleration that is the small sum
-#: of 100 N contact forces) and cut the spatial right-hand side from 9.2 to 6.3 us.
-FASTMATH = {"nsz", "arcp", "contract", "reassoc"}
+#: LLVM fast-math flags of the model right-hand sides: fused multiply-add, reciprocals and signed zeros,
+#: but not "nnan"/"ninf", so a non-finite state still propagates to the integrator's check. They change
+#: results only at round-off (measured: 5e-7 relative on an acceleration that is the small sum of 100 N
+#: contact forces) and cut the spatial right-hand side from 9.2 to ~6 us. "reassoc" is left out: with it,
+#: code compiled in a fresh process and the same code loaded from numba's cache gave different round-off
+#: (different settled states and traces of one scene), breaking the same-input-same-output rule; without
+#: it the two agree bit for bit (tests/simulation/test_determinism.py), at ~4 % on the spatial RHS.
+FASTMATH = {"nsz", "arcp", "contract"}
 
 #: Damping factor standing for R = 0. A perfectly plastic impact is the limit chi -> infinity of this
 #: law: the clamped force vanishes once the overlap recedes faster than v_in / chi, so the rebound is at
