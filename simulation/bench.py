@@ -5,11 +5,13 @@ start-up; from that state, each candidate integrates the same window, and its
 error is measured against a tight-tolerance reference run in the same process:
 
 * the compiled Dormand-Prince loop across tolerances (rtol 1e-4 ... 1e-8);
+* SUNDIALS CVODE (BDF) across tolerances and step caps (2, 5, 20 us);
 * scipy's LSODA, BDF and DOP853 on the same compiled right-hand side;
 * scipy's LSODA on the plain-numpy right-hand side (the "numpy" baseline).
 
-scipy's steppers run through :func:`simulation.solve.step_scipy`, so the contact bookkeeping
-after each accepted step is the same for every candidate.
+CVODE and scipy's steppers run one accepted step at a time (:func:`simulation.solve.step_cvode`,
+:func:`simulation.solve.step_scipy`), so the contact bookkeeping after each accepted step is the same
+for every candidate.
 
 The ball ring is chaotic, so the window is kept at a few milliseconds (DESIGN
 §7). Error: the largest difference in slip over all balls and samples, in
@@ -29,6 +31,7 @@ import numpy.typing as npt
 
 from cageless.conditions import OperatingConditions
 from cageless.kinematics import theoretical_cage_speed
+from simulation.chunks import RTOL_FACTOR
 from simulation.effects import choose_model
 from simulation.models.planar_reference import reference_rhs
 from simulation.problem import Problem
@@ -42,9 +45,14 @@ from simulation.solve import solve, step_scipy
 __all__ = ["accuracy_study", "format_accuracy", "plot_accuracy", "model_study", "format_models", "effects_study",
            "format_effects", "OPTIONAL_EFFECTS"]
 
-CANDIDATES: tuple[tuple[str, float], ...] = (
-    ("dp5", 1e-4), ("dp5", 1e-5), ("dp5", 1e-6), ("dp5", 1e-7), ("dp5", 1e-8),
-    ("LSODA", 1e-6), ("BDF", 1e-6), ("DOP853", 1e-6),
+#: (method, rtol, max_step in s). The step cap is an accuracy knob of its own for the implicit CVODE,
+#: whose steps are otherwise set by accuracy alone: the default 2 us keeps ~15 steps inside a ball-ball
+#: impact (29 us), the longer caps show what resolving contacts by error control alone buys and costs.
+#: CVODE at rtol 1e-7 and 5 us is how ``simulate`` runs it at rtol 1e-6 (simulation.chunks.RTOL_FACTOR).
+CANDIDATES: tuple[tuple[str, float, float], ...] = (
+    ("dp5", 1e-4, 2e-6), ("dp5", 1e-5, 2e-6), ("dp5", 1e-6, 2e-6), ("dp5", 1e-7, 2e-6), ("dp5", 1e-8, 2e-6),
+    ("CVODE", 1e-6, 2e-6), ("CVODE", 1e-6, 5e-6), ("CVODE", 1e-7, 5e-6), ("CVODE", 1e-6, 2e-5),
+    ("LSODA", 1e-6, 2e-6), ("BDF", 1e-6, 2e-6), ("DOP853", 1e-6, 2e-6),
 )
 
 
@@ -96,11 +104,11 @@ def accuracy_study(rpm: float = 3000.0, load_n: float = 500.0, window_s: float =
     t = np.linspace(0.0, window_s, 51)
     ref = solve(pr, t, rtol=1e-10, max_step=2.5e-7)
     rows = []
-    for method, rtol in CANDIDATES:
-        sol, wall = _best_wall(lambda method=method, rtol=rtol: solve(pr, t, method=method, rtol=rtol, max_step=2e-6),
-                               repeats)
+    for method, rtol, cap in CANDIDATES:
+        sol, wall = _best_wall(lambda method=method, rtol=rtol, cap=cap: solve(pr, t, method=method, rtol=rtol,
+                                                                               max_step=cap), repeats)
         slip_pp, pos_um = _errors(sol.y, ref.y, z, cage, radius)
-        rows.append({"solver": f"{method} (compiled RHS)", "rtol": rtol, "ok": sol.success,
+        rows.append({"solver": f"{method} (compiled RHS)", "rtol": rtol, "max_step": cap, "ok": sol.success,
                      "wall_s_per_sim_s": wall / window_s, "slip_error_pp": slip_pp, "position_error_um": pos_um,
                      "steps": sol.n_steps, "rhs_calls": sol.n_rhs})
     tn = np.linspace(0.0, numpy_window_s, 6)
@@ -108,9 +116,11 @@ def accuracy_study(rpm: float = 3000.0, load_n: float = 500.0, window_s: float =
     y_np = sol_np.y
     ref_short = solve(pr, tn, rtol=1e-10, max_step=2.5e-7)
     slip_pp, pos_um = _errors(y_np, ref_short.y, z, cage, radius)
-    rows.append({"solver": "LSODA (numpy RHS)", "rtol": 1e-6, "ok": True, "wall_s_per_sim_s": wall / numpy_window_s,
+    rows.append({"solver": "LSODA (numpy RHS)", "rtol": 1e-6, "max_step": 2e-6, "ok": True, "wall_s_per_sim_s": wall / numpy_window_s,
                  "slip_error_pp": slip_pp, "position_error_um": pos_um, "steps": 0, "rhs_calls": 0})
     base = next(r for r in rows if r["solver"].startswith("dp5") and r["rtol"] == 1e-6)["wall_s_per_sim_s"]
+    for r in rows:
+        r["label"] = f"{r['solver']}, cap {1e6 * r['max_step']:g} us" if r["max_step"] != 2e-6 else r["solver"]
     for r in rows:
         r["time_ratio"] = r["wall_s_per_sim_s"] / base
     return {"scene": {"speed_rpm": rpm, "radial_load_n": load_n, "window_s": window_s, "settle_s": settle_s},
@@ -134,7 +144,8 @@ def format_accuracy(result: dict[str, Any]) -> str:
     sc = result["scene"]
     title = (f"Work-precision, {sc['speed_rpm']:g} rpm, {sc['radial_load_n']:g} N, {1e3 * sc['window_s']:g} ms window "
              f"after {1e3 * sc['settle_s']:g} ms (reference: dp5 rtol 1e-10; ratio: to dp5 rtol 1e-6)")
-    return _cost_table(title, ("solver", "rtol"), result["rows"], lambda r: (r["solver"], f"{r['rtol']:g}"))
+    return _cost_table(title + "; step cap 2 us unless given", ("solver", "rtol"), result["rows"],
+                       lambda r: (r.get("label", r["solver"]), f"{r['rtol']:g}"))
 
 
 def plot_accuracy(result: dict[str, Any], path: str) -> None:
@@ -146,8 +157,8 @@ def plot_accuracy(result: dict[str, Any], path: str) -> None:
 
     with matplotlib.rc_context():
         fig, ax = plt.subplots(figsize=(5.5, 3.8))
-        for solver in dict.fromkeys(r["solver"] for r in result["rows"]):
-            rows = [r for r in result["rows"] if r["solver"] == solver]
+        for solver in dict.fromkeys(r.get("label", r["solver"]) for r in result["rows"]):
+            rows = [r for r in result["rows"] if r.get("label", r["solver"]) == solver]
             ax.loglog([r["wall_s_per_sim_s"] for r in rows], [max(r["slip_error_pp"], 1e-6) for r in rows], "o-",
                       label=solver)
         ax.set_xlabel("wall seconds per simulated second")
@@ -165,30 +176,39 @@ def model_study(window_s: float = 0.005, settle_s: float = 0.03, repeats: int = 
     * Pure radial load (3000 rpm, 500 N), where the planar model is exact: planar and spatial (m = 1, 5)
       against a planar rtol 1e-10 reference.
     * Combined load (3000 rpm, 500 N radial, 400 N axial), where only the spatial model applies: m = 1, 5,
-      11, 21 against a spatial m = 21, rtol 1e-9 reference.
+      11, 21 against a spatial m = 21, rtol 1e-9 reference; and m = 5 under CVODE as ``simulate`` runs it
+      (rtol / 10) with a 2 us cap and with its default 5 us cap.
 
-    All at rtol 1e-6 from the same settled state; wall seconds per simulated second (the best of
+    All at rtol 1e-6 from the same settled state, with DP5 unless named; wall seconds per simulated second (the best of
     ``repeats`` runs: this shared machine's noise only ever adds time) and the ratio to the planar run
     measured in the same process.
     """
     t = np.linspace(0.0, window_s, 51)
     rows = []
     for scene_name, axial, level, ref_strips, cases in (
-            ("pure radial", 0.0, "planar", 1, (("planar", 1), ("spatial", 1), ("spatial", 5))),
-            ("500 N + 400 N axial", 400.0, "spatial", 21, (("spatial", 1), ("spatial", 5), ("spatial", 11),
-                                                           ("spatial", 21)))):
+            ("pure radial", 0.0, "planar", 1, (("planar", 1, "dp5", 2e-6), ("spatial", 1, "dp5", 2e-6),
+                                               ("spatial", 5, "dp5", 2e-6))),
+            ("500 N + 400 N axial", 400.0, "spatial", 21, (
+                ("spatial", 1, "dp5", 2e-6), ("spatial", 5, "dp5", 2e-6), ("spatial", 11, "dp5", 2e-6),
+                ("spatial", 21, "dp5", 2e-6), ("spatial", 5, "CVODE", 2e-6), ("spatial", 5, "CVODE", 5e-6)))):
+        # CVODE rows run as simulate runs them at rtol 1e-6 (rtol / 10, see simulation.chunks.RTOL_FACTOR)
         base, cage = _settled_problem(3000.0, 500.0, settle_s, axial, level, ref_strips)
         ref = solve(base, t, rtol=1e-9 if axial else 1e-10, max_step=5e-7)
         scene = Scene(conditions=OperatingConditions(3000.0, 500.0, axial))
-        for lvl, m in cases:
+        for lvl, m, method, cap in cases:
             pr = build_problem(scene, choose_model(scene, level=lvl, force=True), ModelParameters(strips=m))
             n = len(pr.y0)  # the planar state is the first 5 Z + 6 entries of the spatial one
             y0 = np.concatenate([base.y0, np.zeros(max(0, n - len(base.y0)))])[:n]
             pr = replace(pr, y0=y0, aux=base.aux.copy())
-            sol, wall = _best_wall(lambda pr=pr: solve(pr, t, rtol=1e-6, max_step=2e-6), repeats)
+            rtol = 1e-6 * RTOL_FACTOR.get(method, 1.0)
+            sol, wall = _best_wall(lambda pr=pr, method=method, cap=cap, rtol=rtol: solve(
+                pr, t, method=method, rtol=rtol, max_step=cap), repeats)
             z = int(pr.params[P.P_Z])
             slip_pp, pos_um = _errors(sol.y[:, :5 * z + 6], ref.y[:, :5 * z + 6], z, cage, float(np.mean(pr.y0[:z])))
-            rows.append({"scene": scene_name, "model": lvl if lvl == "planar" else f"spatial, m = {m}",
+            label = lvl if lvl == "planar" else f"spatial, m = {m}"
+            if method != "dp5":
+                label += f", {method} (rtol {rtol:g}, cap {1e6 * cap:g} us)"
+            rows.append({"scene": scene_name, "model": label, "method": method, "max_step": cap,
                          "wall_s_per_sim_s": wall / window_s, "slip_error_pp": slip_pp,
                          "position_error_um": pos_um, "ok": sol.success})
     base_time = rows[0]["wall_s_per_sim_s"]

@@ -5,22 +5,25 @@ kept, internal steps not). With ``method="auto"`` it starts with the compiled DP
 stiffness test (:func:`simulation.integrators.dp5.dp5_integrate`, Hairer & Wanner's h |lambda| > 3.25).
 When most steps of a chunk sit at the stability edge (fraction >= :data:`STIFF_FRACTION`), the
 step is set by stiffness rather than accuracy, as the paper's "Adams-GSTIFF" scheme switches to its
-stiff branch once contacts stiffen (DESIGN §7). The driver then probes the stiff backend, scipy's
-LSODA (variable-order BDF), on the same chunk from the same state, and switches for the rest of the run
-if its work is clearly smaller. The probe's result is discarded, so the trajectory up to the switch is
-DP5's. Probes run only at the chunks in :data:`PROBE_CHUNKS` (10 % and 40 % into a 50-chunk run): the
-first chunks are the violent start at full speed, where LSODA restarting from order 1 is not
-representative (measured with R = 0: work ratio 2.7 on the first millisecond, 0.46 over 50 ms), and
-each probe costs about a chunk and a half of a run that does not switch.
+stiff branch once contacts stiffen (DESIGN §7). The driver then probes the stiff backend,
+SUNDIALS CVODE's variable-order BDF (:data:`STIFF_METHOD`), on the same chunk from the same state, and
+switches for the rest of the run if its cost is clearly smaller. The probe's result is discarded, so
+the trajectory up to the switch is DP5's. Probes run only at the chunks in :data:`PROBE_CHUNKS` (10 %
+and 40 % into a 50-chunk run): the first chunks are the violent start at full speed, where a BDF
+restarting from order 1 is not representative (measured with LSODA and R = 0: work ratio 2.7 on the
+first millisecond, 0.46 over 50 ms), and each probe costs about a chunk and a half of a run that does
+not switch.
 
 The decision must not depend on timing, or the same scene would give different traces on a busy
-machine (the determinism rule of the project). It compares work counts instead: DP5's right-hand-side
-evaluations against LSODA's evaluations plus :data:`STEP_OVERHEAD_RHS` evaluations' worth of Python
-overhead per step, and switches when LSODA's is below :data:`SWITCH_GAIN` of DP5's. Each probe and switch
-is recorded in the solution (``extra["switches"]``) and from there in the trace's solver statistics.
+machine (the determinism rule of the project). It compares a cost model instead: each solver's
+right-hand-side evaluations times the model's cost per evaluation (:data:`RHS_COST_US`) plus its steps
+times the method's Python overhead per step (:data:`STEP_COST_US`), constants measured on this
+project's scenes, and switches when the stiff backend's cost is below :data:`SWITCH_GAIN` of DP5's.
+Each probe and switch is recorded in the solution (``extra["switches"]``) and from there in the
+trace's solver statistics.
 
-LSODA cannot take a step back, so after a switch contact onsets are resolved by its error control and
-``max_step`` only (see :mod:`simulation.solve`).
+The stiff backend cannot take a step back, so after a switch contact onsets are resolved by its error
+control and ``max_step`` only (see :mod:`simulation.solve`).
 """
 
 from __future__ import annotations
@@ -32,47 +35,82 @@ import numpy as np
 import numpy.typing as npt
 from tqdm.auto import tqdm
 
+from simulation.kernels import PLANAR, SPATIAL
 from simulation.problem import Problem
 from simulation.solve import Solution, solve
 
-__all__ = ["solve_chunks", "STIFF_FRACTION", "STEP_OVERHEAD_RHS", "SWITCH_GAIN", "STIFF_METHOD", "PROBE_CHUNKS"]
+__all__ = ["solve_chunks", "default_max_step", "CONTACT_MAX_STEP_S", "MAX_STEP_S", "RTOL_FACTOR", "STIFF_FRACTION", "RHS_COST_US", "STEP_COST_US", "SWITCH_GAIN", "STIFF_METHOD",
+           "PROBE_CHUNKS"]
 
 #: Share of a chunk's accepted DP5 steps at the stability edge that triggers a probe. Measured over 50 ms
-#: at 3000 rpm: the default 500 N scene 0.82 (the race damping: it is probed, LSODA needs 1.16 of DP5's
-#: work, and it stays; the probe costs ~3 % of the run), R = 0 0.74, a 20 kN load 0.99; only the first
-#: milliseconds after the start, while the balls spread, fall below it.
+#: at 3000 rpm: the default 500 N scene 0.82 (the race damping: it is probed and stays, see
+#: :data:`SWITCH_GAIN`), R = 0 0.74, a 20 kN load 0.99; only the first milliseconds after the start,
+#: while the balls spread, fall below it.
 STIFF_FRACTION = 0.6
 #: The stiff backend the switch goes to.
-STIFF_METHOD = "LSODA"
-#: Python overhead of one scipy step, in compiled right-hand-side evaluations: fitted on this project's
-#: planar scenes (a scipy step costs ~21 us against ~4.4 us per evaluation in the compiled loop) and
-#: rounded up, so that the switch errs towards staying compiled.
-STEP_OVERHEAD_RHS = 6.0
-#: Switch only when the stiff backend's work is below this share of DP5's.
+STIFF_METHOD = "CVODE"
+#: Cost of one right-hand-side evaluation by model id (us), measured inside the compiled DP5 loop on this
+#: 2-core machine (wall time over evaluations, 3000 rpm): planar 1.83, spatial with 5 strips 5.8-6.1.
+#: Models without an entry (the test models) count 1 us.
+RHS_COST_US: dict[int, float] = {PLANAR: 1.8, SPATIAL: 6.0}
+#: Python overhead of one accepted step by method (us), beyond its right-hand-side evaluations: measured
+#: as (wall - evaluations x RHS cost) / steps on 5 ms windows at 3000 rpm. CVODE: 20 (planar) to 33
+#: (spatial, a 138-state dense back-substitution per Newton iteration), taken as 30; scipy's LSODA ~21
+#: (its Python step loop); the compiled DP5 0 (its loop overhead is inside its per-evaluation cost).
+STEP_COST_US: dict[str, float] = {"dp5": 0.0, "CVODE": 30.0, "LSODA": 21.0}
+#: Switch only when the stiff backend's cost is below this share of DP5's (see the README's table of
+#: measured ratios: the stiff scenes come out far below it, the default planar scene above it).
 SWITCH_GAIN = 0.6
+#: Default step cap (s) for contact resolution: ~t_H / 15 for a ball-ball impact (t_H = 29 us at 0.1 m/s).
+#: DP5 never reaches it in practice (the race damping holds its step at ~1.2 us) and checks onsets itself.
+CONTACT_MAX_STEP_S = 2e-6
+#: Per-method default caps where they differ. CVODE has no onset control, but its error control with at
+#: least 6 steps per impact resolves them: over 5 ms at 1800 rpm from a bunched state (105 ball-ball
+#: episodes) a 5 us cap logged the same episodes as a DP5 rtol 1e-10 reference, with peak forces within
+#: 0.8 % and slip within 1.7e-3 pp, in 1126 steps (a 2 us cap: 4.4e-3 pp, 2608 steps; 20 us: 8.7e-3 pp).
+MAX_STEP_S: dict[str, float] = {"CVODE": 5e-6}
+#: Per-method factor on the caller's rtol, so that one rtol means one accuracy whichever method runs.
+#: CVODE's error test (a weighted RMS norm over the states) is looser than DP5's at the same rtol: from
+#: the packed start under 20 kN, over 20 ms, the energy balance drifted by 1.1e-5 of the input work at
+#: rtol 1e-6 against DP5's 1.7e-6, and by 2.0e-6 at rtol 1e-7, for the same wall time (its steps are
+#: held by the cap: 0.54 against 0.57 s; 3000 rpm 500 N + 400 N axial: 16-17 against 20 wall s per
+#: simulated s).
+RTOL_FACTOR: dict[str, float] = {"CVODE": 0.1}
 #: The chunks (0-based) after which a stiff DP5 chunk is probed.
 PROBE_CHUNKS = (5, 20)
 
 
-def _work(sol: Solution) -> float:
-    """Work of a solve in compiled right-hand-side evaluations (see :data:`STEP_OVERHEAD_RHS`)."""
-    if sol.method == "dp5":
-        return float(sol.n_rhs)
-    return float(sol.n_rhs) + STEP_OVERHEAD_RHS * sol.n_steps
+def _cost(sol: Solution, model_id: int) -> float:
+    """Modelled cost of a solve in us (see :data:`RHS_COST_US` and :data:`STEP_COST_US`)."""
+    return sol.n_rhs * RHS_COST_US.get(model_id, 1.0) + sol.n_steps * STEP_COST_US.get(sol.method, 30.0)
 
 
 def _probe(part: Problem, t: npt.NDArray[np.float64], sol: Solution, time_s: float, kw: dict[str, Any]) -> dict[str, Any]:
     """Run the stiff backend over the chunk ``sol`` covered and say whether it pays."""
-    trial = solve(part, t, method=STIFF_METHOD, **kw)
-    ratio = _work(trial) / max(_work(sol), 1.0)
-    return {"time_s": time_s, "stiff_fraction": sol.n_stiff_steps / max(sol.n_steps, 1), "work_ratio": ratio,
+    trial = solve(part, t, method=STIFF_METHOD, **_settings(STIFF_METHOD, kw))
+    ratio = _cost(trial, part.model_id) / max(_cost(sol, part.model_id), 1.0)
+    return {"time_s": time_s, "stiff_fraction": sol.n_stiff_steps / max(sol.n_steps, 1), "cost_ratio": ratio,
             "switch": bool(trial.success and ratio < SWITCH_GAIN), "to": STIFF_METHOD, "wall_s": trial.wall_s}
 
 
-def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: str, max_step: float,
+def default_max_step(method: str) -> float:
+    """The step cap (s) a method gets when the caller gives none (see :data:`MAX_STEP_S`)."""
+    return MAX_STEP_S.get(method, CONTACT_MAX_STEP_S)
+
+
+def _settings(method: str, kw: dict[str, Any]) -> dict[str, Any]:
+    """The caller's solver settings as ``method`` runs them: its default cap when none was given, and its
+    rtol factor (:data:`RTOL_FACTOR`)."""
+    return {**kw, "max_step": kw["max_step"] or default_max_step(method),
+            "rtol": kw["rtol"] * RTOL_FACTOR.get(method, 1.0)}
+
+
+def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: str, max_step: float | None,
                  chunks: int, progress: bool, max_steps: int, force_jump: float) -> Solution:
     """Integrate ``pr`` over the samples ``t`` in about ``chunks`` pieces; ``method`` is a key of
-    :data:`simulation.solve.METHODS` or ``"auto"`` (see the module text)."""
+    :data:`simulation.solve.METHODS` or ``"auto"`` (see the module text). ``max_step`` None gives each
+    method its default cap (:func:`default_max_step`), also after a switch; a number applies to all.
+    ``rtol`` is scaled per method by :data:`RTOL_FACTOR`."""
     edges = np.unique(np.linspace(0, len(t) - 1, chunks + 1).astype(int))
     ys = [pr.y0[None, :]]
     totals = dict.fromkeys(("n_steps", "n_rejected", "n_rhs", "n_onset_retries", "n_contact_changes",
@@ -87,7 +125,7 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
             part = replace(pr, aux=aux, y0=y0, t0=t0)
             kw = {"rtol": rtol, "max_step": max_step, "force_jump": force_jump,
                   "max_steps": max(1, max_steps - totals["n_steps"] - totals["n_rejected"])}
-            sol = solve(part, t[a + 1:b + 1], method=current, **kw)
+            sol = solve(part, t[a + 1:b + 1], method=current, **_settings(current, kw))
             ys.append(sol.y)
             for key in totals:
                 totals[key] += getattr(sol, key)

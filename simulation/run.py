@@ -33,7 +33,7 @@ from simulation.parameters import ModelParameters
 from simulation.quasistatic import radial_load_distribution
 from simulation.scene import Scene
 from simulation.problem import Problem
-from simulation.chunks import solve_chunks
+from simulation.chunks import CONTACT_MAX_STEP_S, MAX_STEP_S, RTOL_FACTOR, solve_chunks
 from simulation.solve import FORCE_JUMP, METHODS, Solution
 
 __all__ = ["SimulationResult", "EnergyBalance", "build_problem", "check_supported", "energy_balance", "initial_state",
@@ -249,13 +249,16 @@ def _films(scene: Scene, inner: np.ndarray, outer: np.ndarray, ur_i: np.ndarray,
 
 
 def simulate(scene: Scene, choice: ModelChoice, parameters: ModelParameters | None = None, rtol: float = 1e-6,
-             sample_rate_hz: float = 10_000.0, method: str = "auto", max_step: float = 2e-6,
+             sample_rate_hz: float = 10_000.0, method: str = "auto", max_step: float | None = None,
              out: str | Path | None = None, progress: bool = True, config: dict[str, Any] | None = None,
              max_steps: int = 50_000_000, force_jump: float = FORCE_JUMP) -> SimulationResult:
     """Run ``scene`` with the model ``choice`` and (with ``out``) write the trace atomically.
 
     ``method`` is ``"auto"`` (compiled DP5, switching to a stiff solver when that pays: see
-    :mod:`simulation.chunks`) or a key of :data:`simulation.solve.METHODS`. ``max_steps`` bounds the
+    :mod:`simulation.chunks`) or a key of :data:`simulation.solve.METHODS`. ``max_step`` (s) caps every
+    step; None gives each method its default (:func:`simulation.chunks.default_max_step`: 2 us, 5 us
+    for CVODE, also after an automatic switch); CVODE runs at ``rtol / 10`` to match DP5's accuracy
+    (:data:`simulation.chunks.RTOL_FACTOR`). ``max_steps`` bounds the
     accepted plus rejected steps of the whole run; ``force_jump`` is the force-jump fraction of
     :func:`simulation.solve.solve`.
 
@@ -266,9 +269,13 @@ def simulate(scene: Scene, choice: ModelChoice, parameters: ModelParameters | No
     if method != "auto" and method not in METHODS:
         raise ParameterError("method", "is not a solver" + (suggest(method, [*METHODS, "auto"]) or
                                                             f"; use auto or one of {list(METHODS)}"), method)
+    if max_step is not None and not (0 < max_step < np.inf):
+        raise ParameterError("max_step", "must be a positive number of seconds, or None for the defaults", max_step)
     par = parameters or ModelParameters()
     prov = Provenance.start(config={"scene": scene.to_dict(), "model": json.loads(choice.to_json()),
                                     "solver": {"method": method, "rtol": rtol, "max_step": max_step,
+                                               "default_max_step_s": {**MAX_STEP_S, "others": CONTACT_MAX_STEP_S},
+                                               "rtol_factor": RTOL_FACTOR,
                                                "force_jump": force_jump},
                                     "parameters": par.to_dict(), **(config or {})})
     pr = build_problem(scene, choice, par)

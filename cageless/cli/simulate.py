@@ -55,10 +55,11 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--force", action="store_true", help="allow forced choices that contradict the scene")
     p.add_argument("--explain", action="store_true", help="print the level and effects with reasons; do not solve")
     p.add_argument("--json", action="store_true", help="with --explain: print JSON")
-    p.add_argument("--solver", default="auto", help="integrator: auto (default: compiled dp5, switching to LSODA "
-                   "when stiffness makes that cheaper), dp5, RK45, DOP853, LSODA, BDF, Radau")
+    p.add_argument("--solver", default="auto", help="integrator: auto (default: compiled dp5, switching to CVODE "
+                   "(BDF) when stiffness makes that cheaper), dp5, CVODE, RK45, DOP853, LSODA, BDF, Radau")
     p.add_argument("--rtol", type=finite_float, default=1e-6, help="relative tolerance (default 1e-6)")
-    p.add_argument("--max-step", type=finite_float, default=2e-6, help="largest step (s, default 2e-6)")
+    p.add_argument("--max-step", type=finite_float, default=None,
+                   help="largest step (s; default 2e-6, and 5e-6 for CVODE, also after an automatic switch)")
     p.add_argument("--restitution", type=finite_float,
                    help="ball-ball coefficient of restitution R, 0 < R <= 1 (same as --set restitution=R)")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", dest="set_values",

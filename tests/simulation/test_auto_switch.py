@@ -1,10 +1,10 @@
 """The automatic switch to the stiff backend (simulation.chunks): deterministic, recorded, and taken only
-where the work counts say it pays.
+where the cost model says it pays.
 
-Measured on 50 ms runs at 3000 rpm: with R = 0 (ball-ball damping chi = 1000) DP5 sits at the stability
-edge and LSODA needs 0.32 of its work, so the run switches (2.24 s against 2.78 s of wall time); a 20 kN
-load switches at the second probe (2.5 s against 4.6 s); the default lubricated 500 N scene probes once
-(LSODA 1.16 of DP5's work) and stays on DP5.
+Measured on 50 ms runs at 3000 rpm (wall time, auto against DP5 throughout): with R = 0 (ball-ball
+damping chi = 1000) DP5 sits at the stability edge and CVODE costs 0.26 of it, so the run switches at
+6 ms (1.4 s against 2.1-2.8 s); a 20 kN load switches at 6 ms (cost ratio 0.45; 1.7 s against 4.7 s);
+the default lubricated 500 N scene probes once (CVODE 1.9 of DP5's cost) and stays on DP5.
 """
 
 from __future__ import annotations
@@ -25,15 +25,18 @@ def _run(load: float, duration: float = 0.03, **par):
     return simulate(scene, choose_model(scene), parameters=ModelParameters(**par), progress=False)
 
 
-def test_a_stiff_scene_switches_to_lsoda_and_says_so():
+def test_a_stiff_scene_switches_to_cvode_and_says_so():
     res = _run(500.0, restitution=0.0)
     sol, tr = res.solution, res.trace
     assert sol.success and np.all(np.isfinite(tr.slip))
-    assert sol.method.startswith("auto: dp5 -> LSODA at")
+    assert sol.method.startswith("auto: dp5 -> CVODE at")
     probes = tr.provenance["solver_stats"]["switch_probes"]
-    assert probes[0]["switch"] and probes[0]["work_ratio"] < 0.6 and probes[0]["stiff_fraction"] > 0.6
+    assert probes[0]["switch"] and probes[0]["cost_ratio"] < 0.6 and probes[0]["stiff_fraction"] > 0.6
     assert tr.simulation.solver == sol.method
-    again = _run(500.0, restitution=0.0)  # the decision uses work counts, not timing: same trace again
+    solver = tr.provenance["config"]["solver"]  # the resolved settings the switched run used are on record
+    assert solver["max_step"] is None and solver["default_max_step_s"]["CVODE"] == 5e-6
+    assert solver["rtol_factor"]["CVODE"] == 0.1
+    again = _run(500.0, restitution=0.0)  # the decision uses counts, not timing: same trace again
     assert again.solution.method == sol.method and np.array_equal(again.trace.slip, tr.slip, equal_nan=True)
 
 
@@ -43,7 +46,9 @@ def test_the_default_scene_stays_compiled():
     assert all(not p["switch"] for p in sol.extra["switches"])
 
 
-def test_an_unknown_method_is_refused_before_anything_runs():
+def test_an_unknown_method_or_a_bad_cap_is_refused_before_anything_runs():
     scene = Scene(conditions=OperatingConditions(3000.0, 500.0))
+    with pytest.raises(ParameterError, match="max_step"):
+        simulate(scene, choose_model(scene), max_step=0.0, progress=False)
     with pytest.raises(ParameterError, match="Did you mean 'LSODA'"):
         simulate(scene, choose_model(scene), method="LSDOA", progress=False)

@@ -115,7 +115,7 @@ def test_hard_case_statistics_converge(name):
     settle = startup_duration(rpm, g.ball_diameter_m, g.pitch_diameter_m)
     scene, par = _scene(name, settle + STATISTICS_S)
     profiles, peaks = [], []
-    for rtol, max_step in ((1e-6, 2e-6), (1e-7, 1e-6)):
+    for rtol, max_step in ((1e-6, None), (1e-7, 1e-6)):  # default caps (2 us; CVODE 5 us), then at most half
         tr = simulate(scene, choose_model(scene), parameters=par, rtol=rtol, max_step=max_step, progress=False).trace
         keep = (tr.time >= settle)[:, None] & tr.valid
         profiles.append(angle_profile(tr.angle, tr.slip, 1.0, valid=keep)["mean"].to_numpy())
