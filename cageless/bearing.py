@@ -139,6 +139,25 @@ class Geometry:
         """Outer groove curvature radius r_o = f_o D (m)."""
         return self.outer_curvature_factor * self.ball_diameter_m
 
+    def with_diametral_clearance(self, clearance_m: float) -> Geometry:
+        """The same bearing with diametral clearance ``clearance_m`` (m), the pitch diameter kept.
+
+        The races move apart symmetrically: d_i and d_o change by -/+ half the change of P_d. For the
+        ranges of the clearance groups see ISO 5753-1 (deep-groove ball bearings of bore over 24 up to
+        30 mm, this bearing's size: CN 5-20 um, C3 13-28 um, C4 23-41 um).
+
+        Raises
+        ------
+        GeometryError
+            For a negative or non-finite clearance.
+        """
+        if not (math.isfinite(clearance_m) and clearance_m >= 0.0):
+            raise GeometryError("geometry.diametral_clearance_m", "must be a finite clearance >= 0 m "
+                                "(interference fits are not supported)", clearance_m)
+        half = 0.5 * (clearance_m - self.diametral_clearance_m)
+        return dataclasses.replace(self, inner_race_diameter_m=self.inner_race_diameter_m - half,
+                                   outer_race_diameter_m=self.outer_race_diameter_m + half)
+
 
 @dataclass(frozen=True)
 class Material:

@@ -48,6 +48,9 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--moment-load-nm", type=finite_float, default=0.0,
                    help="moment load on the inner ring about y (N m); selects the spatial level")
     p.add_argument("--oil-air-density", type=finite_float, help="oil-air mixture density (kg/m^3); enables drag")
+    p.add_argument("--clearance-um", type=finite_float,
+                   help="diametral clearance (um), races moved apart symmetrically (default: the bearing's, 0 for "
+                   "the paper's; ISO 5753-1 C4 for this size is 23-41 um)")
     p.add_argument("--dry", action="store_true", help="no lubricant")
     p.add_argument("--seed", type=int, default=0, help="perturbs the initial gaps")
     p.add_argument("--level", help="force the model level: planar or spatial")
@@ -84,6 +87,8 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     bearing = bearing_from_config(config)
     if args.dry:
         bearing = dataclasses.replace(bearing, lubricant=None)
+    if args.clearance_um is not None:
+        bearing = dataclasses.replace(bearing, geometry=bearing.geometry.with_diametral_clearance(1e-6 * args.clearance_um))
     scene = Scene(conditions=OperatingConditions(args.speed_rpm, args.radial_load_n, args.axial_load_n),
                   bearing=bearing, gravity_m_s2=args.gravity, orientation=args.orientation,
                   misalignment_rad=args.misalignment_rad, moment_load_nm=args.moment_load_nm,

@@ -68,6 +68,19 @@ def test_races_must_make_room_for_the_ball():
         _geometry(ball_diameter_m=9.6e-3)
 
 
+def test_a_clearance_moves_the_races_apart_about_the_pitch_circle():
+    g = wang2026.geometry()
+    c4 = g.with_diametral_clearance(40e-6)
+    # P_d = d_o - d_i - 2D (Harris & Kotzalas, vol. 1, ch. 2), with d_m = (d_i + d_o) / 2 unchanged
+    assert c4.outer_race_diameter_m - c4.inner_race_diameter_m - 2 * c4.ball_diameter_m == pytest.approx(40e-6, abs=1e-12)
+    assert c4.pitch_diameter_m == pytest.approx(g.pitch_diameter_m, abs=1e-12)
+    assert c4.with_diametral_clearance(0.0).diametral_clearance_m == 0.0
+    for bad in (-1e-6, math.nan):
+        with pytest.raises(GeometryError, match="clearance") as err:
+            g.with_diametral_clearance(bad)
+        assert err.value.parameter == "geometry.diametral_clearance_m"
+
+
 def test_material_and_lubricant_rules():
     with pytest.raises(ParameterError, match=r"\(-1, 0.5\)") as err:
         Material(density_kg_m3=7810.0, youngs_modulus_pa=208e9, poisson_ratio=0.5)
