@@ -147,9 +147,11 @@ def _summary_line(trace: Any, sol: Any, out: str) -> str:
 
     settle = min(startup_duration(trace.speed_rpm, trace.ball_diameter_m, trace.pitch_diameter_m),
                  0.5 * float(trace.time[-1]))
-    return (f"{trace.status} ({sol.method}): {sol.n_steps} steps, {sol.n_rejected} rejected ({sol.n_onset_retries} at "
-            f"contact onsets, {sol.n_force_jump_retries} at force jumps; {sol.n_contact_changes} contact changes; "
-            f"{sol.n_stiff_steps} at the stability edge), {sol.n_rhs} RHS calls, "
+    dp5_only = sol.method in ("dp5", "auto: dp5")
+    counted = "" if dp5_only else " by DP5; CVODE's and scipy's rejections are not counted"
+    return (f"{trace.status} ({sol.method}): {sol.n_steps} steps, {sol.n_rejected} rejected{counted} "
+            f"({sol.n_onset_retries} at contact onsets, {sol.n_force_jump_retries} at force jumps; "
+            f"{sol.n_contact_changes} contact changes; {sol.n_stiff_steps} at the stability edge), {sol.n_rhs} RHS calls, "
             f"{trace.simulation.wall_s:.2f} s wall for {trace.time[-1]:g} s simulated; contact episodes "
             f"{len(ev)} ({int((ev.kind == 'impact').sum())} impacts); peak slip in the unloaded zone after "
             f"{1e3 * settle:.0f} ms: {100 * peak_unloaded_slip(trace, settle_s=settle):.2f}% -> {out}")
