@@ -183,14 +183,18 @@ def test_with_clearance_slip_falls_and_rubbing_takes_over_as_axial_load_grows(cl
     300 N, so these appear. Measured over 150 ms after 150 ms (3000 rpm, 500 N radial): peak slip in the
     unloaded zone 1.57 % at 300 N, 0.42 % at 400 N, 0.16 % at 500 N; 30 impacts and 44 rubbing episodes
     (mean 6.0 ms) at 300 N, 0 impacts and 30 rubbing episodes (mean 6.8 ms) at 500 N; swing of the inner
-    contact angle 23.2, 21.6, 20.2 deg; impacts at 184-191 deg, the load being at 270 deg. Not reproduced:
-    the number of rubbing episodes does not grow (44 -> 27 -> 30; they merge into longer ones)."""
+    contact angle 23.2, 21.6, 20.2 deg; impacts at 184-191 deg, the load being at 270 deg. Seeds 1-3 give
+    the same to within 0.01 pp of slip and 0.03 deg of swing. So contacts are more likely to be rubbing
+    (59 % -> 100 % of episodes) and rubbing lasts longer; the number of rubbing episodes does not grow
+    (44 -> 27 -> 30; they merge into longer ones)."""
     late = {fa: tr.time > 0.15 for fa, tr in clearance_runs.items()}
     peak = {fa: peak_unloaded_slip(tr, 0.15) for fa, tr in clearance_runs.items()}
     assert peak[300.0] > 0.005 and peak[500.0] < 0.5 * peak[300.0]
     events = {fa: tr.events[tr.events.time > 0.15] for fa, tr in clearance_runs.items()}
     share = {fa: float((ev.kind == "rubbing").mean()) for fa, ev in events.items()}
     assert (events[300.0].kind == "impact").sum() >= 5 and share[500.0] > share[300.0]
+    length = {fa: float(ev.duration[ev.kind == "rubbing"].mean()) for fa, ev in events.items()}
+    assert length[500.0] > length[300.0]  # seeds 0-3: 6.0-6.3 ms at 300 N, 6.8 ms at 500 N
     impact_deg = np.degrees(events[300.0].angle[events[300.0].kind == "impact"].to_numpy()) % 360
     assert not np.any((impact_deg > 240) & (impact_deg < 300))
     swing = {}
