@@ -45,8 +45,8 @@ from simulation.kernels import PLANAR, SPATIAL
 from simulation.problem import Problem
 from simulation.solve import Solution, solve
 
-__all__ = ["solve_chunks", "default_max_step", "CONTACT_MAX_STEP_S", "MAX_STEP_S", "RTOL_FACTOR", "STIFF_FRACTION", "RHS_COST_US", "STEP_COST_US", "SWITCH_GAIN", "STIFF_METHOD",
-           "PROBE_CHUNKS"]
+__all__ = ["solve_chunks", "default_max_step", "CONTACT_MAX_STEP_S", "MAX_STEP_S", "RTOL_FACTOR", "STIFF_FRACTION",
+           "RHS_COST_US", "STEP_COST_US", "SWITCH_GAIN", "STIFF_METHOD", "PROBE_CHUNKS"]
 
 #: Share of a chunk's accepted DP5 steps at the stability edge that triggers a probe. Measured over 50 ms
 #: at 3000 rpm: the default 500 N scene 0.82 (the race damping: it is probed and stays, see
@@ -91,7 +91,8 @@ def _cost(sol: Solution, model_id: int) -> float:
     return sol.n_rhs * RHS_COST_US.get(model_id, 1.0) + sol.n_steps * STEP_COST_US.get(sol.method, 30.0)
 
 
-def _probe(part: Problem, t: npt.NDArray[np.float64], sol: Solution, time_s: float, kw: dict[str, Any]) -> dict[str, Any]:
+def _probe(part: Problem, t: npt.NDArray[np.float64], sol: Solution, time_s: float,
+           kw: dict[str, Any]) -> dict[str, Any]:
     """Run the stiff backend over the chunk ``sol`` covered and say whether it pays."""
     trial = solve(part, t, method=STIFF_METHOD, **_settings(STIFF_METHOD, kw))
     ratio = _cost(trial, part.model_id) / max(_cost(sol, part.model_id), 1.0)
@@ -141,18 +142,19 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
             if not sol.success:
                 break
             span = float(t[b] - t[a])
-            if current == STIFF_METHOD and method == "auto" and _cost(sol, pr.model_id) / span > dp5_rate:
+            rate = _cost(sol, pr.model_id) / span
+            if current == STIFF_METHOD and method == "auto" and rate > dp5_rate:
                 # the probe's chunk was not representative: the stiff backend now costs more per simulated
                 # second than DP5 did there, so go back to DP5 for good
-                probes.append({"time_s": float(t[b]), "switch": True, "to": "dp5", "cost_ratio":
-                               _cost(sol, pr.model_id) / span / dp5_rate, "stiff_fraction": float("nan"), "wall_s": 0.0})
+                probes.append({"time_s": float(t[b]), "switch": True, "to": "dp5", "cost_ratio": rate / dp5_rate,
+                               "stiff_fraction": None, "wall_s": 0.0})
                 current, switched_back = "dp5", True
             elif (method == "auto" and current == "dp5" and not switched_back and i in PROBE_CHUNKS
                     and sol.n_stiff_steps >= STIFF_FRACTION * max(sol.n_steps, 1)):
                 probes.append(_probe(part, t[a + 1:b + 1], sol, float(t[b]), kw))
                 wall += probes[-1]["wall_s"]
                 if probes[-1]["switch"]:
-                    current, dp5_rate = STIFF_METHOD, _cost(sol, pr.model_id) / span
+                    current, dp5_rate = STIFF_METHOD, rate
             y0, aux, t0 = sol.y[-1].copy(), sol.extra.get("aux", aux), float(t[b])
     y = np.concatenate(ys)
     if len(y) < len(t):

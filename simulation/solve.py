@@ -193,7 +193,8 @@ def step_cvode(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float = n
             status, message = 1, _MESSAGES[1]
             break
         res = solver.step(float(t_eval[-1]), method="onestep")
-        state, now = np.array(res.y, dtype=np.float64).reshape(-1), float(np.ravel(res.t)[0])  # writable: one compiled variant
+        # a writable copy: a read-only array would compile a second variant of the bookkeeping
+        state, now = np.array(res.y, dtype=np.float64).reshape(-1), float(np.ravel(res.t)[0])
         if not res.success:
             status = _cvode_status(state, int(res.status))
             message = f"CVODE: {res.message}"

@@ -88,7 +88,8 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     if args.dry:
         bearing = dataclasses.replace(bearing, lubricant=None)
     if args.clearance_um is not None:
-        bearing = dataclasses.replace(bearing, geometry=bearing.geometry.with_diametral_clearance(1e-6 * args.clearance_um))
+        geometry = bearing.geometry.with_diametral_clearance(1e-6 * args.clearance_um)
+        bearing = dataclasses.replace(bearing, geometry=geometry)
     scene = Scene(conditions=OperatingConditions(args.speed_rpm, args.radial_load_n, args.axial_load_n),
                   bearing=bearing, gravity_m_s2=args.gravity, orientation=args.orientation,
                   misalignment_rad=args.misalignment_rad, moment_load_nm=args.moment_load_nm,
@@ -151,7 +152,8 @@ def _summary_line(trace: Any, sol: Any, out: str) -> str:
     counted = "" if dp5_only else " by DP5; CVODE's and scipy's rejections are not counted"
     return (f"{trace.status} ({sol.method}): {sol.n_steps} steps, {sol.n_rejected} rejected{counted} "
             f"({sol.n_onset_retries} at contact onsets, {sol.n_force_jump_retries} at force jumps; "
-            f"{sol.n_contact_changes} contact changes; {sol.n_stiff_steps} at the stability edge), {sol.n_rhs} RHS calls, "
+            f"{sol.n_contact_changes} contact changes; {sol.n_stiff_steps} at the stability edge), "
+            f"{sol.n_rhs} RHS calls, "
             f"{trace.simulation.wall_s:.2f} s wall for {trace.time[-1]:g} s simulated; contact episodes "
             f"{len(ev)} ({int((ev.kind == 'impact').sum())} impacts); peak slip in the unloaded zone after "
             f"{1e3 * settle:.0f} ms: {100 * peak_unloaded_slip(trace, settle_s=settle):.2f}% -> {out}")

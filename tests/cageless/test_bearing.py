@@ -72,7 +72,8 @@ def test_a_clearance_moves_the_races_apart_about_the_pitch_circle():
     g = wang2026.geometry()
     c4 = g.with_diametral_clearance(40e-6)
     # P_d = d_o - d_i - 2D (Harris & Kotzalas, vol. 1, ch. 2), with d_m = (d_i + d_o) / 2 unchanged
-    assert c4.outer_race_diameter_m - c4.inner_race_diameter_m - 2 * c4.ball_diameter_m == pytest.approx(40e-6, abs=1e-12)
+    clearance = c4.outer_race_diameter_m - c4.inner_race_diameter_m - 2 * c4.ball_diameter_m
+    assert clearance == pytest.approx(40e-6, abs=1e-12)
     assert c4.pitch_diameter_m == pytest.approx(g.pitch_diameter_m, abs=1e-12)
     assert c4.with_diametral_clearance(0.0).diametral_clearance_m == 0.0
     for bad in (-1e-6, math.nan):

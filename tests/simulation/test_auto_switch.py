@@ -50,8 +50,8 @@ def test_a_switch_that_stops_paying_is_undone():
 
     scene = Scene(conditions=OperatingConditions(3000.0, 500.0), duration_s=0.02)
     scene = replace(scene, bearing=replace(scene.bearing, lubricant=None))
-    res = simulate(scene, choose_model(scene, level="spatial", force=True), parameters=ModelParameters(dry_friction_coefficient=0.1),
-                   progress=False)
+    res = simulate(scene, choose_model(scene, level="spatial", force=True),
+                   parameters=ModelParameters(dry_friction_coefficient=0.1), progress=False)
     probes = res.solution.extra["switches"]
     assert [p["to"] for p in probes if p["switch"]] == ["CVODE", "dp5"]
     assert probes[-1]["cost_ratio"] > 1.0
