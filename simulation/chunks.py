@@ -43,7 +43,7 @@ from tqdm.auto import tqdm
 
 from simulation.kernels import PLANAR, SPATIAL
 from simulation.problem import Problem
-from simulation.solve import Solution, solve
+from simulation.solve import CvodeSession, Solution, solve, step_cvode
 
 __all__ = ["solve_chunks", "default_max_step", "CONTACT_MAX_STEP_S", "MAX_STEP_S", "RTOL_FACTOR", "STIFF_FRACTION",
            "RHS_COST_US", "STEP_COST_US", "SWITCH_GAIN", "STIFF_METHOD", "PROBE_CHUNKS"]
@@ -127,13 +127,20 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
     current = "dp5" if method == "auto" else method
     probes: list[dict[str, Any]] = []
     dp5_rate, switched_back = np.inf, False
+    session: CvodeSession | None = None
     sol = None
     with tqdm(total=float(t[-1] - t[0]), desc="simulated s", unit="s", disable=not progress, leave=False) as bar:
         for i, (a, b) in enumerate(zip(edges[:-1], edges[1:], strict=True)):
             part = replace(pr, aux=aux, y0=y0, t0=t0)
             kw = {"rtol": rtol, "max_step": max_step, "force_jump": force_jump,
                   "max_steps": max(1, max_steps - totals["n_steps"] - totals["n_rejected"])}
-            sol = solve(part, t[a + 1:b + 1], method=current, **_settings(current, kw))
+            settings = _settings(current, kw)
+            if current == "CVODE":  # kept warm across chunks (see simulation.solve.CvodeSession)
+                sol = step_cvode(part, t[a + 1:b + 1], settings["rtol"], settings["max_step"],
+                                 max_steps=settings["max_steps"], session=session)
+                session = sol.extra["cvode"]
+            else:
+                sol = solve(part, t[a + 1:b + 1], method=current, **settings)
             ys.append(sol.y)
             for key in totals:
                 totals[key] += getattr(sol, key)

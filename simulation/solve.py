@@ -38,7 +38,7 @@ from simulation.integrators.dp5 import STATUS_OK, dp5_integrate
 from simulation.kernels import model_post, model_rhs
 from simulation.problem import Problem
 
-__all__ = ["FORCE_JUMP", "Problem", "Solution", "METHODS", "solve", "step_scipy"]
+__all__ = ["FORCE_JUMP", "Problem", "Solution", "METHODS", "CvodeSession", "solve", "step_scipy", "step_cvode"]
 
 FloatArray = npt.NDArray[np.float64]
 _SCIPY = {"RK45": RK45, "DOP853": DOP853, "LSODA": LSODA, "BDF": BDF, "Radau": Radau}
@@ -155,44 +155,77 @@ def _cvode_status(y: FloatArray, status: int) -> int:
     return 1 if status == -1 else 2
 
 
+@dataclass
+class CvodeSession:
+    """A CVODE integrator kept between calls, so a run in chunks does not restart it cold each time.
+
+    A cold restart begins again at order 1 from a small step and evaluates a new difference-quotient
+    Jacobian (one right-hand side per state). Over 20 ms in 50 chunks that cost 8 % more wall time under
+    a 20 kN load and 36 % at the spatial level (500 N + 400 N axial) than one uninterrupted call.
+    """
+
+    solver: Any
+    model_id: int
+    params: FloatArray
+    aux: FloatArray
+    #: CVODE's own time and state: the end of its last internal step (at or past the last sample).
+    t: float
+    state: FloatArray
+    n_rhs: int = 0
+
+    @classmethod
+    def start(cls, pr: Problem, rtol: float, max_step: float, first_step: float | None,
+              max_steps: int) -> CvodeSession:
+        """A new integrator at ``pr``'s start."""
+        try:
+            from sksundae.cvode import CVODE
+        except ImportError as exc:  # pragma: no cover - a declared dependency
+            raise ParameterError("method", "CVODE needs scikit-sundae; install it (pip install scikit-sundae) "
+                                 "or choose dp5 or LSODA", "CVODE") from exc
+        buf = np.empty(len(pr.y0))  # CVODE's y is read-only; a writable copy avoids a second compiled variant
+        session = cls(None, pr.model_id, pr.params, pr.aux.copy(), float(pr.t0), pr.y0.astype(np.float64))
+
+        def rhs(t: float, y: FloatArray, yp: FloatArray) -> None:
+            session.n_rhs += 1
+            buf[:] = y
+            model_rhs(session.model_id, t, buf, session.params, session.aux, yp)
+
+        session.solver = CVODE(rhs, method="BDF", rtol=rtol, atol=pr.atol.astype(np.float64), linsolver="dense",
+                               max_step=0.0 if not np.isfinite(max_step) else max_step,
+                               first_step=first_step or 0.0, max_num_steps=max_steps)
+        session.solver.init_step(session.t, session.state.copy())
+        return session
+
+    def sample(self, t: float) -> FloatArray:
+        """The state at ``t``, inside the last internal step (CVODE's interpolant)."""
+        return self.state if t == self.t else np.ravel(self.solver.step(float(t)).y)
+
+
 def step_cvode(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float = np.inf,
-               first_step: float | None = None, max_steps: int = 50_000_000) -> Solution:
+               first_step: float | None = None, max_steps: int = 50_000_000,
+               session: CvodeSession | None = None) -> Solution:
     """Integrate with SUNDIALS CVODE (BDF) one internal step at a time, sampling by its interpolant.
 
     After every accepted step the model's bookkeeping runs on the step's end state, and the samples the
     step passed are read from CVODE's Nordsieck interpolant (a ``normal``-mode call behind the current
-    time interpolates without stepping).
+    time interpolates without stepping). ``session`` continues an earlier call's integrator (whose last
+    sample was ``pr``'s start; ``pr.y0`` and ``pr.aux`` are then its own); the solution's
+    ``extra["cvode"]`` is the session to continue with.
     """
-    try:
-        from sksundae.cvode import CVODE
-    except ImportError as exc:  # pragma: no cover - a declared dependency
-        raise ParameterError("method", "CVODE needs scikit-sundae; install it (pip install scikit-sundae) "
-                             "or choose dp5 or LSODA", "CVODE") from exc
-    aux = pr.aux.copy()
-    count = [0]
-    model_id, params = pr.model_id, pr.params
-    state_buf = np.empty(len(pr.y0))  # CVODE's y is read-only; a writable copy avoids a second compiled variant
-
-    def rhs(t: float, y: FloatArray, yp: FloatArray) -> None:
-        count[0] += 1
-        state_buf[:] = y
-        model_rhs(model_id, t, state_buf, params, aux, yp)
-
     start = time.perf_counter()
-    solver = CVODE(rhs, method="BDF", rtol=rtol, atol=pr.atol.astype(np.float64), linsolver="dense",
-                   max_step=0.0 if not np.isfinite(max_step) else max_step, first_step=first_step or 0.0,
-                   max_num_steps=max_steps)
+    if session is None:
+        session = CvodeSession.start(pr, rtol, max_step, first_step, max_steps)
+    rhs_before = session.n_rhs
     y = np.full((len(t_eval), len(pr.y0)), np.nan)
     k, steps, status, message = 0, 0, STATUS_OK, "reached the end"
-    while k < len(t_eval) and t_eval[k] <= pr.t0:
-        y[k] = pr.y0
+    while k < len(t_eval) and t_eval[k] <= session.t:
+        y[k] = session.sample(t_eval[k])
         k += 1
-    solver.init_step(pr.t0, pr.y0.astype(np.float64))
     while k < len(t_eval):
         if steps >= max_steps:
             status, message = 1, _MESSAGES[1]
             break
-        res = solver.step(float(t_eval[-1]), method="onestep")
+        res = session.solver.step(float(t_eval[-1]), method="onestep")
         # a writable copy: a read-only array would compile a second variant of the bookkeeping
         state, now = np.array(res.y, dtype=np.float64).reshape(-1), float(np.ravel(res.t)[0])
         if not res.success:
@@ -200,12 +233,14 @@ def step_cvode(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float = n
             message = f"CVODE: {res.message}"
             break
         steps += 1
-        model_post(model_id, now, state, params, aux)  # accepted-step bookkeeping
+        session.t, session.state = now, state
+        model_post(session.model_id, now, state, session.params, session.aux)  # accepted-step bookkeeping
         while k < len(t_eval) and t_eval[k] <= now:
-            y[k] = state if t_eval[k] == now else np.ravel(solver.step(float(t_eval[k])).y)
+            y[k] = session.sample(t_eval[k])
             k += 1
-    return Solution(t=t_eval, y=y, status=status, message=message, method="CVODE", n_steps=steps, n_rhs=count[0],
-                    wall_s=time.perf_counter() - start, extra={"aux": aux})
+    return Solution(t=t_eval, y=y, status=status, message=message, method="CVODE", n_steps=steps,
+                    n_rhs=session.n_rhs - rhs_before, wall_s=time.perf_counter() - start,
+                    extra={"aux": session.aux, "cvode": session})
 
 
 def _scipy(method: str) -> Callable[..., Solution]:

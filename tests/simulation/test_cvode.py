@@ -34,3 +34,18 @@ def test_cvode_follows_a_tight_reference_through_impacts(settled):
     assert sol.n_steps < 0.8 * solve(pr, t, rtol=1e-6, max_step=2e-6).n_steps  # not held by stability as DP5 is
     episodes = 5 * z  # the logged-episode counter (simulation.models.planar, auxiliary layout)
     assert sol.extra["aux"][episodes] == ref.extra["aux"][episodes] > 0
+
+
+def test_a_run_in_chunks_keeps_one_warm_integrator(settled):
+    """In chunks, CVODE continues one integrator (simulation.solve.CvodeSession) instead of restarting cold
+    at order 1 with a new Jacobian each time; measured over 20 ms at the spatial level, 50 cold restarts
+    cost 35 % more right-hand-side calls (18506 against 13663), warm chunks 13657."""
+    from simulation.chunks import solve_chunks
+
+    pr, cage = settled
+    z = int(pr.params[P.P_Z])
+    t = np.linspace(0.0, 0.005, 51)
+    one = solve(pr, t, method="CVODE", rtol=1e-7, max_step=5e-6)
+    chunked = solve_chunks(pr, t, 1e-6, "CVODE", None, 25, False, 50_000_000, 0.5)  # rtol / 10 and the 5 us cap
+    assert chunked.success and abs(chunked.n_rhs - one.n_rhs) < 0.02 * one.n_rhs
+    assert 100 * np.abs(chunked.y[:, 3 * z:4 * z] - one.y[:, 3 * z:4 * z]).max() / cage < 1e-3
