@@ -116,12 +116,11 @@ def accuracy_study(rpm: float = 3000.0, load_n: float = 500.0, window_s: float =
     y_np = sol_np.y
     ref_short = solve(pr, tn, rtol=1e-10, max_step=2.5e-7)
     slip_pp, pos_um = _errors(y_np, ref_short.y, z, cage, radius)
-    rows.append({"solver": "LSODA (numpy RHS)", "rtol": 1e-6, "max_step": 2e-6, "ok": True, "wall_s_per_sim_s": wall / numpy_window_s,
-                 "slip_error_pp": slip_pp, "position_error_um": pos_um, "steps": 0, "rhs_calls": 0})
+    rows.append({"solver": "LSODA (numpy RHS)", "rtol": 1e-6, "max_step": 2e-6, "ok": True,
+                 "wall_s_per_sim_s": wall / numpy_window_s, "slip_error_pp": slip_pp, "position_error_um": pos_um, "steps": 0, "rhs_calls": 0})
     base = next(r for r in rows if r["solver"].startswith("dp5") and r["rtol"] == 1e-6)["wall_s_per_sim_s"]
     for r in rows:
         r["label"] = f"{r['solver']}, cap {1e6 * r['max_step']:g} us" if r["max_step"] != 2e-6 else r["solver"]
-    for r in rows:
         r["time_ratio"] = r["wall_s_per_sim_s"] / base
     return {"scene": {"speed_rpm": rpm, "radial_load_n": load_n, "window_s": window_s, "settle_s": settle_s},
             "reference": {"method": "dp5", "rtol": 1e-10, "max_step": 2.5e-7, "wall_s": ref.wall_s}, "rows": rows}
@@ -179,9 +178,9 @@ def model_study(window_s: float = 0.005, settle_s: float = 0.03, repeats: int = 
       11, 21 against a spatial m = 21, rtol 1e-9 reference; and m = 5 under CVODE as ``simulate`` runs it
       (rtol / 10) with a 2 us cap and with its default 5 us cap.
 
-    All at rtol 1e-6 from the same settled state, with DP5 unless named; wall seconds per simulated second (the best of
-    ``repeats`` runs: this shared machine's noise only ever adds time) and the ratio to the planar run
-    measured in the same process.
+    All at rtol 1e-6 from the same settled state, with DP5 unless named; wall seconds per simulated
+    second (the best of ``repeats`` runs: this shared machine's noise only ever adds time) and the ratio to
+    the planar run measured in the same process.
     """
     t = np.linspace(0.0, window_s, 51)
     rows = []
