@@ -5,7 +5,8 @@ start-up; from that state, each candidate integrates the same window, and its
 error is measured against a tight-tolerance reference run in the same process:
 
 * the compiled Dormand-Prince loop across tolerances (rtol 1e-4 ... 1e-8);
-* SUNDIALS CVODE (BDF) across tolerances and step caps (2, 5, 20 us);
+* SUNDIALS CVODE (BDF) across tolerances and step caps (2, 5, 20 us), and at its default settings
+  with each Jacobian of :data:`simulation.solve.JACOBIANS`;
 * scipy's LSODA, BDF and DOP853 on the same compiled right-hand side;
 * scipy's LSODA on the plain-numpy right-hand side (the "numpy" baseline).
 
@@ -40,7 +41,7 @@ from simulation.models import planar as P
 from simulation.parameters import ModelParameters
 from simulation.run import build_problem
 from simulation.scene import Scene
-from simulation.solve import solve, step_scipy
+from simulation.solve import solve, step_cvode, step_scipy
 
 __all__ = ["accuracy_study", "format_accuracy", "plot_accuracy", "model_study", "format_models", "effects_study",
            "format_effects", "OPTIONAL_EFFECTS"]
@@ -48,12 +49,20 @@ __all__ = ["accuracy_study", "format_accuracy", "plot_accuracy", "model_study", 
 #: (method, rtol, max_step in s). The step cap is an accuracy knob of its own for the implicit CVODE,
 #: whose steps are otherwise set by accuracy alone: the default 2 us keeps ~15 steps inside a ball-ball
 #: impact (29 us), the longer caps show what resolving contacts by error control alone buys and costs.
-#: CVODE at rtol 1e-7 and 5 us is how ``simulate`` runs it at rtol 1e-6 (simulation.chunks.RTOL_FACTOR).
+#: CVODE at rtol 3e-8 and 5 us is how ``simulate`` runs it at rtol 1e-6 (simulation.chunks.RTOL_FACTOR).
 CANDIDATES: tuple[tuple[str, float, float], ...] = (
     ("dp5", 1e-4, 2e-6), ("dp5", 1e-5, 2e-6), ("dp5", 1e-6, 2e-6), ("dp5", 1e-7, 2e-6), ("dp5", 1e-8, 2e-6),
-    ("CVODE", 1e-6, 2e-6), ("CVODE", 1e-6, 5e-6), ("CVODE", 1e-7, 5e-6), ("CVODE", 1e-6, 2e-5),
+    ("CVODE", 1e-6, 2e-6), ("CVODE", 1e-6, 5e-6), ("CVODE", 1e-7, 5e-6), ("CVODE", 3e-8, 5e-6),
+    ("CVODE", 1e-6, 2e-5),
     ("LSODA", 1e-6, 2e-6), ("BDF", 1e-6, 2e-6), ("DOP853", 1e-6, 2e-6),
 )
+#: CVODE as ``simulate`` runs it (rtol 1e-7, 5 us) with the other Jacobians of
+#: :data:`simulation.solve.JACOBIANS` (the rows above use the default, the structured one): what the
+#: structured Jacobian saves, and what SuperLU_MT's sparse factorisation costs at this size.
+JACOBIAN_VARIANTS: tuple[tuple[str, float, float, str], ...] = (
+    ("CVODE", 3e-8, 5e-6, "dense"), ("CVODE", 3e-8, 5e-6, "sparse"),
+)
+_JACOBIAN_LABELS = {"dense": "CVODE's own Jacobian", "sparse": "structured Jacobian, sparse LU"}
 
 
 def _settled_problem(rpm: float, load_n: float, settle_s: float, axial_n: float = 0.0, level: str | None = None,
@@ -104,13 +113,16 @@ def accuracy_study(rpm: float = 3000.0, load_n: float = 500.0, window_s: float =
     t = np.linspace(0.0, window_s, 51)
     ref = solve(pr, t, rtol=1e-10, max_step=2.5e-7)
     rows = []
-    for method, rtol, cap in CANDIDATES:
-        sol, wall = _best_wall(lambda method=method, rtol=rtol, cap=cap: solve(pr, t, method=method, rtol=rtol,
-                                                                               max_step=cap), repeats)
+    for method, rtol, cap, jacobian in [(*c, None) for c in CANDIDATES] + list(JACOBIAN_VARIANTS):
+        def run(method: str = method, rtol: float = rtol, cap: float = cap, jacobian: str | None = jacobian) -> Any:
+            if jacobian is None:
+                return solve(pr, t, method=method, rtol=rtol, max_step=cap)
+            return step_cvode(pr, t, rtol, max_step=cap, jacobian=jacobian)
+        sol, wall = _best_wall(run, repeats)
         slip_pp, pos_um = _errors(sol.y, ref.y, z, cage, radius)
         rows.append({"solver": f"{method} (compiled RHS)", "rtol": rtol, "max_step": cap, "ok": sol.success,
                      "wall_s_per_sim_s": wall / window_s, "slip_error_pp": slip_pp, "position_error_um": pos_um,
-                     "steps": sol.n_steps, "rhs_calls": sol.n_rhs})
+                     "steps": sol.n_steps, "rhs_calls": sol.n_rhs, "jacobian": jacobian})
     tn = np.linspace(0.0, numpy_window_s, 6)
     sol_np, wall = _best_wall(lambda: _numpy_lsoda(pr, tn, 1e-6), repeats)
     y_np = sol_np.y
@@ -121,6 +133,8 @@ def accuracy_study(rpm: float = 3000.0, load_n: float = 500.0, window_s: float =
     base = next(r for r in rows if r["solver"].startswith("dp5") and r["rtol"] == 1e-6)["wall_s_per_sim_s"]
     for r in rows:
         r["label"] = f"{r['solver']}, cap {1e6 * r['max_step']:g} us" if r["max_step"] != 2e-6 else r["solver"]
+        if r.get("jacobian"):
+            r["label"] += f", {_JACOBIAN_LABELS[r['jacobian']]}"
         r["time_ratio"] = r["wall_s_per_sim_s"] / base
     return {"scene": {"speed_rpm": rpm, "radial_load_n": load_n, "window_s": window_s, "settle_s": settle_s},
             "reference": {"method": "dp5", "rtol": 1e-10, "max_step": 2.5e-7, "wall_s": ref.wall_s}, "rows": rows}
@@ -176,7 +190,7 @@ def model_study(window_s: float = 0.005, settle_s: float = 0.03, repeats: int = 
       against a planar rtol 1e-10 reference.
     * Combined load (3000 rpm, 500 N radial, 400 N axial), where only the spatial model applies: m = 1, 5,
       11, 21 against a spatial m = 21, rtol 1e-9 reference; and m = 5 under CVODE as ``simulate`` runs it
-      (rtol / 10) with a 2 us cap and with its default 5 us cap.
+      (rtol x 0.03) with a 2 us cap and with its default 5 us cap.
 
     All at rtol 1e-6 from the same settled state, with DP5 unless named; wall seconds per simulated
     second (the best of ``repeats`` runs: this shared machine's noise only ever adds time) and the ratio to
@@ -190,7 +204,7 @@ def model_study(window_s: float = 0.005, settle_s: float = 0.03, repeats: int = 
             ("500 N + 400 N axial", 400.0, "spatial", 21, (
                 ("spatial", 1, "dp5", 2e-6), ("spatial", 5, "dp5", 2e-6), ("spatial", 11, "dp5", 2e-6),
                 ("spatial", 21, "dp5", 2e-6), ("spatial", 5, "CVODE", 2e-6), ("spatial", 5, "CVODE", 5e-6)))):
-        # CVODE rows run as simulate runs them at rtol 1e-6 (rtol / 10, see simulation.chunks.RTOL_FACTOR)
+        # CVODE rows run as simulate runs them at rtol 1e-6 (rtol x 0.03, see simulation.chunks.RTOL_FACTOR)
         base, cage = _settled_problem(3000.0, 500.0, settle_s, axial, level, ref_strips)
         ref = solve(base, t, rtol=1e-9 if axial else 1e-10, max_step=5e-7)
         scene = Scene(conditions=OperatingConditions(3000.0, 500.0, axial))

@@ -11,7 +11,8 @@ import numba
 
 from simulation.models import planar, spatial, textbook, two_balls
 
-__all__ = ["PLANAR", "SPATIAL", "TWO_BALLS", "OSCILLATOR", "RICCATI", "model_rhs", "model_post", "model_signature"]
+__all__ = ["PLANAR", "SPATIAL", "TWO_BALLS", "OSCILLATOR", "RICCATI", "model_rhs", "model_post", "model_signature",
+           "model_ring_share"]
 
 PLANAR, TWO_BALLS, SPATIAL = planar.MODEL_ID, two_balls.MODEL_ID, spatial.MODEL_ID
 OSCILLATOR, RICCATI = textbook.OSCILLATOR, textbook.RICCATI
@@ -49,3 +50,13 @@ def model_signature(model_id, y, p):  # pragma: no cover - compiled
     if model_id == SPATIAL:
         return spatial.spatial_signature(y, p)
     return 0.0
+
+
+@numba.njit(cache=True)
+def model_ring_share(model_id, t, y, p, j, out):  # pragma: no cover - compiled
+    """Ball j's additive share of the rows every ball reaches (the ring's accelerations), for the structured
+    Jacobian of :mod:`simulation.jacobian`. Only the ball-bearing models have one."""
+    if model_id == PLANAR:
+        planar.planar_ring_share(t, y, p, j, out)
+    elif model_id == SPATIAL:
+        spatial.spatial_ring_share(t, y, p, j, out)

@@ -257,7 +257,7 @@ def simulate(scene: Scene, choice: ModelChoice, parameters: ModelParameters | No
     ``method`` is ``"auto"`` (compiled DP5, switching to a stiff solver when that pays: see
     :mod:`simulation.chunks`) or a key of :data:`simulation.solve.METHODS`. ``max_step`` (s) caps every
     step; None gives each method its default (:func:`simulation.chunks.default_max_step`: 2 us, 5 us
-    for CVODE, also after an automatic switch); CVODE runs at ``rtol / 10`` to match DP5's accuracy
+    for CVODE, also after an automatic switch); CVODE runs at ``rtol x 0.03`` to match DP5's accuracy
     (:data:`simulation.chunks.RTOL_FACTOR`). ``max_steps`` bounds the
     accepted plus rejected steps of the whole run; ``force_jump`` is the force-jump fraction of
     :func:`simulation.solve.solve`.

@@ -5,12 +5,13 @@
 * ``"dp5"``: Dormand-Prince 5(4) with its whole loop compiled (the default); it rejects and retries
   any step longer than ``Problem.onset_step`` in which a contact opens or closes, or across which a
   force jumps by more than the fraction ``force_jump`` (see :func:`solve`), and counts both;
-* ``"CVODE"``: SUNDIALS CVODE's variable-order BDF (orders 1-5, Newton iteration with a dense
-  difference-quotient Jacobian) through scikit-sundae, on the compiled right-hand side: the stiff
-  backend the automatic switch of :mod:`simulation.chunks` goes to. Its loop is compiled C, so a step
-  costs the right-hand-side calls plus ~30 us of Python (one call per step for the bookkeeping);
+* ``"CVODE"``: SUNDIALS CVODE's variable-order BDF (orders 1-5, Newton iteration) through
+  scikit-sundae, on the compiled right-hand side, with the structured Jacobian of
+  :mod:`simulation.jacobian` (see :data:`JACOBIANS`): the stiff backend the automatic switch of
+  :mod:`simulation.chunks` goes to. Its loop is compiled C, so a step costs the right-hand-side calls
+  plus 17 us (planar) to 30 us (spatial) of Python and dense linear algebra;
 * ``"RK45"``, ``"DOP853"``, ``"LSODA"``, ``"BDF"``, ``"Radau"``: scipy's ``solve_ivp`` steppers on the
-  same compiled right-hand side, as references.
+  same compiled right-hand side, as references; the implicit ones get the structured Jacobian too.
 
 CVODE and scipy's steppers are stepped one accepted step at a time here, so the accepted-step
 bookkeeping (contact episodes) runs after every step as it does in the compiled loop. They cannot
@@ -25,6 +26,7 @@ statistics; a failure is a result with ``success = False``, never an exception.
 from __future__ import annotations
 
 import time
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -35,6 +37,7 @@ from scipy.integrate import BDF, DOP853, LSODA, RK45, Radau
 
 from cageless.errors import ParameterError, suggest
 from simulation.integrators.dp5 import STATUS_OK, dp5_integrate
+from simulation.jacobian import JacobianStructure
 from simulation.kernels import model_post, model_rhs
 from simulation.problem import Problem
 
@@ -42,6 +45,8 @@ __all__ = ["FORCE_JUMP", "Problem", "Solution", "METHODS", "CvodeSession", "solv
 
 FloatArray = npt.NDArray[np.float64]
 _SCIPY = {"RK45": RK45, "DOP853": DOP853, "LSODA": LSODA, "BDF": BDF, "Radau": Radau}
+#: scipy's methods that use a Jacobian; on the compiled path they get the structured one.
+_IMPLICIT = ("LSODA", "BDF", "Radau")
 #: Default force-jump fraction (see :func:`solve`): a step across which a contact force more than
 #: doubles or halves (a change above half its larger value) is retried shorter.
 FORCE_JUMP = 0.5
@@ -121,6 +126,15 @@ def step_scipy(pr: Problem, t_eval: FloatArray, method: str, rtol: float, max_st
     kw: dict[str, Any] = {"max_step": max_step}
     if first_step:
         kw["first_step"] = first_step
+    structure = JacobianStructure.for_problem(pr) if fun is None and method in _IMPLICIT else None
+    if structure is not None:  # the compiled path gets the structured Jacobian (DESIGN §7: its sparsity)
+        evaluate, jac = structure.evaluator(pr, aux, pr.atol / rtol), np.empty((len(pr.y0), len(pr.y0)))
+
+        def jacobian(t: float, y: FloatArray) -> FloatArray:
+            count[0] += structure.rhs_per_jacobian
+            evaluate(t, y, jac)
+            return jac.copy()
+        kw["jac"] = jacobian
     start = time.perf_counter()
     solver = _SCIPY[method](counted, pr.t0, pr.y0.astype(np.float64), float(t_eval[-1]), rtol=rtol, atol=pr.atol,
                             **kw)
@@ -155,13 +169,51 @@ def _cvode_status(y: FloatArray, status: int) -> int:
     return 1 if status == -1 else 2
 
 
+#: CVODE's Jacobian and linear solver: ``"sparse"``, the structured Jacobian of :mod:`simulation.jacobian`
+#: factorised by SuperLU_MT; ``"structured"``, the same Jacobian in CVODE's dense LU; ``"dense"``, CVODE's own
+#: difference quotients (one right-hand side per state) and dense LU. Models without a structure (the test
+#: models) always use ``"dense"``.
+JACOBIANS = ("sparse", "structured", "dense")
+JACOBIAN_DEFAULT = "structured"
+
+
+def _jacobian_options(pr: Problem, session: CvodeSession, jacobian: str, rtol: float) -> dict[str, Any]:
+    """CVODE's ``linsolver``, ``jacfn`` and ``sparsity`` for ``jacobian``."""
+    if jacobian not in JACOBIANS:
+        raise ParameterError("jacobian", f"must be one of {', '.join(JACOBIANS)}{suggest(jacobian, JACOBIANS)}",
+                             jacobian)
+    structure = JacobianStructure.for_problem(pr) if jacobian != "dense" else None
+    if structure is None:
+        return {"linsolver": "dense"}
+    evaluate = structure.evaluator(pr, session.aux, pr.atol / rtol)
+    per_jacobian = structure.rhs_per_jacobian  # counted with the right-hand sides, for the cost model
+    n = len(pr.y0)
+    full = np.empty((n, n))
+
+    if jacobian == "structured":
+        def jac_dense(t: float, y: FloatArray, yp: FloatArray, jj: FloatArray) -> None:
+            session.n_jac += 1
+            session.n_rhs += per_jacobian
+            evaluate(t, y, full)
+            jj[:, :] = full
+        return {"linsolver": "dense", "jacfn": jac_dense}
+    cols, rows = np.nonzero(structure.pattern.T)  # CSC order: by column, then row
+
+    def jac_sparse(t: float, y: FloatArray, yp: FloatArray, jj: FloatArray) -> None:
+        session.n_jac += 1
+        session.n_rhs += per_jacobian
+        evaluate(t, y, full)
+        jj[:] = full[rows, cols]
+    return {"linsolver": "sparse", "jacfn": jac_sparse, "sparsity": structure.pattern.astype(np.float64)}
+
+
 @dataclass
 class CvodeSession:
     """A CVODE integrator kept between calls, so a run in chunks does not restart it cold each time.
 
-    A cold restart begins again at order 1 from a small step and evaluates a new difference-quotient
-    Jacobian (one right-hand side per state). Over 20 ms in 50 chunks that cost 8 % more wall time under
-    a 20 kN load and 36 % at the spatial level (500 N + 400 N axial) than one uninterrupted call.
+    A cold restart begins again at order 1 from a small step and evaluates a new Jacobian. Over 20 ms in
+    50 chunks that cost 8 % more wall time under a 20 kN load and 36 % at the spatial level (500 N + 400 N
+    axial) than one uninterrupted call (measured with CVODE's own difference-quotient Jacobian).
     """
 
     solver: Any
@@ -172,11 +224,13 @@ class CvodeSession:
     t: float
     state: FloatArray
     n_rhs: int = 0
+    #: Jacobians evaluated by the structured routine (CVODE's own difference quotients are not counted here).
+    n_jac: int = 0
 
     @classmethod
     def start(cls, pr: Problem, rtol: float, max_step: float, first_step: float | None,
-              max_steps: int) -> CvodeSession:
-        """A new integrator at ``pr``'s start."""
+              max_steps: int, jacobian: str = JACOBIAN_DEFAULT) -> CvodeSession:
+        """A new integrator at ``pr``'s start; ``jacobian`` is one of :data:`JACOBIANS`."""
         try:
             from sksundae.cvode import CVODE
         except ImportError as exc:  # pragma: no cover - a declared dependency
@@ -190,9 +244,12 @@ class CvodeSession:
             buf[:] = y
             model_rhs(session.model_id, t, buf, session.params, session.aux, yp)
 
-        session.solver = CVODE(rhs, method="BDF", rtol=rtol, atol=pr.atol.astype(np.float64), linsolver="dense",
-                               max_step=0.0 if not np.isfinite(max_step) else max_step,
-                               first_step=first_step or 0.0, max_num_steps=max_steps)
+        options = _jacobian_options(pr, session, jacobian, rtol)
+        with warnings.catch_warnings():  # sparsity with a jacfn: scikit-sundae notes its own routine is unused
+            warnings.filterwarnings("ignore", message="Custom sparse Jacobian approximation")
+            session.solver = CVODE(rhs, method="BDF", rtol=rtol, atol=pr.atol.astype(np.float64),
+                                   max_step=0.0 if not np.isfinite(max_step) else max_step,
+                                   first_step=first_step or 0.0, max_num_steps=max_steps, **options)
         session.solver.init_step(session.t, session.state.copy())
         return session
 
@@ -203,7 +260,7 @@ class CvodeSession:
 
 def step_cvode(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float = np.inf,
                first_step: float | None = None, max_steps: int = 50_000_000,
-               session: CvodeSession | None = None) -> Solution:
+               session: CvodeSession | None = None, jacobian: str = JACOBIAN_DEFAULT) -> Solution:
     """Integrate with SUNDIALS CVODE (BDF) one internal step at a time, sampling by its interpolant.
 
     After every accepted step the model's bookkeeping runs on the step's end state, and the samples the
@@ -214,7 +271,7 @@ def step_cvode(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float = n
     """
     start = time.perf_counter()
     if session is None:
-        session = CvodeSession.start(pr, rtol, max_step, first_step, max_steps)
+        session = CvodeSession.start(pr, rtol, max_step, first_step, max_steps, jacobian)
     rhs_before = session.n_rhs
     y = np.full((len(t_eval), len(pr.y0)), np.nan)
     k, steps, status, message = 0, 0, STATUS_OK, "reached the end"

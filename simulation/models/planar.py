@@ -52,7 +52,7 @@ from simulation.traction import dry_friction, regression_traction
 
 __all__ = [
     "PlanarLayout", "planar_problem", "planar_energy", "packed_start", "contact_events", "DEFAULT_CHO_N_S_M",
-    "RUBBING_FACTOR",
+    "RUBBING_FACTOR", "planar_ring_share", "planar_ring_rows",
 ]
 
 #: Id of this model in :mod:`simulation.kernels`.
@@ -259,6 +259,25 @@ def planar_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     dydt[5 * z + 4] = power_in
     dydt[5 * z + 5] = power
 
+
+
+@numba.njit(cache=True)
+def planar_ring_share(t, y, p, j, out):  # pragma: no cover - compiled
+    """Ball j's share of the ring's accelerations (y'', z''), the rows every ball reaches (see
+    :mod:`simulation.jacobian`): its inner-race force on the ring over the ring's mass."""
+    z = int(p[P_Z])
+    out[0] = out[1] = 0.0
+    if p[P_F_RACE] > 0.5:
+        ramp = p[P_RAMP]
+        w_i = p[P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
+        th = y[z + j]
+        _, _, _, ry, rz, _, _ = _race_forces(y, p, j, z, w_i, np.cos(th), np.sin(th))
+        out[0], out[1] = ry / p[P_MR], rz / p[P_MR]
+
+
+def planar_ring_rows(n_balls: int) -> list[int]:
+    """State indices of the rows :func:`planar_ring_share` fills (the ring's y'' and z'')."""
+    return [5 * n_balls + 2, 5 * n_balls + 3]
 
 @numba.njit(cache=True)
 def planar_signature(y, p):  # pragma: no cover - compiled

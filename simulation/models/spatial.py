@@ -46,7 +46,8 @@ from simulation.hertz import compliance, hertz_contact, race_curvatures
 from simulation.models import planar as P
 from simulation.problem import Problem
 
-__all__ = ["MODEL_ID", "SpatialLayout", "spatial_problem", "spatial_rhs", "spatial_signature", "race_geometry", "spatial_energy"]
+__all__ = ["MODEL_ID", "SpatialLayout", "spatial_problem", "spatial_rhs", "spatial_signature", "race_geometry",
+           "spatial_energy", "spatial_ring_share", "spatial_ring_rows"]
 
 MODEL_ID = 4
 P_RGI, P_RGO, P_FA, P_TILT_Y, P_TILT_Z, P_STRIPS, P_AI, P_AO, P_IR, P_MY, P_GAX = range(P.N_PARAMS, P.N_PARAMS + 11)
@@ -354,6 +355,33 @@ def spatial_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     dydt[tb + 2] = (-s_bz * rmx + c_bz * rmy + p[P_MY]) / p[P_IR]
     dydt[tb + 3] = rmz / p[P_IR]
 
+
+
+@numba.njit(cache=True)
+def spatial_ring_share(t, y, p, j, out):  # pragma: no cover - compiled
+    """Ball j's share of the rows every ball reaches (see :mod:`simulation.jacobian`): the ring's y'', z'',
+    x'' and tilt accelerations from its inner-race contact, in the order of :func:`spatial_ring_rows`."""
+    z = int(p[P.P_Z])
+    for i in range(5):
+        out[i] = 0.0
+    if p[P.P_F_RACE] > 0.5:
+        ramp = p[P.P_RAMP]
+        w_i = p[P.P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
+        tb = y.shape[0] - 4
+        s_bz, c_bz = math.sin(p[P_TILT_Z] + y[tb + 1]), math.cos(p[P_TILT_Z] + y[tb + 1])
+        wt = (-s_bz * y[tb + 2], c_bz * y[tb + 2], y[tb + 3])
+        th = y[z + j]
+        fx, fy, fz, _, _, _, _, _, _, qx, qy, qz = _race(y, p, j, z, True, w_i, _tilt(y, p), math.cos(th),
+                                                         math.sin(th), wt)
+        m_ring = p[P.P_MR]
+        out[0], out[1], out[2] = -fy / m_ring, -fz / m_ring, -fx / m_ring
+        out[3], out[4] = (-s_bz * qx + c_bz * qy) / p[P_IR], qz / p[P_IR]
+
+
+def spatial_ring_rows(n_balls: int) -> list[int]:
+    """State indices of the rows :func:`spatial_ring_share` fills: ring y'', z'', x'', beta_y'', beta_z''."""
+    b = 5 * n_balls + 6
+    return [5 * n_balls + 2, 5 * n_balls + 3, b + 4 * n_balls + 1, b + 4 * n_balls + 4, b + 4 * n_balls + 5]
 
 @numba.njit(cache=True)
 def spatial_signature(y, p):  # pragma: no cover - compiled

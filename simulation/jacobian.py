@@ -1,0 +1,200 @@
+"""The structured finite-difference Jacobian of the bearing models, for the implicit backend (DESIGN §7).
+
+An implicit BDF step solves a Newton system with the matrix I - gamma J, J = df/dy. CVODE's
+default difference-quotient Jacobian perturbs one state at a time: one right-hand side per state
+(76 at the planar level, 138 at the spatial level), and those evaluations were 58 % and 70 % of all
+right-hand sides of a CVODE run. The bearing's Jacobian is sparse with a known structure:
+
+* ball j's states reach only the rows of balls j - 1, j and j + 1 (ball-ball contacts join
+  neighbours only), plus the rows of the inner ring's accelerations (every ball presses on the ring);
+* the ring's states (position, axial position, tilt, their rates) reach every row;
+* the two energy counters (input work, dissipated energy) reach no row.
+
+So J is a cyclic block-tridiagonal band with a dense border, an "arrowhead": no ordering makes it
+banded, but it is sparse. Its columns are estimated in groups (Curtis, Powell & Reid, "On the
+estimation of sparse Jacobian matrices", J. Inst. Math. Appl. 13 (1974) 117-119): balls at least
+three apart round the ring share no ball row, so one right-hand side with the same state of every
+ball of one colour perturbed gives all their ball rows at once. The ring rows are a sum over the
+balls, so each perturbed ball's own share of them is evaluated separately
+(:func:`simulation.kernels.model_ring_share`: one inner-race contact, a small fraction of a right-hand
+side). Fourteen balls need four colours: 5 x 4 + 4 = 24 right-hand sides per planar Jacobian instead of
+76, and 9 x 4 + 10 = 46 instead of 138 at the spatial level.
+
+The counters' own rows (the input and dissipated power) are left zero. Nothing depends on the
+counters, so this only delays their Newton update by one iteration; their values come from the same
+converged states.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+import numpy.typing as npt
+
+from simulation.kernels import PLANAR, SPATIAL, model_rhs, model_ring_share
+from simulation.models import planar, spatial
+from simulation.problem import Problem
+
+__all__ = ["JacobianStructure", "ball_colours", "dense_fd_jacobian"]
+
+IntArray = npt.NDArray[np.int64]
+FloatArray = npt.NDArray[np.float64]
+
+_SRUR = float(np.sqrt(np.finfo(float).eps))
+
+
+def ball_colours(n_balls: int) -> IntArray:
+    """A colouring of the ball ring in which balls of one colour are at least three apart round the ring.
+
+    Blocks 0 1 2 and 0 1 2 3 laid end to end keep that distance across every block boundary and across
+    the ring's closure, so ``n_balls = 3 a + 4 b`` needs at most four colours (fourteen balls: 4).
+    Rings that cannot be split so (fewer than six balls, other than three or four) give every ball its
+    own colour.
+    """
+    if n_balls < 1:
+        raise ValueError(f"n_balls must be positive, got {n_balls}")
+    for fours in range(n_balls // 4 + 1):
+        rest = n_balls - 4 * fours
+        if rest % 3 == 0:
+            colours = [c for _ in range(fours) for c in range(4)] + [c for _ in range(rest // 3) for c in range(3)]
+            return np.array(colours, dtype=np.int64)
+    return np.arange(n_balls, dtype=np.int64)
+
+
+@numba.njit(cache=True)
+def _structured_fd(model_id, t, y, p, aux, ball_cols, groups, ring_rows, other_cols, counters, floor, jac,
+                   y_work, f0, f1, share0, share1):  # pragma: no cover - compiled
+    """Fill ``jac`` (n x n, dense storage) with the grouped difference quotients."""
+    n, n_fields, z, n_ring = y.shape[0], ball_cols.shape[0], ball_cols.shape[1], ring_rows.shape[0]
+    jac[:, :] = 0.0
+    model_rhs(model_id, t, y, p, aux, f0)
+    for j in range(z):
+        model_ring_share(model_id, t, y, p, j, share0[j])
+    y_work[:] = y
+    for f in range(n_fields):
+        for c in range(groups.shape[0]):
+            for m in range(groups.shape[1]):
+                j = groups[c, m]
+                if j < 0:
+                    break
+                col = ball_cols[f, j]
+                y_work[col] = y[col] + _SRUR * max(abs(y[col]), floor[col])
+            model_rhs(model_id, t, y_work, p, aux, f1)
+            for m in range(groups.shape[1]):
+                j = groups[c, m]
+                if j < 0:
+                    break
+                col = ball_cols[f, j]
+                h = y_work[col] - y[col]  # the increment as stored, so the quotient is exact in it
+                for dj in (-1, 0, 1):
+                    jj = (j + dj + z) % z
+                    for ff in range(n_fields):
+                        row = ball_cols[ff, jj]
+                        jac[row, col] = (f1[row] - f0[row]) / h
+                model_ring_share(model_id, t, y_work, p, j, share1)
+                for q in range(n_ring):
+                    jac[ring_rows[q], col] = (share1[q] - share0[j, q]) / h
+                y_work[col] = y[col]
+    for k in range(other_cols.shape[0]):
+        col = other_cols[k]
+        y_work[col] = y[col] + _SRUR * max(abs(y[col]), floor[col])
+        h = y_work[col] - y[col]
+        model_rhs(model_id, t, y_work, p, aux, f1)
+        for i in range(n):
+            jac[i, col] = (f1[i] - f0[i]) / h
+        y_work[col] = y[col]
+    for k in range(counters.shape[0]):
+        jac[counters[k], :] = 0.0
+
+
+@dataclass(frozen=True)
+class JacobianStructure:
+    """Where the nonzeros of a bearing model's Jacobian can be, and how to estimate them in groups."""
+
+    #: State index of field f of ball j, (fields, Z).
+    ball_cols: IntArray
+    #: Balls of each colour, (colours, largest class), padded with -1.
+    groups: IntArray
+    #: Rows every ball reaches (the ring's accelerations), in the order of the model's ring share.
+    ring_rows: IntArray
+    #: Columns estimated one at a time (the ring's states).
+    other_cols: IntArray
+    #: The energy counters: their columns are zero, their rows are left zero.
+    counters: IntArray
+    #: Structural nonzeros, (n, n) boolean.
+    pattern: npt.NDArray[np.bool_]
+
+    @classmethod
+    def for_problem(cls, problem: Problem) -> JacobianStructure | None:
+        """The structure of ``problem``'s model, or None for a model without one (the test models)."""
+        if problem.model_id not in (PLANAR, SPATIAL):
+            return None
+        z = int(problem.params[planar.P_Z])
+        n = len(problem.y0)
+        if problem.model_id == PLANAR:
+            fields = [list(range(f * z, (f + 1) * z)) for f in range(5)]
+            ring_rows = planar.planar_ring_rows(z)
+            other = list(range(5 * z, 5 * z + 4))
+        else:
+            b = 5 * z + 6
+            fields = [list(range(f * z, (f + 1) * z)) for f in range(5)]
+            fields += [list(range(b + f * z, b + (f + 1) * z)) for f in range(4)]
+            ring_rows = spatial.spatial_ring_rows(z)
+            other = list(range(5 * z, 5 * z + 4)) + list(range(b + 4 * z, n))
+        counters = [5 * z + 4, 5 * z + 5]
+        ball_cols = np.array(fields, dtype=np.int64)
+        if sorted(ball_cols.ravel().tolist() + other + counters) != list(range(n)):
+            raise ValueError(f"the state layout of model {problem.model_id} does not match its Jacobian structure")
+        colours = ball_colours(z)
+        members = [np.flatnonzero(colours == c) for c in range(colours.max() + 1)]
+        groups = np.full((len(members), max(len(m) for m in members)), -1, dtype=np.int64)
+        for c, m in enumerate(members):
+            groups[c, :len(m)] = m
+        pattern = np.zeros((n, n), dtype=bool)
+        for j in range(z):
+            rows = ball_cols[:, [(j - 1) % z, j, (j + 1) % z]].ravel()
+            pattern[np.ix_(np.concatenate([rows, ring_rows]), ball_cols[:, j])] = True
+        pattern[:, other] = True
+        pattern[counters, :] = False
+        pattern[np.arange(n), np.arange(n)] = True  # the diagonal is always stored (I - gamma J)
+        return cls(ball_cols, groups, np.array(ring_rows, dtype=np.int64), np.array(other, dtype=np.int64),
+                   np.array(counters, dtype=np.int64), pattern)
+
+    @property
+    def rhs_per_jacobian(self) -> int:
+        """Right-hand sides per Jacobian: one per (field, colour), one per ring state, one at the base point."""
+        return self.ball_cols.shape[0] * self.groups.shape[0] + len(self.other_cols) + 1
+
+    def evaluator(self, problem: Problem, aux: FloatArray, floor: FloatArray):  # noqa: ANN201 - a closure
+        """A function ``(t, y, jac)`` filling ``jac`` (n x n) for ``problem`` with this structure.
+
+        ``floor`` (per state) sets the smallest perturbation scale: the increment of state i is
+        sqrt(eps) max(|y_i|, floor_i), as in CVODE's own difference quotients.
+        """
+        n = len(problem.y0)
+        g = len(self.ring_rows)
+        work = [np.empty(n) for _ in range(4)]  # y copy (CVODE's y is read-only), perturbed y, f0, f1
+        share0, share1 = np.empty((self.ball_cols.shape[1], g)), np.empty(g)
+        floor = np.ascontiguousarray(floor, dtype=np.float64)
+
+        def evaluate(t: float, y: FloatArray, jac: FloatArray) -> None:
+            work[3][:] = y
+            _structured_fd(problem.model_id, float(t), work[3], problem.params, aux, self.ball_cols, self.groups,
+                           self.ring_rows, self.other_cols, self.counters, floor, jac, work[0], work[1], work[2],
+                           share0, share1)
+
+        return evaluate
+
+
+def dense_fd_jacobian(problem: Problem, t: float, y: FloatArray, floor: FloatArray) -> FloatArray:
+    """The plain one-state-at-a-time difference-quotient Jacobian (the reference in the tests)."""
+    f0 = problem.rhs(t, y)
+    n = len(y)
+    jac = np.empty((n, n))
+    for col in range(n):
+        yp = y.copy()
+        yp[col] = y[col] + _SRUR * max(abs(y[col]), floor[col])
+        jac[:, col] = (problem.rhs(t, yp) - f0) / (yp[col] - y[col])
+    return jac
