@@ -22,17 +22,19 @@ project's scenes, and switches when the stiff backend's cost is below :data:`SWI
 Each probe and switch is recorded in the solution (``extra["switches"]``) and from there in the
 trace's solver statistics.
 
-A probe sees one chunk only. After a switch, each chunk's cost per simulated second is compared with
-DP5's on the probed chunk; once the stiff backend costs more, the run goes back to DP5 for good (no more
-probes). The first chunk after the switch is not judged: it holds the integrator's cold start (order 1,
-small steps, a first Jacobian), which the probe already paid and judged. Measured on a dry scene at the
-spatial level: the probe inside the start-up found CVODE at 0.58 of DP5's cost, two milliseconds later
-it cost 1.6 times DP5's rate (Newton failures on the steep dry friction law); without the way back it
-ran to the end at 1.7 times DP5's wall time. A mean over the last two chunks was tried: it kept that run
-on CVODE until 12 ms (1.1-1.2 times DP5's wall time, and an energy error above the hard-case bound).
+A probe sees one chunk only. After a switch, the stiff backend's mean cost per simulated second over
+its last :data:`BACK_WINDOW` chunks is compared with DP5's on the probed chunk; once it costs more, the
+run goes back to DP5 for good (no more probes). The first chunk after the switch is not judged: it holds
+the integrator's cold start (order 1, small steps, a first Jacobian), which the probe already paid and
+judged. Single chunks are not judged either: a burst of contacts can double one chunk's cost (the
+default scene over 50 ms: 1.13 times DP5's rate at 44 ms, between chunks at 0.5-0.65). Measured on a
+dry scene at the spatial level: the probe inside the start-up finds CVODE at 0.48 of DP5's cost, then its
+chunks grow dearer (Newton failures on the steep dry friction law) and the run goes back at 10.4 ms,
+4.9-5.1 s against 4.6 s with DP5 throughout; with no way back CVODE ran to the end at 1.7 times DP5's
+wall time.
 
-The stiff backend cannot take a step back, so after a switch contact onsets are resolved by its error
-control and ``max_step`` only (see :mod:`simulation.solve`).
+The stiff backend cannot take a step back; after a switch it is stopped ahead of predicted contact
+onsets instead (see :func:`simulation.solve.step_cvode`).
 """
 
 from __future__ import annotations
@@ -94,8 +96,8 @@ MAX_STEP_S: dict[str, float] = {"CVODE": 5e-6}
 #: ~1e-6 of the input work; CVODE at 1e-7 by 1.1e-5 (1.17 s), at 3e-8 by 1.3e-6 (1.24 s: its steps are
 #: held by the cap, so the tighter rtol costs ~6 %). Planar, 20 kN: 1.1e-5 at 1e-6, 9e-7 at 1e-7.
 RTOL_FACTOR: dict[str, float] = {"CVODE": 0.03}
-#: Stiff-backend chunks averaged by the way back to DP5 (see the module text: 2 was too slow to react).
-BACK_WINDOW = 1
+#: Stiff-backend chunks averaged by the way back to DP5 (see the module text).
+BACK_WINDOW = 2
 #: The chunks (0-based) after which a stiff DP5 chunk is probed.
 PROBE_CHUNKS = (5, 20)
 
@@ -167,7 +169,8 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
             rate = _cost(sol, pr.model_id) / span
             if current == STIFF_METHOD and method == "auto":
                 stiff_rates.append(rate)
-            # the first chunk after the switch holds the integrator's cold start, paid once: not judged
+            # the first chunk after the switch holds the integrator's cold start, paid once: not judged;
+            # then the mean of the last BACK_WINDOW chunks, so that one burst of contacts does not decide
             recent = stiff_rates[1:][-BACK_WINDOW:]
             if current == STIFF_METHOD and len(recent) == BACK_WINDOW and np.mean(recent) > dp5_rate:
                 # the probe's chunk was not representative: the stiff backend now costs more per simulated

@@ -12,7 +12,7 @@ import numba
 from simulation.models import planar, spatial, textbook, two_balls
 
 __all__ = ["PLANAR", "SPATIAL", "TWO_BALLS", "OSCILLATOR", "RICCATI", "model_rhs", "model_post", "model_signature",
-           "model_ring_share"]
+           "model_ring_share", "model_gaps"]
 
 PLANAR, TWO_BALLS, SPATIAL = planar.MODEL_ID, two_balls.MODEL_ID, spatial.MODEL_ID
 OSCILLATOR, RICCATI = textbook.OSCILLATOR, textbook.RICCATI
@@ -50,6 +50,16 @@ def model_signature(model_id, y, p):  # pragma: no cover - compiled
     if model_id == SPATIAL:
         return spatial.spatial_signature(y, p)
     return 0.0
+
+
+@numba.njit(cache=True)
+def model_gaps(model_id, y, p, out):  # pragma: no cover - compiled
+    """The overlap of every contact of the ball-bearing models (3 Z values; see
+    :func:`simulation.models.planar.planar_gaps`)."""
+    if model_id == PLANAR:
+        planar.planar_gaps(y, p, out)
+    elif model_id == SPATIAL:
+        spatial.spatial_gaps(y, p, out)
 
 
 @numba.njit(cache=True)

@@ -52,7 +52,7 @@ from simulation.traction import dry_friction, regression_traction
 
 __all__ = [
     "PlanarLayout", "planar_problem", "planar_energy", "packed_start", "contact_events", "DEFAULT_CHO_N_S_M",
-    "RUBBING_FACTOR", "planar_ring_share", "planar_ring_rows",
+    "RUBBING_FACTOR", "planar_ring_share", "planar_ring_rows", "planar_gaps",
 ]
 
 #: Id of this model in :mod:`simulation.kernels`.
@@ -299,6 +299,25 @@ def planar_signature(y, p):  # pragma: no cover - compiled
         if d * d - (dx * dx + dz * dz) > 0.0:
             sig += 1.0 + 2 * z + j
     return sig * (sig + 1.0)  # spreads sums so that one contact swapping for another rarely keeps the value
+
+
+@numba.njit(cache=True)
+def planar_gaps(y, p, out):  # pragma: no cover - compiled
+    """The overlap of every contact (m; > 0 closed), the quantities :func:`planar_signature` tests: outer
+    race j at ``out[j]``, inner race j at ``out[z + j]``, balls j and j + 1 at ``out[2 z + j]``. CVODE
+    locates their sign changes (:mod:`simulation.solve`), so it does not step over a contact onset."""
+    z = int(p[P_Z])
+    d = p[P_D]
+    cy, cz = y[5 * z], y[5 * z + 1]
+    for j in range(z):
+        r, th = y[j], y[z + j]
+        out[j] = r + 0.5 * d - 0.5 * p[P_DO]
+        sx, sz = r * np.cos(th) - cy, r * np.sin(th) - cz
+        out[z + j] = 0.5 * p[P_DI] + 0.5 * d - np.sqrt(sx * sx + sz * sz)
+        k = j + 1 if j + 1 < z else 0
+        dx = y[k] * np.cos(y[z + k]) - r * np.cos(th)
+        dz = y[k] * np.sin(y[z + k]) - r * np.sin(th)
+        out[2 * z + j] = d - np.sqrt(dx * dx + dz * dz)
 
 
 # Auxiliary array layout: per pair j (between ball j and j+1):

@@ -47,7 +47,7 @@ from simulation.models import planar as P
 from simulation.problem import Problem
 
 __all__ = ["MODEL_ID", "SpatialLayout", "spatial_problem", "spatial_rhs", "spatial_signature", "race_geometry",
-           "spatial_energy", "spatial_ring_share", "spatial_ring_rows"]
+           "spatial_energy", "spatial_ring_share", "spatial_ring_rows", "spatial_gaps"]
 
 MODEL_ID = 4
 P_RGI, P_RGO, P_FA, P_TILT_Y, P_TILT_Z, P_STRIPS, P_AI, P_AO, P_IR, P_MY, P_GAX = range(P.N_PARAMS, P.N_PARAMS + 11)
@@ -403,6 +403,24 @@ def spatial_signature(y, p):  # pragma: no cover - compiled
         if p[P.P_D] ** 2 - (dx * dx + dy * dy + dz * dz) > 0.0:
             sig += 1.0 + 2 * z + j
     return sig * (sig + 1.0)
+
+
+@numba.njit(cache=True)
+def spatial_gaps(y, p, out):  # pragma: no cover - compiled
+    """The overlap of every contact (m; > 0 closed), as :func:`simulation.models.planar.planar_gaps` orders
+    them, in three dimensions (the quantities :func:`spatial_signature` tests)."""
+    z = int(p[P.P_Z])
+    b = 5 * z + 6
+    rot = _tilt(y, p)
+    for j in range(z):
+        c, s = math.cos(y[z + j]), math.sin(y[z + j])
+        out[j] = _groove(y, p, j, z, False, rot, c, s)[6]
+        out[z + j] = _groove(y, p, j, z, True, rot, c, s)[6]
+        k = j + 1 if j + 1 < z else 0
+        dx = y[b + k] - y[b + j]
+        dy = y[k] * math.cos(y[z + k]) - y[j] * c
+        dz = y[k] * math.sin(y[z + k]) - y[j] * s
+        out[2 * z + j] = p[P.P_D] - math.sqrt(dx * dx + dy * dy + dz * dz)
 
 
 def spatial_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLike, ring0: tuple[float, float],
