@@ -6,7 +6,7 @@ error is measured against a tight-tolerance reference run in the same process:
 
 * the compiled Dormand-Prince loop across tolerances (rtol 1e-4 ... 1e-8);
 * SUNDIALS CVODE (BDF) across tolerances and step caps (2, 5, 20 us), and at its default settings
-  with each Jacobian of :data:`simulation.solve.JACOBIANS`;
+  with each Jacobian of :data:`simulation.solve.JACOBIANS` and without its onset control;
 * scipy's LSODA, BDF and DOP853 on the same compiled right-hand side;
 * scipy's LSODA on the plain-numpy right-hand side (the "numpy" baseline).
 
@@ -56,13 +56,15 @@ CANDIDATES: tuple[tuple[str, float, float], ...] = (
     ("CVODE", 1e-6, 2e-5),
     ("LSODA", 1e-6, 2e-6), ("BDF", 1e-6, 2e-6), ("DOP853", 1e-6, 2e-6),
 )
-#: CVODE as ``simulate`` runs it (rtol 1e-7, 5 us) with the other Jacobians of
-#: :data:`simulation.solve.JACOBIANS` (the rows above use the default, the structured one): what the
-#: structured Jacobian saves, and what SuperLU_MT's sparse factorisation costs at this size.
-JACOBIAN_VARIANTS: tuple[tuple[str, float, float, str], ...] = (
-    ("CVODE", 3e-8, 5e-6, "dense"), ("CVODE", 3e-8, 5e-6, "sparse"),
+#: CVODE as ``simulate`` runs it (rtol 3e-8, 5 us) with one setting changed: the other Jacobians of
+#: :data:`simulation.solve.JACOBIANS` (the rows above use the structured one: what it saves, and what
+#: SuperLU_MT's sparse factorisation costs at this size), and without the onset control (what stopping
+#: ahead of contact changes costs). Variant names are keys of :data:`_VARIANT_LABELS`.
+CVODE_VARIANTS: tuple[tuple[str, float, float, str], ...] = (
+    ("CVODE", 3e-8, 5e-6, "dense"), ("CVODE", 3e-8, 5e-6, "sparse"), ("CVODE", 3e-8, 5e-6, "no onset control"),
 )
-_JACOBIAN_LABELS = {"dense": "CVODE's own Jacobian", "sparse": "structured Jacobian, sparse LU"}
+_VARIANT_LABELS = {"dense": "CVODE's own Jacobian", "sparse": "structured Jacobian, sparse LU",
+                   "no onset control": "no onset control"}
 
 
 def _settled_problem(rpm: float, load_n: float, settle_s: float, axial_n: float = 0.0, level: str | None = None,
@@ -113,16 +115,18 @@ def accuracy_study(rpm: float = 3000.0, load_n: float = 500.0, window_s: float =
     t = np.linspace(0.0, window_s, 51)
     ref = solve(pr, t, rtol=1e-10, max_step=2.5e-7)
     rows = []
-    for method, rtol, cap, jacobian in [(*c, None) for c in CANDIDATES] + list(JACOBIAN_VARIANTS):
-        def run(method: str = method, rtol: float = rtol, cap: float = cap, jacobian: str | None = jacobian) -> Any:
-            if jacobian is None:
+    for method, rtol, cap, variant in [(*c, None) for c in CANDIDATES] + list(CVODE_VARIANTS):
+        def run(method: str = method, rtol: float = rtol, cap: float = cap, variant: str | None = variant) -> Any:
+            if variant is None:
                 return solve(pr, t, method=method, rtol=rtol, max_step=cap)
-            return step_cvode(pr, t, rtol, max_step=cap, jacobian=jacobian)
+            if variant == "no onset control":
+                return step_cvode(pr, t, rtol, max_step=cap, onset_control=False)
+            return step_cvode(pr, t, rtol, max_step=cap, jacobian=variant)
         sol, wall = _best_wall(run, repeats)
         slip_pp, pos_um = _errors(sol.y, ref.y, z, cage, radius)
         rows.append({"solver": f"{method} (compiled RHS)", "rtol": rtol, "max_step": cap, "ok": sol.success,
                      "wall_s_per_sim_s": wall / window_s, "slip_error_pp": slip_pp, "position_error_um": pos_um,
-                     "steps": sol.n_steps, "rhs_calls": sol.n_rhs, "jacobian": jacobian})
+                     "steps": sol.n_steps, "rhs_calls": sol.n_rhs, "variant": variant})
     tn = np.linspace(0.0, numpy_window_s, 6)
     sol_np, wall = _best_wall(lambda: _numpy_lsoda(pr, tn, 1e-6), repeats)
     y_np = sol_np.y
@@ -133,8 +137,8 @@ def accuracy_study(rpm: float = 3000.0, load_n: float = 500.0, window_s: float =
     base = next(r for r in rows if r["solver"].startswith("dp5") and r["rtol"] == 1e-6)["wall_s_per_sim_s"]
     for r in rows:
         r["label"] = f"{r['solver']}, cap {1e6 * r['max_step']:g} us" if r["max_step"] != 2e-6 else r["solver"]
-        if r.get("jacobian"):
-            r["label"] += f", {_JACOBIAN_LABELS[r['jacobian']]}"
+        if r.get("variant"):
+            r["label"] += f", {_VARIANT_LABELS[r['variant']]}"
         r["time_ratio"] = r["wall_s_per_sim_s"] / base
     return {"scene": {"speed_rpm": rpm, "radial_load_n": load_n, "window_s": window_s, "settle_s": settle_s},
             "reference": {"method": "dp5", "rtol": 1e-10, "max_step": 2.5e-7, "wall_s": ref.wall_s}, "rows": rows}

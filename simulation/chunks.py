@@ -28,9 +28,9 @@ run goes back to DP5 for good (no more probes). The first chunk after the switch
 the integrator's cold start (order 1, small steps, a first Jacobian), which the probe already paid and
 judged. Single chunks are not judged either: a burst of contacts can double one chunk's cost (the
 default scene over 50 ms: 1.13 times DP5's rate at 44 ms, between chunks at 0.5-0.65). Measured on a
-dry scene at the spatial level: the probe inside the start-up finds CVODE at 0.48 of DP5's cost, then its
-chunks grow dearer (Newton failures on the steep dry friction law) and the run goes back at 10.4 ms,
-4.9-5.1 s against 4.6 s with DP5 throughout; with no way back CVODE ran to the end at 1.7 times DP5's
+dry scene at the spatial level: the probe inside the start-up finds CVODE at 0.44 of DP5's cost, then its
+chunks grow dearer (Newton failures on the steep dry friction law) and the run goes back at 9.2 ms,
+4.8-4.9 s against 4.6 s with DP5 throughout; with no way back CVODE ran to the end at 1.7 times DP5's
 wall time.
 
 The stiff backend cannot take a step back; after a switch it is stopped ahead of predicted contact

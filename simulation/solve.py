@@ -174,7 +174,10 @@ def _cvode_status(y: FloatArray, status: int) -> int:
 
 #: Share of the predicted time to the next contact change that a CVODE step may cover (see
 #: :meth:`CvodeSession.stop_time`); below 1 because the linear prediction misses accelerating approaches.
-ONSET_APPROACH = 0.5
+#: Contact changes inside steps longer than the onset step, and steps, over 5 ms at 3000 rpm (settled) /
+#: 10 ms at 1800 rpm from the packed start: no control 16 of 19, 1257 / 9 of 204, 12497 steps; 1.0: 6, 1330
+#: / 3, 12597; 0.7: 0, 1357 / 0, 12822; 0.5: 0, 1401 / 0, 12440.
+ONSET_APPROACH = 0.7
 #: CVODE's Jacobian and linear solver: ``"sparse"``, the structured Jacobian of :mod:`simulation.jacobian`
 #: factorised by SuperLU_MT; ``"structured"``, the same Jacobian in CVODE's dense LU; ``"dense"``, CVODE's own
 #: difference quotients (one right-hand side per state) and dense LU. Models without a structure (the test

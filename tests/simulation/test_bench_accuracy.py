@@ -2,18 +2,18 @@
 
 from __future__ import annotations
 
-from simulation.bench import CANDIDATES, JACOBIAN_VARIANTS, accuracy_study, format_accuracy, plot_accuracy
+from simulation.bench import CANDIDATES, CVODE_VARIANTS, accuracy_study, format_accuracy, plot_accuracy
 
 
 def test_accuracy_study_table_and_plot(tmp_path):
     result = accuracy_study(window_s=0.001, settle_s=0.03, numpy_window_s=0.0002)
-    assert len(result["rows"]) == len(CANDIDATES) + len(JACOBIAN_VARIANTS) + 1
+    assert len(result["rows"]) == len(CANDIDATES) + len(CVODE_VARIANTS) + 1
     assert all(r["ok"] for r in result["rows"])
     dp5 = [r for r in result["rows"] if r["solver"].startswith("dp5")]
     # past the start-up every tolerance stays well within the 0.5 pp convergence bar of DESIGN §7
     assert all(r["slip_error_pp"] < 0.05 for r in dp5)
     cvode = [r for r in result["rows"] if r["solver"].startswith("CVODE")]
-    assert len(cvode) == 5 + len(JACOBIAN_VARIANTS) and all(r["slip_error_pp"] < 0.05 for r in cvode)
+    assert len(cvode) == 5 + len(CVODE_VARIANTS) and all(r["slip_error_pp"] < 0.05 for r in cvode)
     text = format_accuracy(result)
     assert "| dp5 (compiled RHS) | 1e-06 |" in text and "LSODA (numpy RHS)" in text
     plot_accuracy(result, str(tmp_path / "wp.png"))
