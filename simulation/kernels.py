@@ -63,10 +63,10 @@ def model_gaps(model_id, y, p, out):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def model_ring_share(model_id, t, y, p, j, out):  # pragma: no cover - compiled
+def model_ring_share(model_id, t, y, p, aux, j, out):  # pragma: no cover - compiled
     """Ball j's additive share of the rows every ball reaches (the ring's accelerations), for the structured
     Jacobian of :mod:`simulation.jacobian`. Only the ball-bearing models have one."""
     if model_id == PLANAR:
-        planar.planar_ring_share(t, y, p, j, out)
+        planar.planar_ring_share(t, y, p, aux, j, out)
     elif model_id == SPATIAL:
-        spatial.spatial_ring_share(t, y, p, j, out)
+        spatial.spatial_ring_share(t, y, p, aux, j, out)

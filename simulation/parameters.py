@@ -36,6 +36,12 @@ Sources
 * ``dry_friction_coefficient``: no default. A dry scene has no film, and the
   Coulomb friction of the bare steel contact must be given (``--set
   dry_friction_coefficient=...``).
+* ``dry_static_coefficient``: no default (None: the same as the Coulomb
+  coefficient, no Stribeck effect). Given, dry friction rises from the Coulomb
+  value to it as the sliding stops, over ``stribeck_speed_m_s``.
+* ``stribeck_speed_m_s``: 0.01 m/s, a choice within the 1e-4 to 1e-2 m/s range
+  of the Stribeck speeds of metal contacts (Olsson et al., Eur. J. Control 4
+  (1998) 176-195, §2); used only with ``dry_static_coefficient``.
 """
 
 from __future__ import annotations
@@ -78,6 +84,11 @@ class ModelParameters:
         Coulomb friction of a dry steel contact, in (0, 1), or None when not given.
     slip_regularisation_m_s
         Sliding speed (m/s) over which the dry Coulomb friction builds up (tanh), > 0.
+    dry_static_coefficient
+        Static friction of a dry steel contact, at least ``dry_friction_coefficient`` and below 1, or None
+        (no Stribeck effect). See :func:`simulation.traction.dry_friction`.
+    stribeck_speed_m_s
+        Stribeck speed v_s (m/s) over which dry friction falls from the static to the Coulomb value, > 0.
     strips
         Strips m across each race contact ellipse in the spatial model (1 = point contact), 1..101: an
         accuracy knob (``cageless bench accuracy`` measures its cost).
@@ -103,6 +114,8 @@ class ModelParameters:
     drag_coefficient: float = 0.47
     dry_friction_coefficient: float | None = None
     slip_regularisation_m_s: float = 1e-3
+    dry_static_coefficient: float | None = None
+    stribeck_speed_m_s: float = 0.01
     min_entrainment_m_s: float = 0.1
     min_approach_speed_m_s: float = 0.01
     strips: int = 5
@@ -117,6 +130,7 @@ class ModelParameters:
             "restitution": (lambda v: 0 <= v <= 1, "must lie in [0, 1]"),
             "drag_coefficient": (lambda v: v >= 0, "must be >= 0"),
             "slip_regularisation_m_s": (lambda v: v > 0, "must be > 0"),
+            "stribeck_speed_m_s": (lambda v: v > 0, "must be > 0"),
             "min_entrainment_m_s": (lambda v: v > 0, "must be > 0"),
             "min_approach_speed_m_s": (lambda v: v > 0, "must be > 0"),
         }
@@ -132,6 +146,11 @@ class ModelParameters:
         mu = self.dry_friction_coefficient
         if mu is not None and not (isinstance(mu, int | float) and math.isfinite(mu) and 0 < mu < 1):
             raise ParameterError("parameters.dry_friction_coefficient", "must lie in (0, 1), or be None", mu)
+        static = self.dry_static_coefficient
+        if static is not None and not (isinstance(static, int | float) and math.isfinite(static) and mu is not None
+                                       and mu <= static < 1):
+            raise ParameterError("parameters.dry_static_coefficient", "must lie between dry_friction_coefficient "
+                                 "(which must be given too) and 1, or be None", static)
         if self.traction_peak_coefficient <= self.traction_sliding_coefficient:
             raise ParameterError("parameters.traction_peak_coefficient", "must exceed traction_sliding_coefficient",
                                  self.traction_peak_coefficient)

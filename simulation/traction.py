@@ -15,8 +15,16 @@ slide-to-roll ratio s_peak and falls to the sliding value D as s grows.
 (A, B, C, D), so the defaults of :class:`~simulation.parameters.ModelParameters`
 are stated in the units a tribologist reads off a traction curve.
 
-Dry contacts use Coulomb friction mu_dry regularised over a sliding speed v_reg:
-mu = mu_dry tanh(u_s / v_reg).
+Dry contacts use Coulomb friction with the Stribeck effect, regularised over a sliding speed v_reg:
+
+    mu(u_s) = [mu_c + (mu_s - mu_c) exp(-(u_s / v_s)^2)] tanh(u_s / v_reg),
+
+the static coefficient mu_s falling to the Coulomb (kinetic) coefficient mu_c over the Stribeck speed
+v_s. The bracket is the Stribeck curve of Olsson, Åström, Canudas de Wit, Gäfvert & Lischinsky,
+"Friction models and friction compensation", Eur. J. Control 4 (1998) 176-195, with their exponent
+2 (Armstrong-Hélouvry's Gaussian); the tanh makes it continuous at zero speed, as in the combined
+models of Andersson, Söderberg & Björklund, Tribol. Int. 40 (2007) 580-587. With mu_s = mu_c it is
+the regularised Coulomb law.
 
 The compiled functions allocate nothing and return the signed tangential force
 (N) with the sign of the sliding speed.
@@ -48,11 +56,16 @@ def regression_traction(u_s, u_r, q, a, b, c, d, u_floor):  # pragma: no cover -
 
 
 @numba.njit(cache=True, inline="always")
-def dry_friction(u_s, q, mu_dry, v_reg):  # pragma: no cover - compiled
-    """Signed Coulomb friction force (N), regularised over ``v_reg`` (m/s)."""
+def dry_friction(u_s, q, mu_c, v_reg, mu_s, v_s):  # pragma: no cover - compiled
+    """Signed Coulomb-Stribeck friction force (N): static ``mu_s`` falling to ``mu_c`` over the Stribeck
+    speed ``v_s`` (m/s), regularised over ``v_reg`` (m/s)."""
     if q <= 0.0:
         return 0.0
-    return mu_dry * q * math.tanh(u_s / v_reg)
+    mu = mu_c
+    if mu_s != mu_c:
+        x = u_s / v_s
+        mu += (mu_s - mu_c) * math.exp(-x * x)
+    return mu * q * math.tanh(u_s / v_reg)
 
 
 def regression_coefficients(peak_coefficient: float, peak_slide_roll: float,

@@ -64,7 +64,8 @@ P_F_RACE, P_F_BB, P_F_GRAV, P_F_LUB, P_CHO = 14, 15, 16, 17, 18
 P_F_TRAC, P_F_FILM, P_F_BBFILM, P_F_DRAG, P_DRY = 19, 20, 21, 22, 23
 P_ETA0, P_H0, P_TA, P_TB, P_TC, P_TD = range(24, 30)
 P_MU_DRY, P_V_REG, P_CD, P_RHO_MIX, P_RAMP, P_U_FLOOR, P_V_IN_MIN = range(30, 37)
-N_PARAMS = 37
+P_MU_STATIC, P_V_STRIBECK = 37, 38
+N_PARAMS = 39
 
 #: Lubricant damping coefficient at the race contacts (N s/m): the middle of the paper's 2500-7500 range.
 DEFAULT_CHO_N_S_M = ModelParameters().cho_n_s_m
@@ -93,7 +94,7 @@ class PlanarLayout:
 def _tangential(u_s, u_r, q, p):  # pragma: no cover - compiled
     """Signed tangential force (N) at a contact sliding at u_s: lubricated traction, or dry friction."""
     if p[P_DRY] > 0.5:
-        return dry_friction(u_s, q, p[P_MU_DRY], p[P_V_REG])
+        return dry_friction(u_s, q, p[P_MU_DRY], p[P_V_REG], p[P_MU_STATIC], p[P_V_STRIBECK])
     return regression_traction(u_s, u_r, q, p[P_TA], p[P_TB], p[P_TC], p[P_TD], p[P_U_FLOOR])
 
 
@@ -262,22 +263,35 @@ def planar_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def planar_ring_share(t, y, p, j, out):  # pragma: no cover - compiled
-    """Ball j's share of the ring's accelerations (y'', z''), the rows every ball reaches (see
-    :mod:`simulation.jacobian`): its inner-race force on the ring over the ring's mass."""
+def planar_ring_share(t, y, p, aux, j, out):  # pragma: no cover - compiled
+    """Ball j's share of the rows every ball reaches (see :mod:`simulation.jacobian`), in the order of
+    :func:`planar_ring_rows`: its inner-race force on the ring over the ring's mass (y'', z''), its
+    race input power, and the dissipation that depends on its state (its race contacts, its drag and
+    the two ball-ball contacts it takes part in)."""
     z = int(p[P_Z])
-    out[0] = out[1] = 0.0
+    for i in range(4):
+        out[i] = 0.0
+    th = y[z + j]
+    c, s = np.cos(th), np.sin(th)
     if p[P_F_RACE] > 0.5:
         ramp = p[P_RAMP]
         w_i = p[P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
-        th = y[z + j]
-        _, _, _, ry, rz, _, _ = _race_forces(y, p, j, z, w_i, np.cos(th), np.sin(th))
-        out[0], out[1] = ry / p[P_MR], rz / p[P_MR]
+        _, _, _, ry, rz, p_in, p_diss = _race_forces(y, p, j, z, w_i, c, s)
+        out[0], out[1], out[2], out[3] = ry / p[P_MR], rz / p[P_MR], p_in, p_diss
+    if p[P_F_BB] > 0.5:
+        for a, b in ((j - 1 if j > 0 else z - 1, j), (j, j + 1 if j + 1 < z else 0)):
+            ca, sa, cb, sb = np.cos(y[z + a]), np.sin(y[z + a]), np.cos(y[z + b]), np.sin(y[z + b])
+            out[3] += _pair_forces(y, p, aux, a, b, z, ca, sa, cb, sb)[3]
+    if p[P_F_DRAG] > 0.5:
+        v = y[j] * y[3 * z + j]
+        out[3] += 0.5 * p[P_CD] * p[P_RHO_MIX] * 0.25 * np.pi * p[P_D] * p[P_D] * v * v * abs(v)
 
 
 def planar_ring_rows(n_balls: int) -> list[int]:
-    """State indices of the rows :func:`planar_ring_share` fills (the ring's y'' and z'')."""
-    return [5 * n_balls + 2, 5 * n_balls + 3]
+    """State indices of the rows :func:`planar_ring_share` fills: the ring's y'' and z'', the input work
+    and the dissipated energy."""
+    return [5 * n_balls + 2, 5 * n_balls + 3, 5 * n_balls + 4, 5 * n_balls + 5]
+
 
 @numba.njit(cache=True)
 def planar_signature(y, p):  # pragma: no cover - compiled
@@ -434,6 +448,8 @@ def _params(bearing: Bearing, radial_load_n: float, gravity_m_s2: float, inner_s
                                  "steel contacts, which has no cited default: give it with "
                                  "--set dry_friction_coefficient=VALUE (or add a lubricant)")
         p[P_DRY], p[P_MU_DRY] = 1.0, par.dry_friction_coefficient
+        p[P_MU_STATIC] = par.dry_static_coefficient or par.dry_friction_coefficient
+        p[P_V_STRIBECK] = par.stribeck_speed_m_s
     if p[P_F_DRAG]:
         if oil_air_density_kg_m3 is None:
             raise ParameterError("oil_air_density_kg_m3", "drag is on but no oil-air mixture density is given")

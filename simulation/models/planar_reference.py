@@ -16,9 +16,11 @@ __all__ = ["reference_rhs", "tangential_force"]
 
 
 def tangential_force(u_s: np.ndarray, u_r: np.ndarray, q: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """Signed tangential force (N): the traction regression, or dry Coulomb friction."""
+    """Signed tangential force (N): the traction regression, or dry Coulomb-Stribeck friction."""
     if p[P.P_DRY] > 0.5:
-        return p[P.P_MU_DRY] * q * np.tanh(u_s / p[P.P_V_REG])
+        mu_c, mu_s = p[P.P_MU_DRY], p[P.P_MU_STATIC]
+        mu = mu_c + (mu_s - mu_c) * np.exp(-(u_s / p[P.P_V_STRIBECK]) ** 2)
+        return np.where(q > 0, mu * q * np.tanh(u_s / p[P.P_V_REG]), 0.0)
     sr = np.abs(u_s) / np.maximum(np.abs(u_r), p[P.P_U_FLOOR])
     mu = (p[P.P_TA] + p[P.P_TB] * sr) * np.exp(-p[P.P_TC] * sr) + p[P.P_TD]
     return np.where((q > 0) & (u_s != 0), np.sign(u_s) * mu * q, 0.0)

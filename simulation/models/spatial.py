@@ -358,30 +358,47 @@ def spatial_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def spatial_ring_share(t, y, p, j, out):  # pragma: no cover - compiled
-    """Ball j's share of the rows every ball reaches (see :mod:`simulation.jacobian`): the ring's y'', z'',
-    x'' and tilt accelerations from its inner-race contact, in the order of :func:`spatial_ring_rows`."""
+def spatial_ring_share(t, y, p, aux, j, out):  # pragma: no cover - compiled
+    """Ball j's share of the rows every ball reaches (see :mod:`simulation.jacobian`), in the order of
+    :func:`spatial_ring_rows`: the ring's y'', z'', x'' and tilt accelerations from its inner-race contact,
+    its race input power, and the dissipation that depends on its state (both race contacts, its drag
+    and the two ball-ball contacts it takes part in)."""
     z = int(p[P.P_Z])
-    for i in range(5):
+    for i in range(7):
         out[i] = 0.0
+    th = y[z + j]
+    c, s = math.cos(th), math.sin(th)
     if p[P.P_F_RACE] > 0.5:
         ramp = p[P.P_RAMP]
         w_i = p[P.P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
         tb = y.shape[0] - 4
         s_bz, c_bz = math.sin(p[P_TILT_Z] + y[tb + 1]), math.cos(p[P_TILT_Z] + y[tb + 1])
         wt = (-s_bz * y[tb + 2], c_bz * y[tb + 2], y[tb + 3])
-        th = y[z + j]
-        fx, fy, fz, _, _, _, _, _, _, qx, qy, qz = _race(y, p, j, z, True, w_i, _tilt(y, p), math.cos(th),
-                                                         math.sin(th), wt)
+        rot = _tilt(y, p)
+        fx, fy, fz, _, _, _, pin, pd, _, qx, qy, qz = _race(y, p, j, z, True, w_i, rot, c, s, wt)
         m_ring = p[P.P_MR]
         out[0], out[1], out[2] = -fy / m_ring, -fz / m_ring, -fx / m_ring
         out[3], out[4] = (-s_bz * qx + c_bz * qy) / p[P_IR], qz / p[P_IR]
+        out[5], out[6] = pin, pd
+        pin_o, pd_o = _race(y, p, j, z, False, w_i, rot, c, s, wt)[6:8]
+        out[5] += pin_o
+        out[6] += pd_o
+    if p[P.P_F_BB] > 0.5:
+        for a, b in ((j - 1 if j > 0 else z - 1, j), (j, j + 1 if j + 1 < z else 0)):
+            ca, sa, cb, sb = math.cos(y[z + a]), math.sin(y[z + a]), math.cos(y[z + b]), math.sin(y[z + b])
+            out[6] += _pair(y, p, aux, a, b, z, ca, sa, cb, sb)[6]
+    if p[P.P_F_DRAG] > 0.5:
+        v = y[j] * y[3 * z + j]
+        out[6] += 0.5 * p[P.P_CD] * p[P.P_RHO_MIX] * 0.25 * np.pi * p[P.P_D] ** 2 * v * v * abs(v)
 
 
 def spatial_ring_rows(n_balls: int) -> list[int]:
-    """State indices of the rows :func:`spatial_ring_share` fills: ring y'', z'', x'', beta_y'', beta_z''."""
+    """State indices of the rows :func:`spatial_ring_share` fills: ring y'', z'', x'', beta_y'', beta_z'',
+    the input work and the dissipated energy."""
     b = 5 * n_balls + 6
-    return [5 * n_balls + 2, 5 * n_balls + 3, b + 4 * n_balls + 1, b + 4 * n_balls + 4, b + 4 * n_balls + 5]
+    return [5 * n_balls + 2, 5 * n_balls + 3, b + 4 * n_balls + 1, b + 4 * n_balls + 4, b + 4 * n_balls + 5,
+            5 * n_balls + 4, 5 * n_balls + 5]
+
 
 @numba.njit(cache=True)
 def spatial_signature(y, p):  # pragma: no cover - compiled

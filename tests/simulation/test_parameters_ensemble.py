@@ -43,6 +43,36 @@ def test_traction_curve_has_the_stated_peak_and_sliding_value(peak, s_peak, slid
     assert math.isclose(coef[0], -slide)
 
 
+
+def test_dry_friction_follows_the_coulomb_stribeck_curve():
+    """mu(u) = [mu_c + (mu_s - mu_c) exp(-(u/v_s)^2)] tanh(u/v_reg) (Olsson et al., Eur. J. Control 4 (1998)
+    176-195, with the tanh regularisation of Andersson et al., Tribol. Int. 40 (2007) 580-587), evaluated
+    by hand: static 0.15, Coulomb 0.1, v_s = 0.01 m/s, v_reg = 1e-3 m/s, load 10 N."""
+    from simulation.traction import dry_friction
+
+    q, mu_c, mu_s, v_s, v_reg = 10.0, 0.1, 0.15, 0.01, 1e-3
+    assert dry_friction(1.0, q, mu_c, v_reg, mu_s, v_s) == pytest.approx(1.0, rel=1e-12)  # far past v_s: Coulomb
+    at_vs = (0.1 + 0.05 * math.exp(-1.0)) * math.tanh(10.0) * 10.0  # = 1.18394 N
+    assert dry_friction(v_s, q, mu_c, v_reg, mu_s, v_s) == pytest.approx(at_vs, rel=1e-12)
+    assert dry_friction(-v_s, q, mu_c, v_reg, mu_s, v_s) == pytest.approx(-at_vs, rel=1e-12)  # odd
+    half_vs = (0.1 + 0.05 * math.exp(-0.25)) * math.tanh(5.0) * 10.0  # u = v_s / 2: 1.38928 N, near static
+    assert dry_friction(5e-3, q, mu_c, v_reg, mu_s, v_s) == pytest.approx(half_vs, rel=1e-12)
+    assert half_vs > at_vs > 1.0
+    assert dry_friction(0.3, q, mu_c, v_reg, mu_c, v_s) == pytest.approx(1.0 * math.tanh(300.0), rel=1e-12)
+    assert dry_friction(0.3, 0.0, mu_c, v_reg, mu_s, v_s) == 0.0
+
+
+def test_static_coefficient_is_validated():
+    assert ModelParameters(dry_friction_coefficient=0.1, dry_static_coefficient=0.15).stribeck_speed_m_s == 0.01
+    for bad in ({"dry_static_coefficient": 0.15},  # without a Coulomb coefficient
+                {"dry_friction_coefficient": 0.1, "dry_static_coefficient": 0.05},  # below it
+                {"dry_friction_coefficient": 0.1, "dry_static_coefficient": float("nan")}):
+        with pytest.raises(ParameterError, match="dry_static_coefficient"):
+            ModelParameters(**bad)
+    with pytest.raises(ParameterError, match="stribeck_speed_m_s"):
+        ModelParameters(stribeck_speed_m_s=0.0)
+
+
 def test_ensemble_writes_one_trace_per_seed(tmp_path, capsys):
     out = tmp_path / "ens.trace.h5"
     assert main(["simulate", "--speed-rpm", "6000", "--radial-load-n", "500", "--duration", "0.002", "-q",

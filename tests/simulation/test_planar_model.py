@@ -109,6 +109,33 @@ def test_compiled_and_numpy_right_hand_sides_agree(effects):
         np.testing.assert_allclose(aux_fast[:z], aux_ref[:z], rtol=1e-12)
 
 
+
+def test_dry_stribeck_right_hand_sides_agree():
+    """A dry bearing with the Coulomb-Stribeck law (static 0.15, Coulomb 0.1, v_s 0.01 m/s): the compiled
+    RHS against the plain-numpy reference on states whose contacts slide slower and faster than v_s."""
+    from dataclasses import replace
+
+    from simulation.models.planar_reference import reference_rhs
+    from simulation.parameters import ModelParameters
+
+    rng = np.random.default_rng(7)
+    dry = replace(B, lubricant=None)
+    par = ModelParameters(dry_friction_coefficient=0.1, dry_static_coefficient=0.15)
+    th = packed_start(dry, seed=2, spread=0.0)
+    pr = planar_problem(dry, th, np.full(G.n_balls, 0.5 * G.pitch_diameter_m), (1e-6, -4e-6), 500.0,
+                        effects={"race_traction": True}, inner_speed_rad_s=300.0, parameters=par)
+    z = G.n_balls
+    for _ in range(5):
+        y = pr.y0.copy()
+        y[:z] += rng.normal(0, 2e-6, z)
+        y[3 * z:4 * z] = rng.normal(100.0, 5.0, z)
+        # spins that put the ball surfaces within a few v_s of rolling and far from it
+        y[4 * z:5 * z] = rng.normal(-0.5 * G.pitch_diameter_m * 100.0 / (0.5 * G.ball_diameter_m), 30.0, z)
+        aux_fast, aux_ref = pr.aux.copy(), pr.aux.copy()
+        np.testing.assert_allclose(pr.rhs(4e-4, y, aux_fast), reference_rhs(4e-4, y, pr.params, aux_ref),
+                                   rtol=1e-10, atol=1e-8)
+
+
 def _coasting_ball(v: float, **kw):
     """Ball 3 coasting at ``v`` onto its resting neighbour (no gravity, no load); the problem and a time just
     past the first contact."""

@@ -1,8 +1,8 @@
 """The simulator issue's hard cases, each from the packed start over 20 ms (the fast set).
 
 Cases (simulator issue "Stability tests: hard cases", DESIGN §7): 1800 rpm bunching; 6000 and 12000 rpm;
-radial loads of 10 N and 20 kN; R = 0 and R = 0.95; no lubricant; every ball starting in contact with
-its neighbours; an instantaneous start at full speed (every case but ``ramped`` starts so, and
+radial loads of 10 N and 20 kN; R = 0 and R = 0.95; no lubricant (Coulomb, and Coulomb-Stribeck); every
+ball starting in contact with its neighbours; an instantaneous start at full speed (every case but ``ramped`` starts so, and
 ``ramped`` reaches speed in 10 ms).
 
 Every case asserts:
@@ -57,6 +57,8 @@ CASES = {
     "R=0.95": (3000, 500, {"restitution": 0.95}, {}),
     # no lubricant: Coulomb friction 0.1, a value given for the test (dry steel has no cited default)
     "dry": (3000, 500, {"dry_friction_coefficient": 0.1}, {"dry": True}),
+    # the same with the Stribeck effect (simulation.traction.dry_friction): static 0.15 over 0.01 m/s
+    "dry-stribeck": (3000, 500, {"dry_friction_coefficient": 0.1, "dry_static_coefficient": 0.15}, {"dry": True}),
     "all-in-contact": (3000, 500, {}, {"initial_gap_fraction": 0.0}),
     "ramped": (3000, 500, {}, {"speed_ramp_s": 0.01}),
 }
