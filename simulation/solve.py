@@ -199,19 +199,20 @@ def _jacobian_options(pr: Problem, session: CvodeSession, jacobian: str, rtol: f
     n = len(pr.y0)
     full = np.empty((n, n))
 
+    def fill(t: float, y: FloatArray) -> None:
+        session.n_jac += 1
+        session.n_rhs += per_jacobian
+        evaluate(t, y, full)
+
     if jacobian == "structured":
         def jac_dense(t: float, y: FloatArray, yp: FloatArray, jj: FloatArray) -> None:
-            session.n_jac += 1
-            session.n_rhs += per_jacobian
-            evaluate(t, y, full)
+            fill(t, y)
             jj[:, :] = full
         return {"linsolver": "dense", "jacfn": jac_dense}
     cols, rows = np.nonzero(structure.pattern.T)  # CSC order: by column, then row
 
     def jac_sparse(t: float, y: FloatArray, yp: FloatArray, jj: FloatArray) -> None:
-        session.n_jac += 1
-        session.n_rhs += per_jacobian
-        evaluate(t, y, full)
+        fill(t, y)
         jj[:] = full[rows, cols]
     return {"linsolver": "sparse", "jacfn": jac_sparse, "sparsity": structure.pattern.astype(np.float64)}
 
