@@ -123,8 +123,6 @@ class JacobianStructure:
     ring_rows: IntArray
     #: Columns estimated one at a time (the ring's states).
     other_cols: IntArray
-    #: The energy counters: their columns are zero.
-    counters: IntArray
     #: Structural nonzeros, (n, n) boolean.
     pattern: npt.NDArray[np.bool_]
 
@@ -161,7 +159,7 @@ class JacobianStructure:
         pattern[:, other] = True
         pattern[np.arange(n), np.arange(n)] = True  # the diagonal is always stored (I - gamma J)
         return cls(ball_cols, groups, np.array(ring_rows, dtype=np.int64), np.array(other, dtype=np.int64),
-                   np.array(counters, dtype=np.int64), pattern)
+                   pattern)
 
     @property
     def rhs_per_jacobian(self) -> int:

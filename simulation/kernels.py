@@ -54,7 +54,7 @@ def model_signature(model_id, y, p):  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def model_gaps(model_id, y, p, out):  # pragma: no cover - compiled
-    """The overlap of every contact of the ball-bearing models (3 Z values; see
+    """Every contact's overlap (m, > 0 closed) for the ball-bearing models (3 Z values; see
     :func:`simulation.models.planar.planar_gaps`)."""
     if model_id == PLANAR:
         planar.planar_gaps(y, p, out)

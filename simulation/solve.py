@@ -236,8 +236,8 @@ class CvodeSession:
     n_rhs: int = 0
     #: Jacobians evaluated by the structured routine (CVODE's own difference quotients are not counted here).
     n_jac: int = 0
-    #: Onset control (see :func:`step_cvode`): the contact overlaps at the last step end and before it,
-    #: and the predicted time from the last step end to the next contact change.
+    #: Onset control (see :func:`step_cvode`): the contact overlaps (:func:`simulation.kernels.model_gaps`)
+    #: at the last step end and before it, and the predicted time from there to the next contact change.
     gaps: FloatArray | None = None
     gaps_before: FloatArray | None = None
     tau: float = np.inf
@@ -304,8 +304,9 @@ class CvodeSession:
 
 @numba.njit(cache=True)
 def _onset_update(model_id, y, p, gaps, before, dt):  # pragma: no cover - compiled
-    """Fill ``gaps`` with the overlaps at ``y``; return whether a contact changed since ``before`` (``dt``
-    earlier) and the earliest time at which a linearly extrapolated overlap changes sign (inf if none)."""
+    """Fill ``gaps`` with the contact overlaps at ``y``; return whether a contact changed since
+    ``before`` (``dt`` earlier) and the earliest time at which a linearly extrapolated overlap changes sign
+    (inf if none)."""
     model_gaps(model_id, y, p, gaps)
     changed, tau = False, np.inf
     for i in range(gaps.shape[0]):

@@ -293,45 +293,47 @@ def planar_ring_rows(n_balls: int) -> list[int]:
     return [5 * n_balls + 2, 5 * n_balls + 3, 5 * n_balls + 4, 5 * n_balls + 5]
 
 
+@numba.njit(cache=True, inline="always")
+def _overlaps(y, p, j, z):  # pragma: no cover - compiled
+    """Ball j's contacts, each > 0 when closed: outer and inner race overlap (m), and D^2 - |c_k - c_j|^2
+    with its neighbour k = j + 1 (m^2)."""
+    d = p[P_D]
+    r, th = y[j], y[z + j]
+    sx, sz = r * np.cos(th) - y[5 * z], r * np.sin(th) - y[5 * z + 1]
+    k = j + 1 if j + 1 < z else 0
+    dx = y[k] * np.cos(y[z + k]) - r * np.cos(th)
+    dz = y[k] * np.sin(y[z + k]) - r * np.sin(th)
+    return (r + 0.5 * d - 0.5 * p[P_DO], 0.5 * p[P_DI] + 0.5 * d - np.sqrt(sx * sx + sz * sz),
+            d * d - (dx * dx + dz * dz))
+
+
 @numba.njit(cache=True)
 def planar_signature(y, p):  # pragma: no cover - compiled
     """Which contacts are closed, as a number: sum over contacts of (its index + 1) when closed."""
     z = int(p[P_Z])
-    d = p[P_D]
-    cy, cz = y[5 * z], y[5 * z + 1]
     sig = 0.0
     for j in range(z):
-        r, th = y[j], y[z + j]
-        if r + 0.5 * d - 0.5 * p[P_DO] > 0.0:
+        outer, inner, pair = _overlaps(y, p, j, z)
+        if outer > 0.0:
             sig += 1.0 + j
-        sx, sz = r * np.cos(th) - cy, r * np.sin(th) - cz
-        if 0.5 * p[P_DI] + 0.5 * d - np.sqrt(sx * sx + sz * sz) > 0.0:
+        if inner > 0.0:
             sig += 1.0 + z + j
-        k = j + 1 if j + 1 < z else 0
-        dx = y[k] * np.cos(y[z + k]) - r * np.cos(th)
-        dz = y[k] * np.sin(y[z + k]) - r * np.sin(th)
-        if d * d - (dx * dx + dz * dz) > 0.0:
+        if pair > 0.0:
             sig += 1.0 + 2 * z + j
     return sig * (sig + 1.0)  # spreads sums so that one contact swapping for another rarely keeps the value
 
 
 @numba.njit(cache=True)
 def planar_gaps(y, p, out):  # pragma: no cover - compiled
-    """The overlap of every contact (m; > 0 closed), the quantities :func:`planar_signature` tests: outer
-    race j at ``out[j]``, inner race j at ``out[z + j]``, balls j and j + 1 at ``out[2 z + j]``. CVODE
-    locates their sign changes (:mod:`simulation.solve`), so it does not step over a contact onset."""
+    """Every contact's overlap (m; > 0 closed; :func:`_overlaps`), the quantities :func:`planar_signature`
+    tests: outer race j at ``out[j]``, inner race j at ``out[z + j]``, balls j and j + 1 at
+    ``out[2 z + j]``. CVODE's steps are stopped ahead of their predicted sign changes
+    (:mod:`simulation.solve`), so it does not step over a contact onset."""
     z = int(p[P_Z])
     d = p[P_D]
-    cy, cz = y[5 * z], y[5 * z + 1]
     for j in range(z):
-        r, th = y[j], y[z + j]
-        out[j] = r + 0.5 * d - 0.5 * p[P_DO]
-        sx, sz = r * np.cos(th) - cy, r * np.sin(th) - cz
-        out[z + j] = 0.5 * p[P_DI] + 0.5 * d - np.sqrt(sx * sx + sz * sz)
-        k = j + 1 if j + 1 < z else 0
-        dx = y[k] * np.cos(y[z + k]) - r * np.cos(th)
-        dz = y[k] * np.sin(y[z + k]) - r * np.sin(th)
-        out[2 * z + j] = d - np.sqrt(dx * dx + dz * dz)
+        out[j], out[z + j], pair = _overlaps(y, p, j, z)
+        out[2 * z + j] = d - np.sqrt(d * d - pair)  # in metres, as the race overlaps, so they extrapolate alike
 
 
 # Auxiliary array layout: per pair j (between ball j and j+1):

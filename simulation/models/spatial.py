@@ -400,44 +400,46 @@ def spatial_ring_rows(n_balls: int) -> list[int]:
             5 * n_balls + 4, 5 * n_balls + 5]
 
 
+@numba.njit(cache=True, inline="always")
+def _overlaps(y, p, j, z, rot):  # pragma: no cover - compiled
+    """Ball j's contacts in three dimensions, as :func:`simulation.models.planar._overlaps` returns them."""
+    b = 5 * z + 6
+    c, s = math.cos(y[z + j]), math.sin(y[z + j])
+    k = j + 1 if j + 1 < z else 0
+    dx = y[b + k] - y[b + j]
+    dy = y[k] * math.cos(y[z + k]) - y[j] * c
+    dz = y[k] * math.sin(y[z + k]) - y[j] * s
+    return (_groove(y, p, j, z, False, rot, c, s)[6], _groove(y, p, j, z, True, rot, c, s)[6],
+            p[P.P_D] ** 2 - (dx * dx + dy * dy + dz * dz))
+
+
 @numba.njit(cache=True)
 def spatial_signature(y, p):  # pragma: no cover - compiled
     """Which contacts are closed, as a number (see :func:`simulation.models.planar.planar_signature`)."""
     z = int(p[P.P_Z])
-    b = 5 * z + 6
     rot = _tilt(y, p)
     sig = 0.0
     for j in range(z):
-        c, s = math.cos(y[z + j]), math.sin(y[z + j])
-        if _groove(y, p, j, z, False, rot, c, s)[6] > 0.0:
+        outer, inner, pair = _overlaps(y, p, j, z, rot)
+        if outer > 0.0:
             sig += 1.0 + j
-        if _groove(y, p, j, z, True, rot, c, s)[6] > 0.0:
+        if inner > 0.0:
             sig += 1.0 + z + j
-        k = j + 1 if j + 1 < z else 0
-        dx = y[b + k] - y[b + j]
-        dy = y[k] * math.cos(y[z + k]) - y[j] * math.cos(y[z + j])
-        dz = y[k] * math.sin(y[z + k]) - y[j] * math.sin(y[z + j])
-        if p[P.P_D] ** 2 - (dx * dx + dy * dy + dz * dz) > 0.0:
+        if pair > 0.0:
             sig += 1.0 + 2 * z + j
     return sig * (sig + 1.0)
 
 
 @numba.njit(cache=True)
 def spatial_gaps(y, p, out):  # pragma: no cover - compiled
-    """The overlap of every contact (m; > 0 closed), as :func:`simulation.models.planar.planar_gaps` orders
-    them, in three dimensions (the quantities :func:`spatial_signature` tests)."""
+    """Every contact's overlap (m), as :func:`simulation.models.planar.planar_gaps` orders them, in three
+    dimensions (the quantities :func:`spatial_signature` tests)."""
     z = int(p[P.P_Z])
-    b = 5 * z + 6
     rot = _tilt(y, p)
+    d = p[P.P_D]
     for j in range(z):
-        c, s = math.cos(y[z + j]), math.sin(y[z + j])
-        out[j] = _groove(y, p, j, z, False, rot, c, s)[6]
-        out[z + j] = _groove(y, p, j, z, True, rot, c, s)[6]
-        k = j + 1 if j + 1 < z else 0
-        dx = y[b + k] - y[b + j]
-        dy = y[k] * math.cos(y[z + k]) - y[j] * c
-        dz = y[k] * math.sin(y[z + k]) - y[j] * s
-        out[2 * z + j] = p[P.P_D] - math.sqrt(dx * dx + dy * dy + dz * dz)
+        out[j], out[z + j], pair = _overlaps(y, p, j, z, rot)
+        out[2 * z + j] = d - math.sqrt(d * d - pair)
 
 
 def spatial_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLike, ring0: tuple[float, float],
