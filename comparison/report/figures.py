@@ -58,7 +58,7 @@ def speed_figure(d: ConditionDescription) -> str:
     return _svg(draw)
 
 
-def slip_figure(d: ConditionDescription) -> str:
+def slip_figure(d: ConditionDescription, size: tuple[float, float] = (5.6, 3.0)) -> str:
     """Slip rate against orbital angle with its spread (mean +- std over balls and revolutions)."""
     c = d.comparison
     assert c is not None
@@ -69,7 +69,7 @@ def slip_figure(d: ConditionDescription) -> str:
         _profile(ax, c.simulated.slip, 100.0, "simulated", "C3")
         ax.set(xlabel="orbital angle (deg)", ylabel="slip rate (%)", xlim=(0, 360))
         ax.legend(fontsize=7)
-    return _svg(draw)
+    return _svg(draw, size=size)
 
 
 def contact_polar_figure(d: ConditionDescription) -> str:

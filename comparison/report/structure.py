@@ -11,7 +11,7 @@ from cageless import __version__
 from comparison.compare import ComparisonRow
 from comparison.metrics import SLIP_RATE_DEFINITION
 from comparison.report import figures
-from comparison.report.describe import ConditionDescription
+from comparison.report.describe import ConditionDescription, tracking_verdict
 from comparison.table import table_frame, to_html
 
 __all__ = ["build_report"]
@@ -34,17 +34,35 @@ def _section(d: ConditionDescription) -> dict[str, Any]:
     section: dict[str, Any] = {"title": d.label, "status": r.status, "facts": facts, "figures": []}
     if d.comparison is not None:
         section["figures"] = [
-            {"caption": "Revolution speed against orbital angle (mean and spread)", "svg": figures.speed_figure(d)},
-            {"caption": "Slip rate against orbital angle (mean and spread)", "svg": figures.slip_figure(d)},
-            {"caption": "Ball-ball contact episodes (simulated): peak force by orbital angle",
+            {"caption": "Revolution speed against orbital angle (mean and spread over balls and passes). Look for "
+                        "the dip in the unloaded zone (0-180 deg, shaded) and whether the two curves share it.",
+             "svg": figures.speed_figure(d)},
+            {"caption": "Slip rate against orbital angle (mean and spread). The table's slip rates are the peaks "
+                        "of these curves in the unloaded zone; the MAE is their mean distance.",
+             "svg": figures.slip_figure(d)},
+            {"caption": "Ball-ball contact episodes (simulated): peak force by orbital angle. Collisions should "
+                        "gather in the unloaded and transition zones, with none at 240-300 deg.",
              "svg": figures.contact_polar_figure(d)},
-            {"caption": "Inner-ring centre orbit and Poincare section (simulated)", "svg": figures.ring_figure(d)},
+            {"caption": "Inner-ring centre orbit and its Poincare section (simulated, one point per shaft "
+                        "revolution). A scattered cloud means aperiodic motion, a closed curve quasi-periodic.",
+             "svg": figures.ring_figure(d)},
         ]
         if d.contact_track is not None:
             section["figures"].append({"caption": "Contact trajectory on the raceways (simulated, spatial model; "
-                                                  "the paper's figure 13)", "svg": figures.contact_track_figure(d)})
+                                                  "the paper's figure 13): how far the contact angle swings "
+                                                  "around the orbit.", "svg": figures.contact_track_figure(d)})
         section["facts"] += [("settling time left out of the simulation", f"{d.comparison.settle_s:g} s")]
     return section
+
+
+def _summary(d: ConditionDescription) -> dict[str, Any]:
+    r = d.row
+    passed, reasons = tracking_verdict(d.qc)
+    return {"title": d.label, "condition": f"{r.speed_rpm:g} r/min, {r.radial_load_n:g} N radial, "
+                                           f"{r.axial_load_n:g} N axial",
+            "theoretical": f"{r.theoretical_slip_pct:.2f} %", "experimental": f"{r.experimental_slip_pct:.2f} %",
+            "mae": f"{r.mae_pp:.2f} pp", "qc_pass": passed, "qc_reasons": reasons,
+            "svg": figures.slip_figure(d, size=(3.4, 2.0)) if d.comparison is not None else None}
 
 
 def _qc(d: ConditionDescription) -> dict[str, Any]:
@@ -86,6 +104,7 @@ def build_report(descriptions: Sequence[ConditionDescription], failed_rows: Sequ
                        for r in table_frame(rows).itertuples()],
         "table_html": to_html(frame),
         "definition": SLIP_RATE_DEFINITION,
+        "summary": [_summary(d) for d in descriptions],
         "sections": [_section(d) for d in descriptions],
         "failures": [{"title": r.label, "message": r.message} for r in failed_rows],
         "qc": [_qc(d) for d in descriptions if d.qc],

@@ -50,7 +50,8 @@ def test_report_opens_in_headless_chromium(small_lab, tmp_path):
         page.screenshot(path=str(art / "report.png"), full_page=True)
         browser.close()
     assert errors == []
-    assert len(images) == 4 and all(done and width > 0 for done, width in images)
+    # four figures in the condition's section and the slip overlay on its summary card
+    assert len(images) == 5 and all(done and width > 0 for done, width in images)
     assert (art / "report.png").stat().st_size > 10_000
 
 
