@@ -190,7 +190,8 @@ ARGS = dict(q=100.0, area=math.pi * 0.4e-3 * 0.06e-3, sigma=0.1e-6, eta_e=150.0,
 
 def _traction(u_s: float, h_min: float, h_c: float | None = None, **kw: float) -> float:
     a = {**ARGS, **kw}
-    return ft.film_traction(u_s, a["q"], a["area"], h_min, h_min if h_c is None else h_c, a["sigma"], a["eta_e"], a["lss"], a["u_min"],
+    h_shear = h_min if h_c is None else h_c
+    return ft.film_traction(u_s, a["q"], a["area"], h_min, h_shear, a["sigma"], a["eta_e"], a["lss"], a["u_min"],
                             a["mu_b"], a["v_reg"], a["lam_b"], a["lam_f"])
 
 
