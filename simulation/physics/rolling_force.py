@@ -62,7 +62,8 @@ import math
 import numba
 
 __all__ = ["MENISCUS_RANGE_M", "chiu_coefficient", "chiu_coefficient_published", "meniscus_parameter",
-           "chiu_rolling_forces", "rolling_force_along"]
+           "chiu_rolling_forces", "rolling_force_along",
+           "rolling_force_and_moment"]
 
 #: Accepted range of the inlet meniscus distance r_s (m), see the module docstring.
 MENISCUS_RANGE_M = (0.05e-3, 2.0e-3)
@@ -159,3 +160,18 @@ def rolling_force_along(eta: float, u_e: float, h: float, r_xi: float, r_eta: fl
     f_r, _, f_h, _ = chiu_rolling_forces(eta, u_e, 0.0, h, r_xi, r_eta, r_s, d)
     sgn = 1.0 if u_e > 0.0 else -1.0
     return sgn * f_h, -sgn * f_r
+
+
+@numba.njit(cache=True)
+def rolling_force_and_moment(eta: float, u_e: float, h: float, r_xi: float, r_eta: float, r_s: float,
+                             d: float) -> tuple[float, float]:  # pragma: no cover - compiled
+    """Force on the ball centre (N, along t) and moment about it (N m, about n x t), for pure rolling.
+
+    With n the unit vector from the ball centre to the contact point and t the contact tangent along which
+    ``u_e`` is signed, the shear f_shear t acts at r_c = (D/2) n, so its moment is
+    (D/2) n x (f_shear t) = (D/2) f_shear (n x t). The pressure passes through the centre and adds no moment.
+    In a planar model whose spin axis is n x t at the contact, the moment is (D/2) f_shear; where the spin axis
+    is -(n x t) (for instance the inner contact of a ball whose n points inward), it enters with a minus sign.
+    """
+    f_p, f_s = rolling_force_along(eta, u_e, h, r_xi, r_eta, r_s, d)
+    return f_p + f_s, 0.5 * d * f_s

@@ -141,6 +141,10 @@ def test_rolling_force_directions_and_limits():
     # surfaces moving along -t: the inlet pressure pushes the ball along -t, the backflow shear along +t
     assert f_p == pytest.approx(-0.0523821, rel=1e-5) and f_s == pytest.approx(0.0216985, rel=1e-5)
     assert rf.rolling_force_along(ETA0, 0.0, 0.2e-6, RX, RY, 0.5e-3, D) == (0.0, 0.0)
+    # on the centre: F_H - F_R = 0.0523821 - 0.0216985 = 0.0306836 N against the ball's travel (along u_e);
+    # moment of the shear about the centre: (D/2) F_R = 4.7625e-3 x 0.0216985 = 1.033391e-4 N m
+    f_c, m = rf.rolling_force_and_moment(ETA0, -2.0, 0.2e-6, RX, RY, 0.5e-3, D)
+    assert f_c == pytest.approx(-0.0306836, rel=1e-5) and m == pytest.approx(1.033391e-4, rel=1e-5)
     # linear in eta at fixed film; more starved (smaller r_s) gives less force; none when fully starved
     a = rf.rolling_force_along(0.02, 2.0, 0.2e-6, RX, RY, 0.5e-3, D)[0]
     b = rf.rolling_force_along(0.06, 2.0, 0.2e-6, RX, RY, 0.5e-3, D)[0]
@@ -277,3 +281,24 @@ def test_churning_moment_limits_and_mixture_density():
     assert drag.churning_moment(1000.0, D, rho, mu) == pytest.approx(-0.5 * 0.398677 * rho * 1e6 * r**5, rel=1e-5)
     # oil-air mixture: 0.05 x 826 + 0.95 x 1.204 = 42.4438 kg/m^3 (Parker 1984; Harris & Kotzalas X ~ 5 %)
     assert drag.mixture_density(826.0) == pytest.approx(42.4438, rel=1e-9)
+
+
+def test_units_compose_inside_compiled_code():
+    """The units are numba functions that a model's compiled right-hand side can call (no Python objects)."""
+    import numba
+
+    @numba.njit
+    def rhs_like(u_e: float, q: float) -> float:
+        eta = vis.viscosity(ETA0, ALPHA, BETA, 0.0, T0, T0, True)
+        h = ft.hd_central_film(eta, ALPHA, E_RED, u_e, q, RX, 8.0)
+        f, m = rf.rolling_force_and_moment(eta, u_e, h, RX, RY, 0.5e-3, D)
+        f += ft.film_traction(0.01, q, 1e-7, h, h, 0.1e-6, 100.0, 0.07, 0.01, 0.1, 1e-3, 1.0, 3.0)
+        f += drag.drag_force(1.7, D, 42.4, 0.002)
+        return f + m / (0.5 * D) + drag.churning_moment(400.0, D, 42.4, 0.002)
+
+    h = ft.hd_central_film(ETA0, ALPHA, E_RED, -2.0, 10.0, RX, 8.0)
+    f, m = rf.rolling_force_and_moment(ETA0, -2.0, h, RX, RY, 0.5e-3, D)
+    parts = (f, ft.film_traction(0.01, 10.0, 1e-7, h, h, 0.1e-6, 100.0, 0.07, 0.01, 0.1, 1e-3, 1.0, 3.0),
+             drag.drag_force(1.7, D, 42.4, 0.002), m / (0.5 * D), drag.churning_moment(400.0, D, 42.4, 0.002))
+    assert all(x != 0.0 for x in parts)
+    assert rhs_like(-2.0, 10.0) == pytest.approx(sum(parts), rel=1e-12)
