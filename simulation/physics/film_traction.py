@@ -9,8 +9,8 @@ rms roughness:
     Lambda = h_min / sigma.                                                          (T1)
 
 Full film: the steady-state limiting-shear-stress law of Bair & Winer, "A rheological model for
-elastohydrodynamic contacts based on primary laboratory data", J. Lubr. Technol. 101 (1979) 258-265, their
-eq. (3) integrated at constant shear rate (no elastic transient):
+elastohydrodynamic contacts based on primary laboratory data", J. Lubr. Technol. 101 (1979) 258-264, their
+constitutive law at constant shear rate (no elastic transient):
 
     tau = tau_L [1 - exp(-eta_e |u_s| / (h tau_L))] sign(u_s),   tau_L = Lambda_LSS p,     (T2)
 
@@ -57,8 +57,9 @@ __all__ = ["DEFAULT_LSS_COEFFICIENT", "LSS_COEFFICIENT_RANGE", "DEFAULT_BOUNDARY
            "LAMBDA_FULL", "hd_central_film", "hd_minimum_film", "film_parameter", "regime_weight",
            "full_film_traction", "boundary_traction", "film_traction", "film_traction_slope"]
 
-#: Limiting shear stress over pressure, Lambda_LSS: Bair & Winer (1979) measured tau_L / p of 0.04-0.1 for
-#: their mineral and synthetic oils (also the traction plateau of twin-disc tests); 0.07 is a choice inside it.
+#: Limiting shear stress over pressure, Lambda_LSS. Bair & Winer (1979) found the limiting shear stress to grow
+#: about in proportion to pressure; coefficients of 0.04-0.1 are typical of mineral oils, and they match the
+#: traction plateaus of twin-disc tests (Evans & Johnson, Proc. IMechE C 200 (1986) 303-312). 0.07 is a choice.
 DEFAULT_LSS_COEFFICIENT = 0.07
 LSS_COEFFICIENT_RANGE = (0.04, 0.1)
 #: Boundary friction of lubricated bearing steel, ~0.1 (Harris & Kotzalas, ch. 4; Hamrock et al. §1.3).
