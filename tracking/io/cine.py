@@ -202,7 +202,7 @@ class CineReader(FrameSource):
             if not allow_truncated or complete == 0:
                 raise VideoError(self.path, f"is truncated: frame {complete} of {n} starts at or runs past the end of "
                                  f"the file ({self._size} bytes).", offset=bad,
-                                 hint="Re-copy the file; to read the complete frames pass allow_truncated=True.")
+                                 hint="Re-copy the file, or re-run with --allow-truncated to use the complete frames.")
         self._data_start = data_start[:complete]
         self._n = complete
 
