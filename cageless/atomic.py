@@ -17,9 +17,9 @@ from pathlib import Path
 
 from cageless.errors import CagelessError
 
-__all__ = ["atomic_path", "atomic_write_text", "atomic_write_bytes", "OutputError", "STALE_PART_S"]
+__all__ = ["atomic_path", "atomic_write_text", "atomic_write_bytes", "OutputError", "STALE_PART_S", "is_abandoned"]
 
-#: A temporary file of the same target older than this is left over from a killed run, and removed.
+#: Where advisory locks are missing, a temporary file older than this counts as left over by a killed run.
 STALE_PART_S = 3600.0
 _FULL = (errno.ENOSPC, errno.EDQUOT)
 
@@ -58,11 +58,42 @@ def _output_error(path: Path, exc: OSError) -> OutputError:
     return OutputError(f"{path}: cannot write it ({exc.strerror or exc}).", exc.errno)
 
 
+def _hold(fd: int) -> None:
+    """Take an exclusive advisory lock on an open temporary file (POSIX; elsewhere nothing)."""
+    try:
+        import fcntl
+
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except (ImportError, OSError):
+        pass
+
+
+def is_abandoned(part: Path, min_age_s: float) -> bool:
+    """True when ``part`` is at least ``min_age_s`` old and no live writer holds its lock."""
+    try:
+        if time.time() - part.stat().st_mtime < min_age_s:
+            return False
+        import fcntl
+
+        fd = os.open(part, os.O_RDONLY)
+    except ImportError:  # pragma: no cover - no advisory locks: age alone decides
+        return time.time() - part.stat().st_mtime >= max(min_age_s, STALE_PART_S)
+    except OSError:
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        return True
+    except OSError:
+        return False
+    finally:
+        os.close(fd)
+
+
 def _remove_stale(path: Path) -> None:
-    now = time.time()
+    """Remove abandoned temporaries of this very target (left by a killed writer)."""
     for p in path.parent.glob(f".{path.name}.*.part"):
         try:
-            if len(p.name) == len(path.name) + 15 and now - p.stat().st_mtime > STALE_PART_S:
+            if len(p.name) == len(path.name) + 15 and is_abandoned(p, 2.0):
                 p.unlink()
         except OSError:
             continue
@@ -97,10 +128,10 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
         fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
     except OSError as exc:
         raise _output_error(path, exc) from exc
-    os.close(fd)
+    _hold(fd)  # a cleaner never removes a temporary file whose writer is alive
     tmp = Path(name)
-    os.chmod(tmp, 0o666 & ~_UMASK)
     try:
+        os.chmod(tmp, 0o666 & ~_UMASK)
         yield tmp
         with open(tmp, "rb+") as fh:
             os.fsync(fh.fileno())
@@ -112,6 +143,8 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
+    finally:
+        os.close(fd)
 
 
 def atomic_write_bytes(path: str | Path, data: bytes) -> None:

@@ -18,12 +18,12 @@ import os
 import re
 import stat
 import tempfile
-import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from datetime import UTC, datetime
 from pathlib import Path
 
+from cageless.atomic import is_abandoned
 from cageless.errors import CagelessError, UsageError
 
 __all__ = ["check_output_file", "check_output_dir", "output_lock", "clean_stale_parts", "LOCK_NAME",
@@ -128,10 +128,6 @@ def check_output_dir(path: str | Path, option: str = "-o") -> Path:
         raise UsageError(f"{option} {path}: is {_kind(path.stat().st_mode) if not path.is_file() else 'a file'}, "
                          "not a folder. Give a folder (it is created if needed).")
     _check_parents(path / "x", option)
-    try:
-        path.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise UsageError(f"{option} {path}: cannot create the folder ({exc.strerror}). Choose another path.") from None
     return path
 
 
@@ -139,15 +135,23 @@ def check_output_dir(path: str | Path, option: str = "-o") -> Path:
 def output_lock(folder: str | Path, what: str = "output folder") -> Iterator[None]:
     """Hold an exclusive lock on ``folder`` (created if needed) for the duration of the block.
 
+    A folder this call created is removed again when the run wrote nothing into it.
+
     Raises
     ------
     FolderInUseError
         When another process holds it, naming that process when it said who it is.
+    UsageError
+        When the folder cannot be created.
     """
     from filelock import FileLock, Timeout
 
     folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
+    created = [p for p in (folder, *folder.parents) if not p.exists()]
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise UsageError(f"{folder}: cannot create the folder ({exc.strerror}). Choose another path.") from None
     lock_path = folder / LOCK_NAME
     info_path = folder / (LOCK_NAME + ".json")
     lock = FileLock(str(lock_path), timeout=0)
@@ -173,12 +177,26 @@ def output_lock(folder: str | Path, what: str = "output folder") -> Iterator[Non
     finally:
         info_path.unlink(missing_ok=True)
         lock.release()
+        _remove_if_empty(created, lock_path)
 
 
-def clean_stale_parts(folder: str | Path, min_age_s: float = 60.0, recursive: bool = True) -> list[Path]:
-    """Delete the ``.part`` files of killed runs under ``folder``: only our temporary names, only old ones.
+def _remove_if_empty(created: list[Path], lock_path: Path) -> None:
+    """Remove the folders this run created when it wrote nothing into them (no empty output is left)."""
+    if not created or any(p != lock_path for p in created[0].iterdir()):
+        return
+    lock_path.unlink(missing_ok=True)
+    for p in created:
+        try:
+            p.rmdir()
+        except OSError:
+            return
 
-    Call it while holding :func:`output_lock` on ``folder`` (no live run of ours writes there then).
+
+def clean_stale_parts(folder: str | Path, min_age_s: float = 2.0, recursive: bool = True) -> list[Path]:
+    """Delete the ``.part`` files of killed runs under ``folder``.
+
+    Only our temporary names, only files at least ``min_age_s`` old, and only those whose writer is gone:
+    a live writer holds an advisory lock on its temporary file (:func:`cageless.atomic.atomic_path`).
 
     Returns
     -------
@@ -188,11 +206,10 @@ def clean_stale_parts(folder: str | Path, min_age_s: float = 60.0, recursive: bo
     folder = Path(folder)
     if not folder.is_dir():
         return []
-    now = time.time()
     removed = []
     for p in folder.rglob("*.part") if recursive else folder.glob("*.part"):
         try:
-            if PART_RE.match(p.name) and p.is_file() and not p.is_symlink() and now - p.stat().st_mtime >= min_age_s:
+            if PART_RE.match(p.name) and p.is_file() and not p.is_symlink() and is_abandoned(p, min_age_s):
                 p.unlink()
                 removed.append(p)
         except OSError:

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 from faultlib import assert_clean, cli, parts
 
-from cageless.atomic import STALE_PART_S, atomic_write_text
+from cageless.atomic import atomic_write_text
 from cageless.outputs import FolderInUseError, clean_stale_parts, output_lock
 
 
@@ -101,21 +101,30 @@ def test_r13_the_lock_is_per_process(tmp_path):
 
 
 def test_r42_stale_part_files_are_cleaned_safely(tmp_path):
-    old = tmp_path / "traces" / ".clip.trace.h5.abcd1234.part"
-    fresh = tmp_path / "traces" / ".other.trace.h5.efgh5678.part"
-    foreign = tmp_path / "traces" / "user-download.part"
-    for p in (old, fresh, foreign):
-        p.parent.mkdir(exist_ok=True)
+    """Only our temporary names, only abandoned ones (old enough and not locked by a live writer)."""
+    import fcntl
+
+    folder = tmp_path / "traces"
+    folder.mkdir()
+    old = folder / ".clip.trace.h5.abcd1234.part"
+    live = folder / ".live.trace.h5.efgh5678.part"
+    fresh = folder / ".fresh.trace.h5.ijkl9012.part"
+    foreign = folder / "user-download.part"
+    for p in (old, live, fresh, foreign):
         p.write_text("x")
-    long_ago = time.time() - 2 * STALE_PART_S
-    os.utime(old, (long_ago, long_ago))
-    os.utime(foreign, (long_ago, long_ago))
-    assert clean_stale_parts(tmp_path) == [old]
-    assert fresh.exists() and foreign.exists()
-    # the atomic writer also removes stale temporaries of its own target
-    os.utime(fresh, (long_ago, long_ago))
-    atomic_write_text(tmp_path / "traces" / "other.trace.h5", "new")
-    assert not fresh.exists() and foreign.exists()
+    long_ago = time.time() - 30
+    for p in (old, live, foreign):
+        os.utime(p, (long_ago, long_ago))
+    fd = os.open(live, os.O_RDONLY)
+    fcntl.flock(fd, fcntl.LOCK_EX)  # a writer still at work
+    try:
+        assert clean_stale_parts(tmp_path) == [old]
+    finally:
+        os.close(fd)
+    assert live.exists() and fresh.exists() and foreign.exists()
+    # the atomic writer also removes abandoned temporaries of its own target
+    atomic_write_text(folder / "live.trace.h5", "new")
+    assert not live.exists() and foreign.exists() and fresh.exists()
 
 
 def test_r42_track_removes_parts_of_killed_runs_in_its_folder(tmp_path, capsys, mini_lab):
@@ -123,7 +132,7 @@ def test_r42_track_removes_parts_of_killed_runs_in_its_folder(tmp_path, capsys, 
     out.mkdir()
     stale = out / ".clip_3000rpm.trace.h5.k1ll3d00.part"
     stale.write_text("half a trace")
-    os.utime(stale, (time.time() - 120, time.time() - 120))
+    os.utime(stale, (time.time() - 30, time.time() - 30))
     assert_clean(cli(capsys, "track", mini_lab, "-o", out, "-q", "--workers", "1"), 0)
     assert not parts(out) and (out / "clip_3000rpm.trace.h5").is_file()
 

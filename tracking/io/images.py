@@ -66,7 +66,7 @@ class ImageSequenceReader(FrameSource):
             height=first.shape[0], dtype=first.dtype.name, bit_depth=8 * first.dtype.itemsize,
             storage=f"{self._files[0].suffix.lstrip('.')} images, {8 * first.dtype.itemsize}-bit",
         )
-        self._check_numbering(has_times=(self.path / TIMES_FILE).is_file())
+        self._check_numbering(has_times=self._times_count() == len(self._files))
         stamps = self._read_times_file()
         self._apply_timing(fps, stamps)
 
@@ -74,6 +74,7 @@ class ImageSequenceReader(FrameSource):
         """Refuse a stray image (another name pattern), a repeated number, or a gap in the numbers.
 
         A gap is allowed when ``times.csv`` gives each image's time (then the times carry the gap).
+        A stray or missing image is named, not reported as a count mismatch with ``times.csv``.
         """
         def pattern(p: Path) -> str:
             return _NUMBER.sub("#", p.stem) + p.suffix.lower()
@@ -95,6 +96,14 @@ class ImageSequenceReader(FrameSource):
                 raise VideoError(self.path / missing, f"is missing: the frame numbers jump from {a} ({pa.name}) to "
                                  f"{b} ({pb.name}).", hint="Restore the frame, or give each image's time in "
                                  f"{TIMES_FILE} beside them.")
+
+    def _times_count(self) -> int | None:
+        """Number of times listed in ``times.csv`` (None without one)."""
+        try:
+            lines = (self.path / TIMES_FILE).read_text().splitlines()
+        except OSError:
+            return None
+        return sum(1 for line in lines[1:] if line.strip())
 
     def _read_times_file(self) -> npt.NDArray[np.float64] | None:
         p = self.path / TIMES_FILE
