@@ -175,11 +175,12 @@ class _Cache:
             return None
         return str(path)
 
+    def _relative(self, path: str | Path) -> str:
+        return os.path.relpath(Path(path).resolve(), self.out.resolve())
+
     def store(self, key: str, path: str, also: list[Path] | None = None) -> None:
-        p = Path(path)
-        rel = lambda q: os.path.relpath(Path(q).resolve(), self.out.resolve())  # noqa: E731
-        self.data[key] = {"path": rel(p), "sha256": sha256_file(p, cache=False),
-                          "also": [rel(a) for a in (also or [])]}
+        self.data[key] = {"path": self._relative(path), "sha256": sha256_file(path, cache=False),
+                          "also": [self._relative(a) for a in (also or [])]}
         atomic_write_text(self.path, json.dumps({"version": self.VERSION, "jobs": self.data}, indent=1,
                                                 sort_keys=True))
 

@@ -59,7 +59,8 @@ def _check_parents(path: Path, option: str) -> None:
         with tempfile.TemporaryFile(dir=existing):
             pass
     except OSError as exc:
-        raise UsageError(f"{option} {path}: cannot write in {existing} ({exc.strerror}). Choose another path.") from None
+        raise UsageError(f"{option} {path}: cannot write in {existing} ({exc.strerror}). "
+                         "Choose another path.") from None
 
 
 def _is_cageless_trace(path: Path) -> bool:

@@ -97,6 +97,9 @@ def _track_one(job: tuple[Path, OperatingConditions, Bearing, Any, Path]) -> tup
         res = track_video(video, conditions, bearing, options, out_dir=out, progress=False)
     except CagelessError as exc:
         return "failed", str(exc)
+    except Exception as exc:  # noqa: BLE001 - one video's surprise must not stop the others
+        log.debug("tracking %s failed", video, exc_info=True)
+        return "failed", f"unexpected {type(exc).__name__}: {exc} (run with -v --workers 1 for the traceback)"
     tr = res.trace
     unloaded = np.sin(tr.angle) > 0
     return "ok", {"path": str(res.path), "frames": tr.n_samples, "balls": tr.n_balls,

@@ -3,7 +3,6 @@ random moments (a fixed seed) leaves nothing that a re-run does not repair."""
 
 from __future__ import annotations
 
-import os
 import shutil
 import signal
 import subprocess

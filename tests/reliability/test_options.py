@@ -11,7 +11,7 @@ import os
 from pathlib import Path
 
 import pytest
-from faultlib import QUICK_REPORT, assert_clean, cli, parts
+from faultlib import QUICK_REPORT, assert_clean, cli
 
 SIM = ("simulate", "--speed-rpm", "3000", "--radial-load-n", "500", "--duration", "0.002")
 

@@ -91,7 +91,8 @@ def test_r13_the_lock_is_per_process(tmp_path):
 
     out = tmp_path / "o"
     code = ("import sys; from cageless.outputs import output_lock, FolderInUseError\n"
-            "try:\n    output_lock(sys.argv[1]).__enter__()\nexcept FolderInUseError as e:\n    print(e); sys.exit(3)\n")
+            "try:\n    output_lock(sys.argv[1]).__enter__()\n"
+            "except FolderInUseError as e:\n    print(e); sys.exit(3)\n")
     with output_lock(out):
         proc = subprocess.run([sys.executable, "-c", code, str(out)], capture_output=True, text=True, timeout=60)
     assert proc.returncode == 3 and "in use" in proc.stdout
