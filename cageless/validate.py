@@ -10,9 +10,9 @@ Where the plausible bounds come from:
 * speed: up to 60 000 r/min, a speed factor n * d_m of 2.8e6 mm r/min for the 46 mm pitch circle of the
   default bearing, about the 3e6 that Harris & Kotzalas (*Essential Concepts of Bearing Technology*,
   5th ed., ch. 1) give as the practical limit of oil-lubricated ball bearings;
-* loads: up to 100 kN, about six times the static load rating of a bearing of this size (SKF lists
-  C0 = 11.2 kN for the 6206, nine 9.525 mm balls; 14 balls scale it to about 17 kN), beyond which the
-  steel yields;
+* loads: up to 100 kN, several times the static load rating of a bearing of this size (a 6206 deep-groove
+  bearing, nine 9.525 mm balls, is catalogued at C0 of about 11-12 kN; 14 balls scale that to about
+  17-19 kN), beyond which the raceways dent permanently;
 * the frame rate: up to 10 million frames/s, above the fastest Phantom cameras (about 1.75 Mfps);
 * the simulated sample rate: up to 1 MHz (the solver's default largest step is 2 us).
 """

@@ -151,7 +151,9 @@ class CineReader(FrameSource):
             self._dtype = np.dtype(np.uint8 if b["bi_bit_count"] == 8 else "<u2")
             self._image_size = n * self._dtype.itemsize
             self._bit_depth = int(s.get("real_bpp") or b["bi_bit_count"])
-            if not 8 <= self._bit_depth <= b["bi_bit_count"]:  # Phantom's RealBPP is 8..16 within its word
+            # The cine format's SETUP.RealBPP is 8 on 8-bit cameras and 8..14 on 14-bit ones, stored in
+            # 16-bit words above 8 (Vision Research's SETUP definition); anything else is a corrupt header.
+            if not 8 <= self._bit_depth <= b["bi_bit_count"]:
                 raise VideoError(self.path, f"declares {self._bit_depth} significant bits per pixel (RealBPP) in "
                                  f"{b['bi_bit_count']}-bit words; a cine holds 8 to {b['bi_bit_count']}.",
                                  offset=self.header["off_setup"] + SETUP_FIELDS["real_bpp"][0],
