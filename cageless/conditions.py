@@ -19,6 +19,7 @@ from __future__ import annotations
 import json
 import logging
 import math
+import os
 import re
 import tomllib
 from collections.abc import Mapping
@@ -196,20 +197,27 @@ def read_conditions_csv(path: str | Path) -> dict[str, dict[str, float]]:
         non-numeric cell or a duplicated file.
     """
     path = Path(path)
+    sep, decimal = _csv_dialect(path)
     try:
-        table = pd.read_csv(path, dtype={"file": str}, skipinitialspace=True)
+        table = pd.read_csv(path, dtype={"file": str}, skipinitialspace=True, sep=sep, decimal=decimal)
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         raise ConditionsError(path, f"cannot parse the CSV: {exc}.") from exc
     table.columns = [str(c).strip() for c in table.columns]
     for required in ("file", "speed_rpm"):
         if required not in table.columns:
+            found = ", ".join(repr(c) for c in table.columns[:8])
             raise ConditionsError(
-                path, f"missing column '{required}'.",
-                f"Columns are: file, {', '.join(CONDITION_KEYS)} (only file and speed_rpm are required).",
+                path, f"missing column '{required}' (the header has {found}).",
+                f"Columns are: file, {', '.join(CONDITION_KEYS)} (only file and speed_rpm are required), "
+                "separated by commas.",
             )
-    for col in table.columns:
+    for col in list(table.columns):
         if col != "file" and col not in CONDITION_KEYS:
-            raise ConditionsError(path, f"unknown column '{col}'." + suggest(col, CONDITION_KEYS))
+            hint = suggest(col, CONDITION_KEYS)
+            if hint:  # a misspelled key would silently lose its value
+                raise ConditionsError(path, f"unknown column '{col}'." + hint)
+            log.warning("%s: ignoring column '%s'; the columns read are file, %s", path, col, ", ".join(CONDITION_KEYS))
+            table = table.drop(columns=col)
     rows: dict[str, dict[str, float]] = {}
     for i, row in table.iterrows():
         line = int(i) + 2  # 1-based, after the header
@@ -228,6 +236,27 @@ def read_conditions_csv(path: str | Path) -> dict[str, dict[str, float]]:
                 raise ConditionsError(path, f"line {line}: '{key}' = {row[key]!r} is not a number.") from None
         rows[name] = values
     return rows
+
+
+def _csv_dialect(path: Path) -> tuple[str, str]:
+    """The field separator and decimal mark of a conditions CSV: ``","``/``"."``, or the European ``";"``/``","``.
+
+    A header with semicolons and no commas is read as semicolon-separated (with decimal commas when
+    the rows hold digits separated by a comma), and logged.
+    """
+    try:
+        with open(path, encoding="utf-8", errors="replace") as fh:
+            lines = [fh.readline() for _ in range(20)]
+    except OSError:
+        return ",", "."
+    header = lines[0]
+    if ";" in header and "," not in header:
+        decimal = "," if any(re.search(r"\d,\d", line) for line in lines[1:]) else "."
+        log.info("%s: read as semicolon-separated%s", path, " with decimal commas" if decimal == "," else "")
+        return ";", decimal
+    if "\t" in header and "," not in header:
+        return "\t", "."
+    return ",", "."
 
 
 _NUMBER = r"(\d+(?:\.\d+)?)"
@@ -369,6 +398,11 @@ def find_videos(folder: str | Path) -> list[Path]:
     return found
 
 
+def _dangling_links(folder: Path) -> list[Path]:
+    """Symbolic links in ``folder`` whose target is missing (they would otherwise be skipped silently)."""
+    return [p for p in sorted(folder.iterdir()) if not p.name.startswith(".") and p.is_symlink() and not p.exists()]
+
+
 def discover_lab(folder: str | Path) -> list[LabEntry]:
     """Find every video of a lab folder and resolve its conditions.
 
@@ -389,7 +423,9 @@ def discover_lab(folder: str | Path) -> list[LabEntry]:
     known = {v.name for v in videos} | {v.stem for v in videos}
     for name in sorted(set(table) - known):
         log.warning("%s: row '%s' matches no video in the folder", csv_path, name)
-    entries = []
+    entries = [LabEntry(video=p, error=ConditionsError(
+        p, f"is a broken symbolic link (to {os.readlink(p)}): the file it points to is missing.",
+        "Fix or remove the link.")) for p in _dangling_links(folder)]
     for video in videos:
         if csv_error is not None:
             entries.append(LabEntry(video=video, error=csv_error))

@@ -22,7 +22,9 @@ from __future__ import annotations
 
 import hashlib
 import json
+import logging
 import math
+import os
 import time
 from collections.abc import Callable, Iterable
 from concurrent.futures import Future
@@ -38,13 +40,17 @@ from cageless.bearing import Bearing, default_bearing
 from cageless.conditions import LabEntry, OperatingConditions, discover_lab
 from cageless.errors import CagelessError
 from cageless.kinematics import startup_duration, theoretical_cage_speed
+from cageless.outputs import clean_stale_parts, output_lock
 from cageless.parallel import job_pool
 from cageless.provenance import sha256_file
 from cageless.trace import read_trace
+from cageless.validate import plausible_entry
 
 __all__ = ["LabOptions", "LabResult", "run_lab"]
 
 CACHE_NAME = ".cageless-cache.json"
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -90,6 +96,18 @@ def _track_job(video: str, conditions: OperatingConditions, bearing: Bearing, ou
     return "ok", str(res.path)
 
 
+def _qc_files(trace_path: Path) -> list[Path]:
+    """The QC files a track job writes beside its trace (their presence is part of a cache hit)."""
+    stem = trace_path.name[: -len(".trace.h5")]
+    qc = trace_path.parent / "qc"
+    files = [qc / f"{stem}.qc.json", qc / f"{stem}.slip_profile.csv"]
+    try:
+        files += [qc / name for name in json.loads(files[0].read_text()).get("overlays", [])]
+    except (OSError, ValueError, AttributeError):
+        pass
+    return files
+
+
 def _simulate_job(conditions: OperatingConditions, bearing: Bearing, duration_s: float, parameters: dict[str, float],
                   rtol: float, out: str) -> tuple[str, str]:
     from simulation.effects import choose_model
@@ -112,12 +130,25 @@ def _simulate_job(conditions: OperatingConditions, bearing: Bearing, duration_s:
 # -- caching --------------------------------------------------------------------------------------------
 
 class _Cache:
+    """Finished jobs of earlier runs: ``{key: {"path": relative to OUT, "sha256": of the output, "also": [...]}}``.
+
+    Paths are relative to the output folder, so a copied or renamed report folder reads its own files.
+    A hit is trusted only when the output (and the files in ``also``) exist, the output's SHA-256 is the
+    one stored, and the trace reads; anything missing or corrupt is redone.
+    """
+
+    VERSION = 2
+
     def __init__(self, out: Path) -> None:
+        self.out = out
         self.path = out / CACHE_NAME
+        self.data: dict[str, dict[str, Any]] = {}
         try:
-            self.data: dict[str, str] = json.loads(self.path.read_text()) if self.path.exists() else {}
-        except (OSError, json.JSONDecodeError):
-            self.data = {}
+            raw = json.loads(self.path.read_text()) if self.path.exists() else {}
+        except (OSError, ValueError):
+            raw = {}
+        if isinstance(raw, dict) and raw.get("version") == self.VERSION and isinstance(raw.get("jobs"), dict):
+            self.data = raw["jobs"]
 
     @staticmethod
     def key(kind: str, payload: dict[str, Any]) -> str:
@@ -125,12 +156,33 @@ class _Cache:
         return hashlib.sha256(text.encode()).hexdigest()
 
     def hit(self, key: str) -> str | None:
-        path = self.data.get(key)
-        return path if path and Path(path).exists() else None
+        """The cached output's absolute path when it can be trusted, else ``None`` (and the entry is dropped)."""
+        entry = self.data.get(key)
+        if not isinstance(entry, dict):
+            return None
+        path = self.out / str(entry.get("path", ""))
+        also = [self.out / str(a) for a in entry.get("also", [])]
+        try:
+            ok = (path.is_file() and all(a.is_file() for a in also)
+                  and sha256_file(path, cache=False) == entry.get("sha256"))
+            if ok:
+                read_trace(path)
+        except (CagelessError, OSError):
+            ok = False
+        if not ok:
+            log.info("%s: cached output missing or damaged; redoing it", path)
+            del self.data[key]
+            return None
+        return str(path)
 
-    def store(self, key: str, path: str) -> None:
-        self.data[key] = path
-        atomic_write_text(self.path, json.dumps(self.data, indent=1, sort_keys=True))
+    def _relative(self, path: str | Path) -> str:
+        return os.path.relpath(Path(path).resolve(), self.out.resolve())
+
+    def store(self, key: str, path: str, also: list[Path] | None = None) -> None:
+        self.data[key] = {"path": self._relative(path), "sha256": sha256_file(path, cache=False),
+                          "also": [self._relative(a) for a in (also or [])]}
+        atomic_write_text(self.path, json.dumps({"version": self.VERSION, "jobs": self.data}, indent=1,
+                                                sort_keys=True))
 
 
 # -- executors ------------------------------------------------------------------------------------------
@@ -174,7 +226,19 @@ def _duration(key: tuple[float, float, float], video_s: Iterable[float], bearing
 
 def run_lab(folder: str | Path, out: str | Path, options: LabOptions | None = None, bearing: Bearing | None = None,
             progress: bool = True) -> LabResult:
-    """Run the whole workflow on a lab folder; see the module docstring."""
+    """Run the whole workflow on a lab folder; see the module docstring.
+
+    The output folder is locked for the run: a second run into it is refused (:class:`FolderInUseError`),
+    and temporary files that killed runs left there are removed first.
+    """
+    out = Path(out)
+    with output_lock(out, "report folder"):
+        clean_stale_parts(out)
+        return _run_lab(folder, out, options, bearing, progress)
+
+
+def _run_lab(folder: str | Path, out: Path, options: LabOptions | None, bearing: Bearing | None,
+             progress: bool) -> LabResult:
     from comparison.compare import ComparisonRow, compare
     from comparison.report import build_report, describe_condition, write_report
     from comparison.table import write_tables
@@ -185,7 +249,7 @@ def run_lab(folder: str | Path, out: str | Path, options: LabOptions | None = No
     (out / "traces").mkdir(parents=True, exist_ok=True)
     (out / "simulations").mkdir(parents=True, exist_ok=True)
     cache, timings, skipped = _Cache(out), {}, 0
-    entries = discover_lab(folder)
+    entries = [plausible_entry(e, options.force) for e in discover_lab(folder)]
     if not entries:
         raise CagelessError(f"{folder}: no videos found. A lab folder holds videos (cine, avi/mp4/mkv or image "
                             "folders) with their conditions (DESIGN §5).")
@@ -243,7 +307,7 @@ def _collect(results: dict[Any, Any], pending: list[Any], keys: list[str], outco
     """Store each finished job's output path (and cache it), or its error."""
     for item, key, (status, info) in zip(pending, keys, outcomes, strict=True):
         if status == "ok":
-            cache.store(key, info)
+            cache.store(key, info, _qc_files(Path(info)) if isinstance(item, Path) else None)
             results[item] = info
         else:
             results[item] = CagelessError(info)

@@ -7,6 +7,11 @@ spawned, not forked: numba's thread pool does not survive a fork.
 
 from __future__ import annotations
 
+import os
+import signal
+import sys
+import threading
+import time
 from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
@@ -14,7 +19,7 @@ from typing import Any
 
 from tqdm.auto import tqdm
 
-__all__ = ["job_pool", "gather"]
+__all__ = ["job_pool", "gather", "die_with_parent"]
 
 
 def job_pool(workers: int = 2, scheduler: str | None = None) -> Any:
@@ -23,7 +28,34 @@ def job_pool(workers: int = 2, scheduler: str | None = None) -> Any:
         from distributed import Client
 
         return Client(scheduler)
-    return ProcessPoolExecutor(max_workers=max(1, workers), mp_context=get_context("spawn"))
+    return ProcessPoolExecutor(max_workers=max(1, workers), mp_context=get_context("spawn"),
+                               initializer=die_with_parent, initargs=(os.getpid(),))
+
+
+def die_with_parent(parent_pid: int) -> None:
+    """Worker initializer: end this process when its parent dies (even by ``kill -9``).
+
+    On Linux the kernel sends SIGKILL on the parent's death (``prctl(PR_SET_PDEATHSIG)``); everywhere,
+    a daemon thread also checks once a second that the parent is still there.
+    """
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(1, int(signal.SIGKILL), 0, 0, 0)  # PR_SET_PDEATHSIG = 1
+        except (OSError, AttributeError):  # pragma: no cover - no libc prctl
+            pass
+    if os.getppid() != parent_pid:  # the parent died before the line above took effect
+        os._exit(1)
+
+    def watch() -> None:
+        while True:
+            time.sleep(1.0)
+            if os.getppid() != parent_pid:
+                os._exit(1)
+
+    threading.Thread(target=watch, name="cageless-parent-watch", daemon=True).start()
 
 
 def gather(futures: Sequence[Any], desc: str, progress: bool = True) -> list[Any]:

@@ -13,6 +13,7 @@ inconsistent shapes, saying why. A round trip is lossless.
 
 from __future__ import annotations
 
+import io
 import json
 import re
 from collections.abc import Mapping
@@ -243,9 +244,14 @@ def write_trace(path: str | Path, trace: Trace) -> Path:
         The written file.
     """
     path = Path(path)
-    with atomic_path(path) as tmp, h5py.File(tmp, "w") as f:
+    # The file is built in memory and written in one go: a full disk then fails a plain write with
+    # ENOSPC (a clear error) instead of failing inside the HDF5 library.
+    buffer = io.BytesIO()
+    with h5py.File(buffer, "w") as f:
         _write_root_attrs(f, trace)
         _write_datasets(f, trace)
+    with atomic_path(path) as tmp:
+        tmp.write_bytes(buffer.getbuffer())
     return path
 
 
@@ -302,6 +308,9 @@ def _check_schema(path: Path, attrs: h5py.AttributeManager) -> None:
     if int(m.group(1)) > SCHEMA_MAJOR:
         raise _fail(path, f"has schema '{schema}', newer than this cageless reads ('{SCHEMA}').",
                     "Upgrade cageless to read it.")
+    if int(m.group(1)) < SCHEMA_MAJOR:
+        raise _fail(path, f"has schema '{schema}', older than this cageless reads ('{SCHEMA}').",
+                    "Re-create it with this version (re-run the track or simulate command).")
 
 
 def read_trace(path: str | Path) -> Trace:
@@ -314,20 +323,27 @@ def read_trace(path: str | Path) -> Trace:
         dataset or attribute, or has inconsistent shapes.
     """
     path = Path(path)
+    if path.is_dir():
+        raise _fail(path, "is a folder, not a trace file.", "Give a *.trace.h5 file.")
     if not path.is_file():
         raise _fail(path, "does not exist.")
     try:
         f = h5py.File(path, "r")
-    except OSError as exc:
+    except (OSError, RuntimeError) as exc:
         raise _fail(path, f"is not a readable HDF5 file ({exc}).") from exc
-    with f:
-        _check_schema(path, f.attrs)
-        try:
-            return _read_body(path, f)
-        except KeyError as exc:
-            raise _fail(path, f"lacks {exc.args[0]!r}, which {SCHEMA} requires.") from exc
-        except ValueError as exc:
-            raise _fail(path, f"is inconsistent: {exc}") from exc
+    try:
+        with f:
+            _check_schema(path, f.attrs)
+            try:
+                return _read_body(path, f)
+            except KeyError as exc:
+                raise _fail(path, f"lacks {exc.args[0]!r}, which {SCHEMA} requires.") from exc
+            except ValueError as exc:
+                raise _fail(path, f"is inconsistent: {exc}") from exc
+    except TraceFormatError:
+        raise
+    except (OSError, RuntimeError, TypeError, UnicodeDecodeError, SystemError) as exc:
+        raise _fail(path, f"is damaged: {exc}.", "Re-create it (re-run the command that wrote it).") from exc
 
 
 def _attr(a: Mapping[str, Any], key: str) -> Any:

@@ -35,7 +35,7 @@ from tracking.io import CineReader, FrameSource, open_video
 from tracking.kinematics import DEFAULT_WINDOW, revolution_speed
 from tracking.link import BallCountWarning, TrackSetup, track_frames
 from tracking.locate import BearingLocation, background_frame, locate_bearing
-from tracking.qc import QCReport, build_qc, write_qc
+from tracking.qc import QCReport, build_qc, slip_warnings, write_qc
 
 __all__ = ["TrackOptions", "TrackResult", "track_video"]
 
@@ -71,6 +71,8 @@ class TrackOptions:
         How many overlay images to write.
     threads
         Segments tracked in parallel threads for long videos (each at least 1024 frames).
+    allow_truncated
+        Track the complete frames of a truncated ``.cine`` instead of refusing it.
     """
 
     detector: DetectorParams = field(default_factory=DetectorParams)
@@ -81,6 +83,7 @@ class TrackOptions:
     fps: float | None = None
     qc_frames: int = 3
     threads: int = 2
+    allow_truncated: bool = False
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready settings."""
@@ -169,7 +172,7 @@ def track_video(
     fps = options.fps or conditions.fps
     prov = Provenance.start(config={"tracking": options.to_dict(), "conditions": conditions.to_dict(),
                                     **(config or {})}, inputs=[path], background=True)
-    with warnings.catch_warnings(record=True) as caught, open_video(path, fps=fps) as video:
+    with warnings.catch_warnings(record=True) as caught, open_video(path, fps=fps, allow_truncated=options.allow_truncated) as video:
         warnings.simplefilter("always", BallCountWarning)
         times = video.times
         if len(video) < options.window:
@@ -192,7 +195,12 @@ def track_video(
     if out_dir is not None:
         out_dir = Path(out_dir)
         written = write_trace(out_dir / f"{_stem(path)}.trace.h5", trace)
-        write_qc(out_dir / "qc", _stem(path), path, qc, table, trace, options.qc_frames, fps)
+        try:
+            write_qc(out_dir / "qc", _stem(path), path, qc, table, trace, options.qc_frames, fps,
+                     allow_truncated=options.allow_truncated)
+        except BaseException:  # no trace without its QC: a re-run redoes both
+            written.unlink(missing_ok=True)
+            raise
     return TrackResult(trace=trace, table=table, qc=qc, path=written)
 
 
@@ -208,7 +216,7 @@ def _track_all(path: Path, fps: float | None, video: FrameSource, frames: _Cropp
 
     def one(span: tuple[int, int]) -> pd.DataFrame:
         a, b = span
-        with open_video(path, fps=fps) as own:
+        with open_video(path, fps=fps, allow_truncated=options.allow_truncated) as own:
             seg = _CroppedFrames(own, frames.rows, frames.cols, options.chunk, offset=a, stop=b)
             return track_frames(seg, times[a:b], setup, str(path), options.strict, update)[0]
 
@@ -262,10 +270,12 @@ def _finish(path: Path, video: FrameSource, table: pd.DataFrame, loc: BearingLoc
     omega_c = theoretical_cage_speed(g, conditions.speed_rad_s)
     px_per_mm = conditions.px_per_mm or orbit.radius / (0.5 * g.pitch_diameter_m * 1e3)
     qc = build_qc(table, order, valid, orbit, loc, direction, px_per_mm, g.n_balls, warned)
+    slip = slip_rate(speed, omega_c)
+    qc.warnings.extend(slip_warnings(angle, speed, slip, valid, omega_c, conditions.speed_rpm))
     meta = video.metadata
     fps = meta.extra.get("fps_override") or meta.timestamp_fps or meta.header_fps or float("nan")
     trace = Trace(
-        source="video", time=times, angle=angle, speed=speed, slip=slip_rate(speed, omega_c), valid=valid,
+        source="video", time=times, angle=angle, speed=speed, slip=slip, valid=valid,
         speed_rpm=conditions.speed_rpm, radial_load_n=conditions.radial_load_n, axial_load_n=conditions.axial_load_n,
         ball_diameter_m=g.ball_diameter_m, pitch_diameter_m=g.pitch_diameter_m, direction=direction,
         config={"tracking": options.to_dict(), "conditions": conditions.to_dict(), "bearing": bearing.to_dict(),

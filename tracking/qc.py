@@ -28,7 +28,7 @@ from tracking.geometry import Orbit
 from tracking.io import open_video
 from tracking.locate import BearingLocation
 
-__all__ = ["QC_LIMITS", "QCReport", "build_qc", "write_qc"]
+__all__ = ["QC_LIMITS", "QCReport", "build_qc", "write_qc", "slip_warnings"]
 
 log = logging.getLogger(__name__)
 
@@ -37,6 +37,10 @@ QC_LIMITS = {
     "min_detection_rate": 0.90,  # per ball
     "max_interpolated_share": 0.10,  # over all samples
     "max_residual_fraction": 0.005,  # orbit fit residual / orbit radius
+    # Balls in the loaded zone roll nearly purely (their slip there is ~0-2 %, paper figure 18), so their
+    # orbit speed measures the cage speed of the stated shaft speed; a larger gap means a wrong speed_rpm.
+    "max_speed_mismatch": 0.08,
+    "min_slip": -0.01,  # a ball cannot orbit faster than pure rolling allows by more than the noise
 }
 
 
@@ -94,6 +98,43 @@ def build_qc(table: pd.DataFrame, order: np.ndarray, valid: np.ndarray, orbit: O
     return report
 
 
+def slip_warnings(angle: np.ndarray, speed: np.ndarray, slip: np.ndarray, valid: np.ndarray, omega_c: float,
+                  speed_rpm: float) -> list[str]:
+    """Cross-check the stated speed against the balls' loaded-zone orbit speed, and flag negative slip.
+
+    Parameters
+    ----------
+    angle, speed, slip, valid
+        The trace's (T, Z) arrays: orbital angle (rad), orbit speed (rad/s), slip, validity.
+    omega_c
+        The pure-rolling cage speed of the stated shaft speed (rad/s).
+    speed_rpm
+        The stated shaft speed.
+
+    Returns
+    -------
+    list of str
+        The warnings (empty when both checks pass).
+    """
+    out: list[str] = []
+    loaded = (np.sin(angle) < -math.sqrt(0.5)) & valid & np.isfinite(speed)  # within 45 deg of 270 deg
+    if loaded.sum() >= 10 and omega_c > 0:
+        ratio = float(np.median(speed[loaded])) / omega_c
+        if abs(ratio - 1.0) > QC_LIMITS["max_speed_mismatch"]:
+            out.append(f"the stated speed {speed_rpm:g} r/min disagrees with the video: balls in the loaded zone "
+                       f"orbit {100 * (ratio - 1):+.1f} % off its pure-rolling cage speed (the video looks like "
+                       f"about {speed_rpm * ratio:.0f} r/min); check speed_rpm")
+    good = valid & np.isfinite(slip)
+    if good.any():
+        mean_slip = float(np.mean(slip[good]))
+        if mean_slip < QC_LIMITS["min_slip"]:
+            out.append(f"negative slip: the mean slip is {100 * mean_slip:.2f} %, so the balls orbit faster than "
+                       "pure rolling at the stated speed; check speed_rpm")
+    for w in out:
+        log.warning("%s", w)
+    return out
+
+
 def _overlay(frame: np.ndarray, rows: pd.DataFrame, orbit: Orbit, scale: int) -> np.ndarray:
     lo, hi = np.percentile(frame, [1, 99.8])
     img8 = np.clip((frame.astype(np.float32) - lo) * (255.0 / max(hi - lo, 1e-6)), 0, 255).astype(np.uint8)
@@ -117,12 +158,32 @@ def _overlay(frame: np.ndarray, rows: pd.DataFrame, orbit: Orbit, scale: int) ->
 
 
 def write_qc(qc_dir: Path, stem: str, video_path: Path, qc: QCReport, table: pd.DataFrame, trace: Trace,
-             n_frames: int, fps: float | None) -> list[Path]:
-    """Write ``<stem>.qc.json`` and ``n_frames`` overlay PNGs (balls numbered as in the trace)."""
-    qc_dir.mkdir(parents=True, exist_ok=True)
+             n_frames: int, fps: float | None, allow_truncated: bool = False) -> list[Path]:
+    """Write ``<stem>.qc.json`` and ``n_frames`` overlay PNGs (balls numbered as in the trace).
+
+    On any failure (a full disk, say) the files written so far are removed, and the ``qc`` folder too
+    when it was created here and is left empty.
+    """
+    created = not qc_dir.exists()
     written: list[Path] = []
+    try:
+        return _write_qc(qc_dir, stem, video_path, qc, table, trace, n_frames, fps, allow_truncated, written)
+    except BaseException:
+        for p in written:
+            p.unlink(missing_ok=True)
+        if created:
+            try:
+                qc_dir.rmdir()
+            except OSError:
+                pass
+        raise
+
+
+def _write_qc(qc_dir: Path, stem: str, video_path: Path, qc: QCReport, table: pd.DataFrame, trace: Trace,
+              n_frames: int, fps: float | None, allow_truncated: bool, written: list[Path]) -> list[Path]:
+    qc_dir.mkdir(parents=True, exist_ok=True)
     label = np.argsort(np.asarray(qc.ball_order))  # tracker column -> trace ball number
-    with open_video(video_path, fps=fps) as video:
+    with open_video(video_path, fps=fps, allow_truncated=allow_truncated) as video:
         n = len(video)
         picks = np.unique(np.linspace(0, n - 1, max(1, n_frames)).round().astype(int))
         scale = max(1, int(math.ceil(600 / max(video.frame_shape))))
@@ -137,7 +198,8 @@ def write_qc(qc_dir: Path, stem: str, video_path: Path, qc: QCReport, table: pd.
             written.append(target)
     qc.overlays = [p.name for p in written]
     atomic_write_text(qc_dir / f"{stem}.qc.json", json.dumps(qc.to_dict(), indent=1, default=float))
+    written.append(qc_dir / f"{stem}.qc.json")
     profile = angle_profile(trace.angle, trace.slip, 1.0, trace.valid)
     atomic_write_text(qc_dir / f"{stem}.slip_profile.csv", profile.to_csv(index=False, float_format="%.6g"))
-    return written
+    return written[:-1]
 

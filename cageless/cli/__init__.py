@@ -14,6 +14,7 @@ import importlib
 import logging
 import sys
 from collections.abc import Sequence
+from pathlib import Path
 
 from cageless._version import __version__
 from cageless.cli.common import ArgumentParser, apply_config_defaults, common_options, setup_logging
@@ -87,6 +88,54 @@ def main(argv: Sequence[str] | None = None) -> int:
     except CagelessError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return EXIT_FAILED
+    except KeyboardInterrupt:
+        print("error: interrupted; finished outputs are kept and a re-run continues from them.", file=sys.stderr)
+        return 130
+    except Exception as exc:  # noqa: BLE001 - the last line of defence: one line, never a bare traceback
+        return _unexpected(exc, argv)
+
+
+def _unexpected(exc: BaseException, argv: Sequence[str]) -> int:
+    """Report an unexpected exception in one line; keep the traceback in a log file (and show it with -v)."""
+    import errno
+    import traceback
+
+    text = "".join(traceback.format_exception(exc))
+    if isinstance(exc, OSError) and exc.errno in (errno.ENOSPC, errno.EDQUOT):
+        where = exc.filename or "the output folder"
+        print(f"error: no space left on {where}. Free some space and re-run.", file=sys.stderr)
+        return EXIT_FAILED
+    if isinstance(exc, MemoryError):
+        print(f"error: out of memory ({exc}). Lower the sizes asked for (duration, sample rate, workers).",
+              file=sys.stderr)
+        return EXIT_FAILED
+    log_path = _write_crash_log(text, argv)
+    where = f"details in {log_path}" if log_path else "no log file could be written"
+    print(f"error: unexpected {type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''} ({where}; "
+          "run with -v for the traceback).", file=sys.stderr)
+    if "-v" in argv or "--verbose" in argv or any(a.startswith("-vv") for a in argv):
+        print(text, file=sys.stderr, end="")
+    return EXIT_FAILED
+
+
+def _write_crash_log(text: str, argv: Sequence[str]) -> str | None:
+    import os
+    import tempfile
+    from datetime import UTC, datetime
+
+    stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%SZ")
+    body = f"cageless {__version__}\nargs: {' '.join(argv)}\n\n{text}"
+    from cageless.provenance import cache_dir
+
+    for folder in (cache_dir() / "logs", Path(tempfile.gettempdir())):
+        path = folder / f"cageless-error-{stamp}-{os.getpid()}.log"
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+            path.write_text(body)
+            return str(path)
+        except OSError:
+            continue
+    return None
 
 
 def entry_point() -> None:

@@ -46,6 +46,12 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     from comparison.report import describe_condition, figures
     from comparison.table import table_frame, to_markdown
 
+    from cageless.outputs import check_output_dir
+    from cageless.validate import check_options
+
+    check_options(args, ("bin_deg", "settle"), force=False)
+    if args.figures:
+        check_output_dir(args.figures, "--figures")
     measured, simulated = read_trace(args.video_trace), read_trace(args.sim_trace)
     if measured.source != "video" or simulated.source != "simulation":
         raise UsageError(f"give the video trace first and the simulation trace second (got {measured.source} "

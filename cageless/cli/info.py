@@ -149,6 +149,9 @@ def _format_video(m: dict[str, Any]) -> str:
 
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Print the bearing or video description; return the exit code."""
+    from cageless.validate import check_options
+
+    check_options(args, ("fps", "speed_rpm"), force=False)
     if args.video is not None:
         meta = describe_video(args.video, args.fps)
         print(json.dumps(meta, indent=2) if args.json else _format_video(meta))

@@ -39,7 +39,8 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--rtol", type=finite_float, default=1e-6, help="simulation tolerance (default 1e-6)")
     p.add_argument("--workers", type=int, default=2, help="local processes (default 2)")
     p.add_argument("--scheduler", help="address of a Dask scheduler to run the jobs on")
-    p.add_argument("--force", action="store_true", help="compare even when a trace's conditions differ")
+    p.add_argument("--force", action="store_true", help="compare even when a trace's conditions differ, and accept "
+                   "numbers and conditions outside their plausible ranges")
 
 
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
@@ -48,8 +49,13 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     from cageless.lab import LabOptions, run_lab
     from simulation.parameters import ModelParameters, parse_set_overrides
 
+    from cageless.outputs import check_output_dir
+    from cageless.validate import check_options
+
     values = parse_set_overrides(args.set_values)
     ModelParameters().with_overrides(values)  # validated before any work starts
+    check_options(args, ("duration", "settle", "rtol", "workers"))
+    check_output_dir(args.out, "-o")
     options = LabOptions(duration_s=args.duration, settle_s=args.settle, rtol=args.rtol, workers=args.workers,
                          scheduler=args.scheduler, force=args.force, parameters=values)
     res = run_lab(args.lab, args.out, options, bearing_from_config(config), progress=not args.quiet)

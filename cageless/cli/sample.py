@@ -33,15 +33,66 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--revolutions", type=finite_float, default=None,
                    help="orbits each ball travels per clip (default 0.34 lab, 0.1 full)")
     p.add_argument("--workers", type=int, default=1, help="processes rendering frames (default 1)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace files of the same names that an earlier 'cageless sample' did not write")
 
 
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Render the folder and print one line per clip; return the exit code."""
-    from tracking.synthetic.lab import make_lab
+    from cageless.outputs import check_output_dir, output_lock
+    from cageless.validate import check_options
+    from tracking.synthetic.lab import PRESETS, make_lab
 
+    check_options(args, ("seed", "revolutions", "workers"), force=False)
+    out = check_output_dir(args.out, "DIR")
     geometry = bearing_from_config(config).geometry
-    results = make_lab(args.out, preset=args.preset, seed=args.seed, revolutions=args.revolutions,
-                       geometry=geometry, workers=max(1, args.workers), progress=not args.quiet)
+    with output_lock(out, "folder"):
+        targets = _targets(PRESETS[args.preset])
+        _refuse_foreign(out, targets, args.overwrite)
+        _record(out, targets, done=False)
+        results = make_lab(out, preset=args.preset, seed=args.seed, revolutions=args.revolutions,
+                           geometry=geometry, workers=max(1, args.workers), progress=not args.quiet)
+        _record(out, targets, done=True)
     for res in results:
         print(f"{res['video']}: {res['n_frames']} frames, truth in {res['truth_csv'].name}")
     return 0
+
+
+_MANIFEST = ".cageless-sample.json"
+
+
+def _targets(specs: Any) -> list[str]:
+    """The names ``make_lab`` writes in the folder for these clips."""
+    from pathlib import Path
+
+    names = {"conditions.csv", "README.md"}
+    for spec in specs:
+        stem = Path(spec.name).stem
+        names |= {spec.name, f"{stem}.truth.csv", f"{stem}.truth.json", f"{stem}.toml"}
+    return sorted(names)
+
+
+def _refuse_foreign(out: Any, targets: list[str], overwrite: bool) -> None:
+    """Refuse to replace files that an earlier ``cageless sample`` into this folder did not write."""
+    import json
+
+    from cageless.errors import UsageError
+
+    try:
+        ours = set(json.loads((out / _MANIFEST).read_text()).get("files", []))
+    except (OSError, ValueError, AttributeError):
+        ours = set()
+    foreign = [n for n in targets if (out / n).exists() and n not in ours]
+    if foreign and not overwrite:
+        shown = ", ".join(foreign[:4]) + (f" and {len(foreign) - 4} more" if len(foreign) > 4 else "")
+        raise UsageError(f"{out}: already holds {shown}, which 'cageless sample' would replace and did not write. "
+                         "Choose an empty folder, or pass --overwrite.")
+
+
+def _record(out: Any, targets: list[str], done: bool) -> None:
+    """Remember which names this command writes (before rendering, so a killed run can be re-run)."""
+    import json
+
+    from cageless.atomic import atomic_write_text
+
+    atomic_write_text(out / _MANIFEST, json.dumps({"files": targets, "complete": done}, indent=1))

@@ -55,7 +55,9 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--seed", type=int, default=0, help="perturbs the initial gaps")
     p.add_argument("--level", help="force the model level: planar or spatial")
     p.add_argument("--effect", action="append", default=[], metavar="NAME=on|off", help="force an effect")
-    p.add_argument("--force", action="store_true", help="allow forced choices that contradict the scene")
+    p.add_argument("--force", action="store_true", help="allow forced choices that contradict the scene, and "
+                   "numbers outside their plausible ranges")
+    p.add_argument("--overwrite", action="store_true", help="allow -o to replace a file that is not a cageless trace")
     p.add_argument("--explain", action="store_true", help="print the level and effects with reasons; do not solve")
     p.add_argument("--json", action="store_true", help="with --explain: print JSON")
     p.add_argument("--solver", default="auto", help="integrator: auto (default: compiled dp5, switching to CVODE "
@@ -64,7 +66,8 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--max-step", type=finite_float, default=None,
                    help="largest step (s; default 2e-6, and 5e-6 for CVODE, also after an automatic switch)")
     p.add_argument("--restitution", type=finite_float,
-                   help="ball-ball coefficient of restitution R, 0 < R <= 1 (same as --set restitution=R)")
+                   help="ball-ball coefficient of restitution R, 0 <= R <= 1, 0 perfectly plastic (same as --set "
+                   "restitution=R)")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", dest="set_values",
                    help="change an open model parameter, e.g. --set cho_n_s_m=2500 (repeatable; "
                    "simulation/parameters.py lists them with their sources)")
@@ -85,6 +88,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     from simulation.scene import Scene
 
     bearing = bearing_from_config(config)
+    _validate(args, bearing)
     if args.dry:
         bearing = dataclasses.replace(bearing, lubricant=None)
     if args.clearance_um is not None:
@@ -100,6 +104,27 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
         print(choice.to_json() if args.json else choice.explain())
         return 0
     return _run(args, scene, choice, config)
+
+
+_CHECKED = ("speed_rpm", "radial_load_n", "axial_load_n", "duration", "gravity", "misalignment_rad", "moment_load_nm",
+            "oil_air_density", "clearance_um", "seed", "rtol", "max_step", "restitution", "speed_ramp", "ensemble",
+            "sample_rate")
+
+
+def _validate(args: argparse.Namespace, bearing: Any) -> None:
+    """Every number in its range and the output path usable, before any work."""
+    from cageless.outputs import check_output_file
+    from cageless.validate import check_options, check_output_size
+
+    check_options(args, _CHECKED)
+    if args.explain:
+        return
+    check_output_size(args.duration, args.sample_rate, bearing.geometry.n_balls)
+    if args.out:
+        check_output_file(args.out, "-o", overwrite=args.overwrite)
+    elif args.ensemble == 1:
+        check_output_file(f"sim_{args.speed_rpm:g}rpm_Fr{args.radial_load_n:g}.trace.h5", "the default output",
+                          overwrite=args.overwrite)
 
 
 def _parameters(args: argparse.Namespace) -> Any:

@@ -51,6 +51,11 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
 
     if args.seeds < 1:
         raise UsageError(f"--seeds must be >= 1, got {args.seeds}")
+    from cageless.outputs import check_output_dir
+    from cageless.validate import check_options
+
+    check_options(args, ("speed_rpm", "radial_load_n", "axial_load_n", "duration", "settle", "workers"), force=False)
+    check_output_dir(args.out, "-o")
     bearing = bearing_from_config(config)
     vary = parse_vary(args.vary, bearing)
     fixed = parse_set_overrides(args.set_values)

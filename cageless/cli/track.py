@@ -16,6 +16,8 @@ from cageless.cli.common import finite_float
 from cageless.conditions import IMAGE_SUFFIXES, LabEntry, OperatingConditions, discover_lab, resolve_conditions
 from cageless.config import bearing_from_config
 from cageless.errors import CagelessError, UsageError
+from cageless.outputs import check_output_dir, clean_stale_parts, output_lock
+from cageless.validate import check_options, plausible_entry
 
 __all__ = ["register", "run", "collect_inputs"]
 
@@ -51,6 +53,9 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
                    help="centroid method: window refinement (default), weighted, or binary mask")
     p.add_argument("--strict", action="store_true", help="a wrong ball count is an error, not a warning")
     p.add_argument("--workers", type=int, default=2, help="videos tracked in parallel (default 2)")
+    p.add_argument("--allow-truncated", action="store_true",
+                   help="track the complete frames of a truncated .cine instead of refusing it")
+    p.add_argument("--force", action="store_true", help="accept conditions outside their plausible ranges")
 
 
 def collect_inputs(inputs: list[str], speed_rpm: float | None) -> list[LabEntry]:
@@ -92,6 +97,9 @@ def _track_one(job: tuple[Path, OperatingConditions, Bearing, Any, Path]) -> tup
         res = track_video(video, conditions, bearing, options, out_dir=out, progress=False)
     except CagelessError as exc:
         return "failed", str(exc)
+    except Exception as exc:  # noqa: BLE001 - one video's surprise must not stop the others
+        log.debug("tracking %s failed", video, exc_info=True)
+        return "failed", f"unexpected {type(exc).__name__}: {exc} (run with -v --workers 1 for the traceback)"
     tr = res.trace
     unloaded = np.sin(tr.angle) > 0
     return "ok", {"path": str(res.path), "frames": tr.n_samples, "balls": tr.n_balls,
@@ -106,11 +114,24 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
 
     if args.window < 3 or args.window % 2 == 0:
         raise UsageError(f"--window {args.window}: must be an odd number of frames >= 3.")
+    _validate(args)
     bearing = bearing_from_config(config)
     options = TrackOptions(detector=replace(DetectorParams(), method=args.detector), window=args.window,
-                           strict=args.strict, fps=args.fps)
-    entries = collect_inputs(args.inputs, args.speed_rpm)
+                           strict=args.strict, fps=args.fps, allow_truncated=args.allow_truncated)
+    entries = [plausible_entry(e, args.force) for e in collect_inputs(args.inputs, args.speed_rpm)]
     out = Path(args.out)
+    with output_lock(out):
+        clean_stale_parts(out)
+        return _run_locked(args, entries, bearing, options, out)
+
+
+def _validate(args: argparse.Namespace) -> None:
+    """Numbers in range and the output folder usable, before any work."""
+    check_options(args, ("speed_rpm", "fps", "window", "workers"))
+    check_output_dir(args.out, "-o")
+
+
+def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bearing, options: Any, out: Path) -> int:
     failed = 0
     for e in entries:
         if not e.ok:

@@ -29,7 +29,7 @@ __all__ = [
 VIDEO_SUFFIXES = {".cine": CineReader, ".avi": OpenCVReader, ".mp4": OpenCVReader, ".mkv": OpenCVReader}
 
 
-def open_video(path: str | Path, fps: float | None = None) -> FrameSource:
+def open_video(path: str | Path, fps: float | None = None, allow_truncated: bool = False) -> FrameSource:
     """Open a video lazily with the reader its path calls for.
 
     Parameters
@@ -38,6 +38,8 @@ def open_video(path: str | Path, fps: float | None = None) -> FrameSource:
         A ``.cine``, ``.avi``, ``.mp4`` or ``.mkv`` file, or a folder of numbered images.
     fps
         Frame-rate override (frames/s), for files without (or with wrong) timing.
+    allow_truncated
+        Read the complete frames of a truncated ``.cine`` instead of refusing it.
 
     Returns
     -------
@@ -58,4 +60,6 @@ def open_video(path: str | Path, fps: float | None = None) -> FrameSource:
     if reader is None:
         raise VideoError(path, f"is not a video cageless reads (suffix '{path.suffix}').",
                          hint="Use .cine, .avi, .mp4, .mkv, or a folder of numbered .tif/.png images.")
+    if allow_truncated and reader is CineReader:
+        return CineReader(path, fps=fps, allow_truncated=True)
     return reader(path, fps=fps)

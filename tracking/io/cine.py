@@ -151,6 +151,13 @@ class CineReader(FrameSource):
             self._dtype = np.dtype(np.uint8 if b["bi_bit_count"] == 8 else "<u2")
             self._image_size = n * self._dtype.itemsize
             self._bit_depth = int(s.get("real_bpp") or b["bi_bit_count"])
+            # The cine format's SETUP.RealBPP is 8 on 8-bit cameras and 8..14 on 14-bit ones, stored in
+            # 16-bit words above 8 (Vision Research's SETUP definition); anything else is a corrupt header.
+            if not 8 <= self._bit_depth <= b["bi_bit_count"]:
+                raise VideoError(self.path, f"declares {self._bit_depth} significant bits per pixel (RealBPP) in "
+                                 f"{b['bi_bit_count']}-bit words; a cine holds 8 to {b['bi_bit_count']}.",
+                                 offset=self.header["off_setup"] + SETUP_FIELDS["real_bpp"][0],
+                                 hint="The header is corrupt: re-export the cine.")
             self._storage = f"{b['bi_bit_count']}-bit words"
         else:
             raise VideoError(self.path, f"has an unsupported pixel format (biCompression = {comp}, "
@@ -202,7 +209,7 @@ class CineReader(FrameSource):
             if not allow_truncated or complete == 0:
                 raise VideoError(self.path, f"is truncated: frame {complete} of {n} starts at or runs past the end of "
                                  f"the file ({self._size} bytes).", offset=bad,
-                                 hint="Re-copy the file; to read the complete frames pass allow_truncated=True.")
+                                 hint="Re-copy the file, or re-run with --allow-truncated to use the complete frames.")
         self._data_start = data_start[:complete]
         self._n = complete
 

@@ -66,8 +66,44 @@ class ImageSequenceReader(FrameSource):
             height=first.shape[0], dtype=first.dtype.name, bit_depth=8 * first.dtype.itemsize,
             storage=f"{self._files[0].suffix.lstrip('.')} images, {8 * first.dtype.itemsize}-bit",
         )
+        self._check_numbering(has_times=self._times_count() == len(self._files))
         stamps = self._read_times_file()
         self._apply_timing(fps, stamps)
+
+    def _check_numbering(self, has_times: bool) -> None:
+        """Refuse a stray image (another name pattern), a repeated number, or a gap in the numbers.
+
+        A gap is allowed when ``times.csv`` gives each image's time (then the times carry the gap).
+        A stray or missing image is named, not reported as a count mismatch with ``times.csv``.
+        """
+        def pattern(p: Path) -> str:
+            return _NUMBER.sub("#", p.stem) + p.suffix.lower()
+
+        patterns = [pattern(p) for p in self._files]
+        common = max(set(patterns), key=patterns.count)
+        stray = [p for p, pat in zip(self._files, patterns, strict=True) if pat != common]
+        if stray:
+            raise VideoError(stray[0], f"does not belong to the sequence of {len(self._files) - len(stray)} images "
+                             f"named like {self._files[patterns.index(common)].name}.",
+                             hint="Move it out of the folder.")
+        numbers = [int(_NUMBER.search(p.stem).group(1)) for p in self._files]  # type: ignore[union-attr]
+        for a, b, pa, pb in zip(numbers, numbers[1:], self._files, self._files[1:]):
+            if b == a:
+                raise VideoError(pb, f"repeats frame number {b} of {pa.name}.", hint="Remove one of them.")
+            if b != a + 1 and not has_times:
+                width = len(_NUMBER.search(pa.stem).group(1))  # type: ignore[union-attr]
+                missing = _NUMBER.sub(f"{a + 1:0{width}d}", pa.stem) + pa.suffix
+                raise VideoError(self.path / missing, f"is missing: the frame numbers jump from {a} ({pa.name}) to "
+                                 f"{b} ({pb.name}).", hint="Restore the frame, or give each image's time in "
+                                 f"{TIMES_FILE} beside them.")
+
+    def _times_count(self) -> int | None:
+        """Number of times listed in ``times.csv`` (None without one)."""
+        try:
+            lines = (self.path / TIMES_FILE).read_text().splitlines()
+        except OSError:
+            return None
+        return sum(1 for line in lines[1:] if line.strip())
 
     def _read_times_file(self) -> npt.NDArray[np.float64] | None:
         p = self.path / TIMES_FILE

@@ -1,0 +1,103 @@
+"""The catalogue's rows about the report cache and its re-runs (issue 17).
+
+Each test copies a finished report of a one-video lab and re-runs on the copy, in-process (the jobs run
+in a thread), so a case costs the verification, at most one redone job, and the report writing.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+import pandas as pd
+from faultlib import QUICK_REPORT, assert_clean, cli, flip_bits, parts
+
+from cageless.lab import CACHE_NAME
+
+
+def _copy(report_template, tmp_path, name="report"):
+    out = tmp_path / name
+    shutil.copytree(report_template, out)
+    return out
+
+
+def _skipped(text: str) -> int:
+    return int(text.split("; ")[-1].split(" jobs unchanged")[0])
+
+
+def test_r10_cache_paths_are_relative_to_the_output_folder(report_template, tmp_path, capsys, mini_lab,
+                                                           in_process_pool):
+    cache = json.loads((report_template / CACHE_NAME).read_text())
+    paths = [job["path"] for job in cache["jobs"].values()]
+    assert sorted(paths) == ["simulations/n3000_Fr500_Fa0.sim.trace.h5", "traces/clip_3000rpm.trace.h5"]
+    # a copied (renamed) report folder reads its own files: damage the original's, the copy still skips
+    out = _copy(report_template, tmp_path, "renamed")
+    run = cli(capsys, "report", mini_lab, "-o", out, *QUICK_REPORT)
+    assert_clean(run, 0, f"{out}/report.html")
+    assert _skipped(run.out) == 2
+    assert str(report_template) not in (out / CACHE_NAME).read_text()
+
+
+def test_r11_deleted_qc_outputs_are_restored(report_template, tmp_path, capsys, mini_lab, in_process_pool):
+    out = _copy(report_template, tmp_path)
+    qc = out / "traces" / "qc"
+    removed = sorted(p.name for p in qc.glob("clip_3000rpm.frame*.png"))
+    assert removed
+    for name in removed:
+        (qc / name).unlink()
+    run = cli(capsys, "report", mini_lab, "-o", out, *QUICK_REPORT)
+    assert_clean(run, 0)
+    assert _skipped(run.out) == 1  # the simulation only; tracking was redone
+    assert sorted(p.name for p in qc.glob("clip_3000rpm.frame*.png")) == removed
+
+
+def test_r12_a_corrupt_cached_video_trace_is_redone(report_template, tmp_path, capsys, mini_lab, in_process_pool):
+    out = _copy(report_template, tmp_path)
+    trace = out / "traces" / "clip_3000rpm.trace.h5"
+    flip_bits(trace)
+    run = cli(capsys, "report", mini_lab, "-o", out, *QUICK_REPORT)
+    assert_clean(run, 0)
+    assert _skipped(run.out) == 1
+    table = pd.read_csv(out / "slip_table.csv")
+    assert list(table.status) == ["ok"]
+    from cageless.trace import read_trace
+
+    read_trace(trace)  # whole again
+
+
+def test_r27_a_corrupt_cached_simulation_is_redone(report_template, tmp_path, capsys, mini_lab, in_process_pool):
+    out = _copy(report_template, tmp_path)
+    sim = out / "simulations" / "n3000_Fr500_Fa0.sim.trace.h5"
+    flip_bits(sim)
+    run = cli(capsys, "report", mini_lab, "-o", out, *QUICK_REPORT)
+    assert_clean(run, 0)
+    assert _skipped(run.out) == 1
+    assert list(pd.read_csv(out / "slip_table.csv").status) == ["ok"] and not parts(out)
+
+
+def test_r27_a_truncated_cached_simulation_is_redone(report_template, tmp_path, capsys, mini_lab, in_process_pool):
+    out = _copy(report_template, tmp_path)
+    sim = out / "simulations" / "n3000_Fr500_Fa0.sim.trace.h5"
+    sim.write_bytes(sim.read_bytes()[:1000])
+    run = cli(capsys, "report", mini_lab, "-o", out, *QUICK_REPORT)
+    assert_clean(run, 0)
+    assert _skipped(run.out) == 1
+
+
+def test_r10_an_old_or_damaged_cache_file_redoes_everything(report_template, tmp_path, capsys, mini_lab,
+                                                           in_process_pool):
+    out = _copy(report_template, tmp_path)
+    (out / CACHE_NAME).write_text('{"abc": "repA/traces/x.h5"}')  # the old, cwd-relative format
+    run = cli(capsys, "report", mini_lab, "-o", out, *QUICK_REPORT)
+    assert_clean(run, 0)
+    assert _skipped(run.out) == 0
+
+
+def test_r15_impossible_sidecar_speed_is_a_failed_row(tmp_path, capsys, mini_lab, in_process_pool):
+    lab = tmp_path / "lab"
+    shutil.copytree(mini_lab, lab)
+    (lab / "clip_3000rpm.toml").write_text("speed_rpm = 1e12\n")
+    run = cli(capsys, "report", lab, "-o", tmp_path / "out", *QUICK_REPORT)
+    assert_clean(run, 1, "clip_3000rpm", "'speed_rpm' = 1e+12", "plausible range", "sidecar clip_3000rpm.toml")
+    table = pd.read_csv(tmp_path / "out" / "slip_table.csv")
+    assert list(table.status) == ["failed"]  # never a "complete" 100 % slip
