@@ -110,7 +110,7 @@ def accuracy_study(rpm: float = 3000.0, load_n: float = 500.0, window_s: float =
     measured against the reference over that shorter window.
     """
     pr, cage = _settled_problem(rpm, load_n, settle_s)
-    z = int(pr.params[P.P_Z])
+    z = pr.n_balls
     radius = float(np.mean(pr.y0[:z]))
     t = np.linspace(0.0, window_s, 51)
     ref = solve(pr, t, rtol=1e-10, max_step=2.5e-7)
@@ -220,7 +220,7 @@ def model_study(window_s: float = 0.005, settle_s: float = 0.03, repeats: int = 
             rtol = 1e-6 * RTOL_FACTOR.get(method, 1.0)
             sol, wall = _best_wall(lambda pr=pr, method=method, cap=cap, rtol=rtol: solve(
                 pr, t, method=method, rtol=rtol, max_step=cap), repeats)
-            z = int(pr.params[P.P_Z])
+            z = pr.n_balls
             slip_pp, pos_um = _errors(sol.y[:, :5 * z + 6], ref.y[:, :5 * z + 6], z, cage, float(np.mean(pr.y0[:z])))
             label = lvl if lvl == "planar" else f"spatial, m = {m}"
             if method != "dp5":

@@ -48,7 +48,6 @@ import numpy.typing as npt
 from tqdm.auto import tqdm
 
 from simulation.kernels import PLANAR, SPATIAL
-from simulation.models.planar import P_DRY
 from simulation.problem import Problem
 from simulation.solve import CvodeSession, Solution, solve, step_cvode
 
@@ -127,8 +126,7 @@ def _probe(part: Problem, t: npt.NDArray[np.float64], sol: Solution, time_s: flo
 
 def _may_switch(pr: Problem) -> bool:
     """Whether the automatic switch may take ``pr`` to the stiff backend (see :data:`SWITCH_WHEN_DRY`)."""
-    dry = pr.model_id in (PLANAR, SPATIAL) and pr.params[P_DRY] > 0.5
-    return SWITCH_WHEN_DRY or not dry
+    return SWITCH_WHEN_DRY or "dry_friction" not in pr.effects
 
 
 def default_max_step(method: str) -> float:

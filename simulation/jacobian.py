@@ -131,7 +131,7 @@ class JacobianStructure:
         """The structure of ``problem``'s model, or None for a model without one (the test models)."""
         if problem.model_id not in (PLANAR, SPATIAL):
             return None
-        z = int(problem.params[planar.P_Z])
+        z = problem.n_balls
         n = len(problem.y0)
         if problem.model_id == PLANAR:
             fields = [list(range(f * z, (f + 1) * z)) for f in range(5)]

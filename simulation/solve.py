@@ -40,8 +40,7 @@ from scipy.integrate import BDF, DOP853, LSODA, RK45, Radau
 from cageless.errors import ParameterError, suggest
 from simulation.integrators.dp5 import STATUS_OK, dp5_integrate
 from simulation.jacobian import JacobianStructure
-from simulation.kernels import PLANAR, SPATIAL, model_gaps, model_post, model_rhs
-from simulation.models.planar import P_Z
+from simulation.kernels import model_gaps, model_post, model_rhs
 from simulation.problem import Problem
 
 __all__ = ["FORCE_JUMP", "Problem", "Solution", "METHODS", "CvodeSession", "solve", "step_scipy", "step_cvode"]
@@ -264,9 +263,9 @@ class CvodeSession:
             model_rhs(session.model_id, t, buf, session.params, session.aux, yp)
 
         options = _jacobian_options(pr, session, jacobian, rtol)
-        if pr.onset_step > 0 and pr.model_id in (PLANAR, SPATIAL):  # contact changes are counted either way
+        if pr.onset_step > 0 and pr.n_gaps > 0:  # contact changes are counted either way
             session.onset_step, session.onset_control = pr.onset_step, onset_control
-            session.gaps = np.empty(3 * int(pr.params[P_Z]))
+            session.gaps = np.empty(pr.n_gaps)
             model_gaps(pr.model_id, session.state, pr.params, session.gaps)
             session.gaps_before = session.gaps.copy()
         with warnings.catch_warnings():  # sparsity with a jacfn: scikit-sundae notes its own routine is unused

@@ -46,9 +46,15 @@ from cageless.bearing import Bearing
 from cageless.errors import ParameterError
 from simulation.forces import FASTMATH, damping_factor, hertz_damped, hertz_impact_duration
 from simulation.hertz import ball_ball_contact, compliance, hertz_contact, race_curvatures
+from simulation.effects import check_lubricant, effect_flags
 from simulation.parameters import ModelParameters
 from simulation.problem import Problem
-from simulation.traction import dry_friction, regression_traction
+from simulation.models.base import (LAYOUT, N_PARAMS, P_CD, P_CHI, P_CHO, P_D, P_DI, P_DO, P_DRY,
+                                    P_ETA0, P_F_BB, P_F_BBFILM, P_F_DRAG, P_F_FILM, P_F_GRAV, P_F_LUB, P_F_RACE,
+                                    P_F_TRAC, P_FR, P_G, P_H0, P_I, P_KB, P_KI, P_KO, P_M, P_MR, P_MU_DRY,
+                                    P_MU_STATIC, P_RAMP, P_RHO_MIX, P_TA, P_TB, P_TC, P_TD, P_U_FLOOR, P_V_IN_MIN,
+                                    P_V_REG, P_V_STRIBECK, P_WI, P_Z)
+from simulation.models.contact_laws import tangential
 
 __all__ = [
     "PlanarLayout", "planar_problem", "planar_energy", "packed_start", "contact_events", "DEFAULT_CHO_N_S_M",
@@ -57,15 +63,6 @@ __all__ = [
 
 #: Id of this model in :mod:`simulation.kernels`.
 MODEL_ID = 0
-
-# Parameter vector layout.
-P_Z, P_D, P_M, P_I, P_MR, P_DI, P_DO, P_KI, P_KO, P_KB, P_CHI, P_G, P_FR, P_WI = range(14)
-P_F_RACE, P_F_BB, P_F_GRAV, P_F_LUB, P_CHO = 14, 15, 16, 17, 18
-P_F_TRAC, P_F_FILM, P_F_BBFILM, P_F_DRAG, P_DRY = 19, 20, 21, 22, 23
-P_ETA0, P_H0, P_TA, P_TB, P_TC, P_TD = range(24, 30)
-P_MU_DRY, P_V_REG, P_CD, P_RHO_MIX, P_RAMP, P_U_FLOOR, P_V_IN_MIN = range(30, 37)
-P_MU_STATIC, P_V_STRIBECK = 37, 38
-N_PARAMS = 39
 
 #: Lubricant damping coefficient at the race contacts (N s/m): the middle of the paper's 2500-7500 range.
 DEFAULT_CHO_N_S_M = ModelParameters().cho_n_s_m
@@ -90,14 +87,6 @@ class PlanarLayout:
                 "input_work": slice(5 * z + 4, 5 * z + 5), "dissipated": slice(5 * z + 5, 5 * z + 6)}
 
 
-@numba.njit(cache=True, inline="always")
-def _tangential(u_s, u_r, q, p):  # pragma: no cover - compiled
-    """Signed tangential force (N) at a contact sliding at u_s: lubricated traction, or dry friction."""
-    if p[P_DRY] > 0.5:
-        return dry_friction(u_s, q, p[P_MU_DRY], p[P_V_REG], p[P_MU_STATIC], p[P_V_STRIBECK])
-    return regression_traction(u_s, u_r, q, p[P_TA], p[P_TB], p[P_TC], p[P_TD], p[P_U_FLOOR])
-
-
 @numba.njit(cache=True, fastmath=FASTMATH)
 def _race_forces(y, p, j, z, w_i, c, s):  # pragma: no cover - compiled
     """Race forces on ball j: (f_y, f_z, spin torque, ring f_y, ring f_z, input power, dissipated power)."""
@@ -118,7 +107,7 @@ def _race_forces(y, p, j, z, w_i, c, s):  # pragma: no cover - compiled
         if trac:
             u = r * thd + half * om  # ball surface against the fixed outer race, along e_theta
             u_r = 0.5 * abs(r * thd + half * om - p[P_DO] * thd)
-            f_t = -_tangential(u, u_r, q, p)
+            f_t = -tangential(u, u_r, q, p)
             p_diss -= f_t * u
             torque += half * f_t
         fy += -q * c - f_t * s
@@ -143,7 +132,7 @@ def _race_forces(y, p, j, z, w_i, c, s):  # pragma: no cover - compiled
             vt = vx * tx + vz * tz
             u = vt - half * om - w_i * r_i  # ball surface against the ring surface, along t
             u_r = 0.5 * abs(vt * (1.0 - 2.0 * r_i / ln) - half * om + w_i * r_i)
-            f_t = -_tangential(u, u_r, q, p)
+            f_t = -tangential(u, u_r, q, p)
             p_diss -= f_t * u
             p_in += w_i * r_i * f_t
             torque -= half * f_t
@@ -191,7 +180,7 @@ def _pair_forces(y, p, aux, j, k, z, cj, sj, ck, sk):  # pragma: no cover - comp
         om_j, om_k = y[4 * z + j], y[4 * z + k]
         u = (vjx - vkx) * tx + (vjz - vkz) * tz + 0.5 * d * (om_j + om_k)  # surface of j against k, along t
         u_r = 0.25 * d * abs(om_j - om_k)
-        f_t = -_tangential(u, u_r, f, p)  # on j, along t
+        f_t = -tangential(u, u_r, f, p)  # on j, along t
         p_diss -= f_t * u
         torque = 0.5 * d * f_t
         return f * nx - f_t * tx, f * nz - f_t * tz, torque, p_diss
@@ -408,50 +397,48 @@ def planar_post(t, y, p, aux):  # pragma: no cover - compiled
             aux[slot] = np.nan
 
 
-def _contact_params(bearing: Bearing, p: npt.NDArray[np.float64]) -> None:
-    """Hertz stiffnesses of the inner, outer and ball-ball contacts."""
+def _contact_params(bearing: Bearing) -> dict[str, float]:
+    """Hertz stiffnesses of the inner, outer and ball-ball contacts, and the lubricant's viscosity."""
     g, mat = bearing.geometry, bearing.material
     eta = compliance(mat)
     rc = race_curvatures(g)
-    p[P_KI] = hertz_contact(*rc["inner"], eta).stiffness
-    p[P_KO] = hertz_contact(*rc["outer"], eta).stiffness
-    p[P_KB] = ball_ball_contact(g, mat).stiffness
+    out = {"KI": hertz_contact(*rc["inner"], eta).stiffness, "KO": hertz_contact(*rc["outer"], eta).stiffness,
+           "KB": ball_ball_contact(g, mat).stiffness}
     if bearing.lubricant is not None:
-        p[P_ETA0] = bearing.lubricant.dynamic_viscosity_pa_s
+        out["ETA0"] = bearing.lubricant.dynamic_viscosity_pa_s
+    return out
 
 
 def _params(bearing: Bearing, radial_load_n: float, gravity_m_s2: float, inner_speed: float,
             effects: dict[str, bool], par: ModelParameters, speed_ramp_s: float,
             oil_air_density_kg_m3: float | None) -> npt.NDArray[np.float64]:
+    """The parameter vector: the named slots of :data:`LAYOUT` filled from the bearing, the scene and ``par``;
+    the effect flags from ``effects`` alone (an effect it does not name is off)."""
     g, masses = bearing.geometry, bearing.masses
-    p = np.zeros(N_PARAMS)
-    p[P_Z], p[P_D], p[P_M] = g.n_balls, g.ball_diameter_m, masses.ball_mass_kg
-    p[P_I] = 0.1 * masses.ball_mass_kg * g.ball_diameter_m**2
-    p[P_MR] = masses.ring_translational_mass_kg
-    p[P_DI], p[P_DO] = g.inner_race_diameter_m, g.outer_race_diameter_m
-    _contact_params(bearing, p)
-    p[P_CHI] = damping_factor(par.restitution)
-    p[P_G], p[P_FR], p[P_WI], p[P_RAMP] = gravity_m_s2, radial_load_n, inner_speed, speed_ramp_s
     lubricated = bearing.lubricant is not None
-    flags = {P_F_RACE: ("race_contact", True), P_F_BB: ("ball_ball_contact", True), P_F_GRAV: ("gravity", True),
-             P_F_LUB: ("lubricant_damping", lubricated), P_F_TRAC: ("race_traction", False),
-             P_F_FILM: ("ehl_film", False), P_F_BBFILM: ("ball_ball_film", False), P_F_DRAG: ("drag", False)}
-    for slot, (name, default) in flags.items():
-        p[slot] = float(effects.get(name, default))
-    if not lubricated and (p[P_F_LUB] or p[P_F_FILM] or p[P_F_BBFILM]):
-        raise ParameterError("effects", "a lubricant effect is on but the bearing has no lubricant")
-    p[P_CHO], p[P_H0] = par.cho_n_s_m, par.film_thickness_m
-    p[P_TA], p[P_TB], p[P_TC], p[P_TD] = par.traction_coefficients
-    p[P_V_REG], p[P_U_FLOOR], p[P_CD] = par.slip_regularisation_m_s, par.min_entrainment_m_s, par.drag_coefficient
-    p[P_V_IN_MIN] = par.min_approach_speed_m_s
-    if p[P_F_TRAC] and not lubricated:
+    check_lubricant(effects, lubricated)
+    p = LAYOUT.zeros()
+    LAYOUT.fill(p, {"Z": g.n_balls, "D": g.ball_diameter_m, "M": masses.ball_mass_kg,
+                    "I": 0.1 * masses.ball_mass_kg * g.ball_diameter_m**2, "MR": masses.ring_translational_mass_kg,
+                    "DI": g.inner_race_diameter_m, "DO": g.outer_race_diameter_m})
+    LAYOUT.fill(p, _contact_params(bearing))
+    LAYOUT.fill(p, {"CHI": damping_factor(par.restitution), "G": gravity_m_s2, "FR": radial_load_n,
+                    "WI": inner_speed, "RAMP": speed_ramp_s})
+    LAYOUT.fill(p, effect_flags(effects))
+    ta, tb, tc, td = par.traction_coefficients
+    LAYOUT.fill(p, {"CHO": par.cho_n_s_m, "H0": par.film_thickness_m, "TA": ta, "TB": tb, "TC": tc, "TD": td,
+                    "V_REG": par.slip_regularisation_m_s, "U_FLOOR": par.min_entrainment_m_s,
+                    "CD": par.drag_coefficient, "V_IN_MIN": par.min_approach_speed_m_s})
+    if p[P_DRY] and p[P_F_TRAC]:
         if par.dry_friction_coefficient is None:
             raise ParameterError("dry_friction_coefficient", "a dry scene needs the Coulomb friction of the bare "
                                  "steel contacts, which has no cited default: give it with "
                                  "--set dry_friction_coefficient=VALUE (or add a lubricant)")
-        p[P_DRY], p[P_MU_DRY] = 1.0, par.dry_friction_coefficient
-        p[P_MU_STATIC] = par.dry_static_coefficient or par.dry_friction_coefficient
-        p[P_V_STRIBECK] = par.stribeck_speed_m_s
+        LAYOUT.fill(p, {"MU_DRY": par.dry_friction_coefficient,
+                        "MU_STATIC": par.dry_static_coefficient or par.dry_friction_coefficient,
+                        "V_STRIBECK": par.stribeck_speed_m_s})
+    else:
+        p[P_DRY] = 0.0  # no friction law is evaluated: nothing to switch
     if p[P_F_DRAG]:
         if oil_air_density_kg_m3 is None:
             raise ParameterError("oil_air_density_kg_m3", "drag is on but no oil-air mixture density is given")
@@ -468,8 +455,8 @@ def planar_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLi
                    oil_air_density_kg_m3: float | None = None, spin0: npt.ArrayLike | None = None) -> Problem:
     """The planar model from a given state, as a :class:`~simulation.solve.Problem`.
 
-    Effects missing from ``effects`` take their defaults: contacts and gravity on, lubricant
-    damping on for a lubricated bearing, and traction, films and drag off. ``parameters`` holds
+    ``effects`` (name -> on, names of :data:`simulation.effects.EFFECTS`) says which effects are on; an
+    effect it does not name is off (:func:`simulation.effects.choose_model` gives a scene's choice). ``parameters`` holds
     the open model parameters; ``restitution`` and ``cho_n_s_m``, when given, replace theirs.
     The absolute tolerances (0.1 nm on positions, 0.1 um/s on speeds) are multiplied by ``atol_scale``;
     contact overlaps are micrometres, so energy-level checks want a smaller scale.
@@ -507,8 +494,10 @@ def planar_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLi
     aux[g.n_balls + 3:5 * g.n_balls:4] = 0.0
     # An impact at 1 m/s approach lasts t_H; contact onsets are resolved to t_H / ONSET_RESOLUTION.
     onset = hertz_impact_duration(1.0, 0.5 * p[P_M], p[P_KB]) / ONSET_RESOLUTION
+    on = frozenset(name for name, value in (effects or {}).items() if value)
     return Problem(model_id=MODEL_ID, params=p, aux=aux, y0=y0, t0=0.0, atol=atol, name="planar cageless bearing",
-                   onset_step=onset, jump_floor=planar_jump_floor(p, lay))
+                   onset_step=onset, jump_floor=planar_jump_floor(p, lay), layout=LAYOUT, effects=on,
+                   n_balls=g.n_balls, n_gaps=3 * g.n_balls)
 
 
 def planar_jump_floor(p: npt.NDArray[np.float64], lay: PlanarLayout) -> npt.NDArray[np.float64]:

@@ -24,7 +24,7 @@ def settled():
 
 def test_cvode_follows_a_tight_reference_through_impacts(settled):
     pr, cage = settled
-    z = int(pr.params[P.P_Z])
+    z = pr.n_balls
     t = np.linspace(0.0, 0.005, 51)
     ref = solve(pr, t, rtol=1e-10, max_step=2.5e-7)
     sol = solve(pr, t, method="CVODE", rtol=1e-6, max_step=2e-6)
@@ -43,7 +43,7 @@ def test_a_run_in_chunks_keeps_one_warm_integrator(settled):
     from simulation.chunks import solve_chunks
 
     pr, cage = settled
-    z = int(pr.params[P.P_Z])
+    z = pr.n_balls
     t = np.linspace(0.0, 0.005, 51)
     one = solve(pr, t, method="CVODE", rtol=3e-8, max_step=5e-6)
     # rtol x 0.03 and the 5 us cap
