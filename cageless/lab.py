@@ -92,20 +92,19 @@ def _track_job(video: str, conditions: OperatingConditions, bearing: Bearing, ou
 
 def _simulate_job(conditions: OperatingConditions, bearing: Bearing, duration_s: float, parameters: dict[str, float],
                   rtol: float, out: str) -> tuple[str, str]:
-    from simulation.effects import choose_model
     from simulation.parameters import ModelParameters
-    from simulation.run import simulate
     from simulation.scene import Scene
+    from simulation.simulation import Choices, Simulation
 
     try:
         scene = Scene(conditions=OperatingConditions(conditions.speed_rpm, conditions.radial_load_n,
                                                      conditions.axial_load_n), bearing=bearing, duration_s=duration_s)
-        res = simulate(scene, choose_model(scene), parameters=ModelParameters().with_overrides(parameters), rtol=rtol,
-                       out=out, progress=False, config={"command": "report"})
+        sim = Simulation(scene, ModelParameters().with_overrides(parameters), Choices(rtol=rtol))
+        trace = sim.run(out=out, config={"command": "report"})
     except CagelessError as exc:
         return "failed", str(exc)
-    if not res.solution.success:
-        return "failed", f"the simulation stopped early: {res.trace.status}"
+    if not sim.solution.success:
+        return "failed", f"the simulation stopped early: {trace.status}"
     return "ok", out
 
 

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import math
-import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -18,11 +17,10 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from cageless.errors import ParameterError, UsageError, suggest
+from cageless.errors import UsageError
 from cageless.kinematics import slip_rate, theoretical_cage_speed
 from cageless.profiles import angle_profile
-from cageless.provenance import Provenance
-from cageless.trace import SimulationInfo, Trace, write_trace
+from cageless.trace import SimulationInfo, Trace
 from simulation.effects import ModelChoice
 from simulation.hertz import compliance, hertz_contact, race_curvatures
 from simulation.models import planar as P
@@ -32,11 +30,10 @@ from simulation.parameters import ModelParameters
 from simulation.quasistatic import radial_load_distribution
 from simulation.scene import Scene
 from simulation.problem import Problem
-from simulation.chunks import CONTACT_MAX_STEP_S, MAX_STEP_S, RTOL_FACTOR, solve_chunks
-from simulation.solve import FORCE_JUMP, METHODS, Solution
+from simulation.solve import FORCE_JUMP, Solution
 
 __all__ = ["SimulationResult", "EnergyBalance", "build_problem", "check_supported", "energy_balance", "initial_state",
-           "simulate",
+           "simulate", "to_trace",
            "peak_unloaded_slip",
            "UNLOADED_ZONE_DEG"]
 
@@ -155,51 +152,23 @@ def simulate(scene: Scene, choice: ModelChoice, parameters: ModelParameters | No
              sample_rate_hz: float = 10_000.0, method: str = "auto", max_step: float | None = None,
              out: str | Path | None = None, progress: bool = True, config: dict[str, Any] | None = None,
              max_steps: int = 50_000_000, force_jump: float = FORCE_JUMP) -> SimulationResult:
-    """Run ``scene`` with the model ``choice`` and (with ``out``) write the trace atomically.
-
-    ``method`` is ``"auto"`` (compiled DP5, switching to a stiff solver when that pays: see
-    :mod:`simulation.chunks`) or a key of :data:`simulation.solve.METHODS`. ``max_step`` (s) caps every
-    step; None gives each method its default (:func:`simulation.chunks.default_max_step`: 2 us, 5 us
-    for CVODE, also after an automatic switch); CVODE runs at ``rtol x 0.03`` to match DP5's accuracy
-    (:data:`simulation.chunks.RTOL_FACTOR`). ``max_steps`` bounds the
-    accepted plus rejected steps of the whole run; ``force_jump`` is the force-jump fraction of
-    :func:`simulation.solve.solve`.
+    """Run ``scene`` with the model ``choice``: :class:`simulation.simulation.Simulation` with these settings
+    (see :class:`~simulation.simulation.Choices` for them), its solution, trace and problem together.
 
     A solver failure does not raise: the result's ``solution.success`` is False and the trace's
     ``status`` says ``"incomplete: <why>"``; samples after the failure are NaN.
     """
-    check_supported(scene, choice)
-    if method != "auto" and method not in METHODS:
-        raise ParameterError("method", "is not a solver" + (suggest(method, [*METHODS, "auto"]) or
-                                                            f"; use auto or one of {list(METHODS)}"), method)
-    if max_step is not None and not (0 < max_step < np.inf):
-        raise ParameterError("max_step", "must be a positive number of seconds, or None for the defaults", max_step)
-    par = parameters or ModelParameters()
-    prov = Provenance.start(config={"scene": scene.to_dict(), "model": json.loads(choice.to_json()),
-                                    "solver": {"method": method, "rtol": rtol, "max_step": max_step,
-                                               "default_max_step_s": {**MAX_STEP_S, "others": CONTACT_MAX_STEP_S},
-                                               "rtol_factor": RTOL_FACTOR,
-                                               "force_jump": force_jump},
-                                    "parameters": par.to_dict(), **(config or {})})
-    pr = build_problem(scene, choice, par)
-    t = np.arange(0.0, scene.duration_s + 0.5 / sample_rate_hz, 1.0 / sample_rate_hz)
-    start = time.perf_counter()
-    sol = solve_chunks(pr, t, rtol, method, max_step, min(50, len(t) - 1), progress, max_steps, force_jump)
-    wall = time.perf_counter() - start
-    provenance = prov.finish().to_dict()
-    provenance["solver_stats"] = {"n_steps": sol.n_steps, "n_rejected": sol.n_rejected, "n_rhs": sol.n_rhs,
-                                  "n_onset_retries": sol.n_onset_retries, "n_contact_changes": sol.n_contact_changes,
-                                  "n_force_jump_retries": sol.n_force_jump_retries,
-                                  "n_stiff_steps": sol.n_stiff_steps, "method": sol.method,
-                                  "switch_probes": sol.extra.get("switches", []),
-                                  "onset_step_s": pr.onset_step, "wall_s": wall}
-    trace = _to_trace(scene, choice, pr, sol, rtol, wall, provenance)
-    if out is not None:
-        write_trace(out, trace)
-    return SimulationResult(solution=sol, trace=trace, problem=pr)
+    from simulation.simulation import Choices, Simulation
+
+    sim = Simulation(scene, parameters, Choices(method=method, rtol=rtol, max_step=max_step,
+                                                sample_rate_hz=sample_rate_hz, max_steps=max_steps,
+                                                force_jump=force_jump), model=choice)
+    trace = sim.run(out=out, progress=progress, config=config)
+    assert sim.solution is not None and sim.problem is not None
+    return SimulationResult(solution=sim.solution, trace=trace, problem=sim.problem)
 
 
-def _to_trace(scene: Scene, choice: ModelChoice, pr: Problem, sol: Solution, rtol: float, wall: float,
+def to_trace(scene: Scene, choice: ModelChoice, pr: Problem, sol: Solution, rtol: float, wall: float,
               provenance: dict[str, Any]) -> Trace:
     g = scene.bearing.geometry
     z = g.n_balls

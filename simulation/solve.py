@@ -8,7 +8,7 @@
 * ``"CVODE"``: SUNDIALS CVODE's variable-order BDF (orders 1-5, Newton iteration) through
   scikit-sundae, on the compiled right-hand side, with the structured Jacobian of
   :mod:`simulation.jacobian` (see :data:`JACOBIANS`): the stiff backend the automatic switch of
-  :mod:`simulation.chunks` goes to. Its loop is compiled C, so a step costs the right-hand-side calls
+  :mod:`simulation.auto_switch` goes to. Its loop is compiled C, so a step costs the right-hand-side calls
   plus 17 us (planar) to 30 us (spatial) of Python and dense linear algebra;
 * ``"RK45"``, ``"DOP853"``, ``"LSODA"``, ``"BDF"``, ``"Radau"``: scipy's ``solve_ivp`` steppers on the
   same compiled right-hand side, as references; the implicit ones get the structured Jacobian too.

@@ -120,20 +120,21 @@ def _run(args: argparse.Namespace, scene: Any, choice: Any, config: dict[str, An
     if args.ensemble < 1:
         raise UsageError(f"--ensemble must be >= 1, got {args.ensemble}")
     out = args.out or f"sim_{args.speed_rpm:g}rpm_Fr{args.radial_load_n:g}.trace.h5"
-    kw = {"parameters": par, "rtol": args.rtol, "sample_rate_hz": args.sample_rate, "method": args.solver,
-          "max_step": args.max_step, "config": {"command": "simulate", "set": args.set_values}}
+    from simulation.simulation import Choices, Simulation
+
+    sim = Simulation(scene, par, Choices(method=args.solver, rtol=args.rtol, max_step=args.max_step,
+                                         sample_rate_hz=args.sample_rate), model=choice)
+    config = {"command": "simulate", "set": args.set_values}
     if args.scheduler and args.ensemble == 1:
         raise UsageError("--scheduler runs an ensemble on a Dask cluster: give --ensemble N as well")
     if args.ensemble == 1:
-        from simulation.run import simulate
-
-        res = simulate(scene, choice, out=out, progress=not args.quiet, **kw)
+        trace = sim.run(out=out, progress=not args.quiet, config=config)
         print(f"effects: {', '.join(choice.active)}")
-        print(_summary_line(res.trace, res.solution, out))
-        return 0 if res.solution.success else 1
+        print(_summary_line(trace, sim.solution, out))
+        return 0 if sim.solution.success else 1
     from simulation.ensemble import run_ensemble
 
-    rows = run_ensemble(scene, choice, args.ensemble, out, progress=not args.quiet, scheduler=args.scheduler, **kw)
+    rows = run_ensemble(sim, args.ensemble, out, progress=not args.quiet, scheduler=args.scheduler, config=config)
     print(f"effects: {', '.join(choice.active)}")
     for row in rows:
         print(f"seed {row['seed']}: {row['summary']}")

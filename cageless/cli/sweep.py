@@ -46,7 +46,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Run the sweep and print the summary."""
     from cageless.config import bearing_from_config
     from cageless.errors import UsageError
-    from cageless.sweep import parse_vary, run_sweep, summarise, write_sweep
+    from simulation.sweep import parse_vary, run_sweep, summarise, write_sweep
     from simulation.parameters import ModelParameters, parse_set_overrides
 
     if args.seeds < 1:

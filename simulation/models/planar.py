@@ -49,11 +49,9 @@ from simulation.hertz import ball_ball_contact, compliance, hertz_contact, race_
 from simulation.effects import check_lubricant, effect_flags
 from simulation.parameters import ModelParameters
 from simulation.problem import Problem
-from simulation.models.base import (LAYOUT, N_PARAMS, P_CD, P_CHI, P_CHO, P_D, P_DI, P_DO, P_DRY,
-                                    P_ETA0, P_F_BB, P_F_BBFILM, P_F_DRAG, P_F_FILM, P_F_GRAV, P_F_LUB, P_F_RACE,
-                                    P_F_TRAC, P_FR, P_G, P_H0, P_I, P_KB, P_KI, P_KO, P_M, P_MR, P_MU_DRY,
-                                    P_MU_STATIC, P_RAMP, P_RHO_MIX, P_TA, P_TB, P_TC, P_TD, P_U_FLOOR, P_V_IN_MIN,
-                                    P_V_REG, P_V_STRIBECK, P_WI, P_Z)
+from simulation.models.base import (LAYOUT, P_CD, P_CHI, P_CHO, P_D, P_DI, P_DO, P_DRY, P_ETA0, P_FR,
+                                    P_F_BB, P_F_BBFILM, P_F_DRAG, P_F_GRAV, P_F_LUB, P_F_RACE, P_F_TRAC, P_G, P_H0,
+                                    P_I, P_KB, P_KI, P_KO, P_M, P_MR, P_RAMP, P_RHO_MIX, P_V_IN_MIN, P_WI, P_Z)
 from simulation.models.contact_laws import tangential
 
 __all__ = [

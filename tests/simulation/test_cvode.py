@@ -40,7 +40,7 @@ def test_a_run_in_chunks_keeps_one_warm_integrator(settled):
     """In chunks, CVODE continues one integrator (simulation.solve.CvodeSession) instead of restarting cold
     at order 1 with a new Jacobian each time; measured over 20 ms at the spatial level, 50 cold restarts
     cost 35 % more right-hand-side calls (18506 against 13663), warm chunks 13657."""
-    from simulation.chunks import solve_chunks
+    from simulation.auto_switch import solve_chunks
 
     pr, cage = settled
     z = pr.n_balls

@@ -1,4 +1,4 @@
-"""``cageless sweep``: one scene over a parameter grid and seeds, locally or on Dask (DESIGN §10).
+"""One scene over a parameter grid and seeds, locally or on Dask (``cageless sweep``; DESIGN §10).
 
 This is the paper's lubrication sensitivity study (§4: viscosity, film thickness and damping varied
 at 1800 rpm). Each grid point runs ``seeds`` simulations; the result is the peak of the mean slip
@@ -79,12 +79,11 @@ def sweep_grid(vary: Mapping[str, Sequence[float]], seeds: int) -> list[dict[str
 def _run_point(point: dict[str, Any], base: dict[str, Any]) -> dict[str, Any]:
     from cageless.conditions import OperatingConditions
     from cageless.errors import CagelessError
-    from simulation.effects import choose_model
-    from simulation.parameters import ModelParameters
-    from simulation.run import peak_unloaded_slip, simulate
-    from simulation.scene import Scene
-
     from cageless.kinematics import startup_duration
+    from simulation.parameters import ModelParameters
+    from simulation.run import peak_unloaded_slip
+    from simulation.scene import Scene
+    from simulation.simulation import Simulation
 
     scene_kw = {n: point.get(n, base[n]) for n in SCENE_NAMES}
     model = {k: v for k, v in point.items() if k not in SCENE_NAMES and "." not in k and k != "seed"}
@@ -96,15 +95,15 @@ def _run_point(point: dict[str, Any], base: dict[str, Any]) -> dict[str, Any]:
             scene_kw["speed_rpm"], g.ball_diameter_m, g.pitch_diameter_m)
         scene = Scene(conditions=OperatingConditions(**scene_kw), bearing=bearing,
                       duration_s=settle + base["duration_s"], seed=int(point["seed"]))
-        res = simulate(scene, choose_model(scene),
-                       parameters=ModelParameters().with_overrides({**base["parameters"], **model}),
-                       progress=False, config={"command": "sweep"})
+        sim = Simulation(scene, ModelParameters().with_overrides({**base["parameters"], **model}))
+        trace = sim.run(config={"command": "sweep"})
     except CagelessError as exc:
         return {**point, "peak_slip_pct": float("nan"), "status": "failed", "message": str(exc), "wall_s": 0.0}
-    ok = res.solution.success
-    peak = peak_unloaded_slip(res.trace, settle_s=settle) if ok else float("nan")
+    assert sim.solution is not None
+    ok = sim.solution.success
+    peak = peak_unloaded_slip(trace, settle_s=settle) if ok else float("nan")
     return {**point, "peak_slip_pct": 100 * peak, "status": "ok" if ok else "failed",
-            "message": "" if ok else res.trace.status, "wall_s": res.trace.simulation.wall_s}
+            "message": "" if ok else trace.status, "wall_s": trace.simulation.wall_s}
 
 
 def run_sweep(vary: Mapping[str, Sequence[float]], seeds: int, speed_rpm: float, radial_load_n: float = 0.0,

@@ -1,4 +1,4 @@
-"""Long runs in chunks: progress, bounded memory, and the automatic switch to a stiff solver.
+"""The automatic stiff-solver switch, run over a long solve in chunks: progress, bounded memory, and the switch.
 
 :func:`solve_chunks` integrates a problem chunk by chunk (one progress-bar update per chunk, samples
 kept, internal steps not). With ``method="auto"`` it starts with the compiled DP5 and watches its
