@@ -59,11 +59,14 @@ class LabOptions:
     scheduler: str | None = None
     force: bool = False
     parameters: dict[str, float] = field(default_factory=dict)
+    #: Where the parameters came from when a calibration file gave them (one line), or None.
+    calibration: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready, without the scheduler address (it does not change results)."""
         return {"duration_s": self.duration_s, "settle_s": self.settle_s, "bin_deg": self.bin_deg, "rtol": self.rtol,
-                "force": self.force, "parameters": dict(self.parameters)}
+                "force": self.force, "parameters": dict(self.parameters),
+                **({"calibration": self.calibration} if self.calibration else {})}
 
 
 @dataclass
@@ -223,7 +226,8 @@ def run_lab(folder: str | Path, out: str | Path, options: LabOptions | None = No
     rows = [d.row for d in descriptions] + failed
     tables = write_tables(rows, out / "slip_table")
     structure = build_report(descriptions, failed, reproduction={
-        "lab folder": str(folder), "configuration": options.to_dict(), "bearing": bearing.to_dict()}, timings=timings)
+        "lab folder": str(folder), **({"calibration": options.calibration} if options.calibration else {}),
+        "configuration": options.to_dict(), "bearing": bearing.to_dict()}, timings=timings)
     report = write_report(structure, out / "report.html")
     return LabResult(report=report, table=tables["csv"], rows=rows, n_failed=len(failed), timings=timings,
                      skipped=skipped)

@@ -102,10 +102,11 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     return _run(args, scene, choice, config)
 
 
-def _parameters(args: argparse.Namespace) -> Any:
-    from simulation.parameters import ModelParameters, parse_set_overrides
+def _parameters(args: argparse.Namespace, config: dict[str, Any]) -> Any:
+    from cageless.cli.common import parameter_values
+    from simulation.parameters import ModelParameters
 
-    values = parse_set_overrides(args.set_values)
+    values = parameter_values(args, config)  # [parameters] of --config, then --set
     if args.restitution is not None:
         values["restitution"] = args.restitution
     return ModelParameters().with_overrides(values)
@@ -116,7 +117,7 @@ def _run(args: argparse.Namespace, scene: Any, choice: Any, config: dict[str, An
     from simulation.run import check_supported
 
     check_supported(scene, choice)
-    par = _parameters(args)  # validated before anything compiles
+    par = _parameters(args, config)  # validated before anything compiles
     if args.ensemble < 1:
         raise UsageError(f"--ensemble must be >= 1, got {args.ensemble}")
     out = args.out or f"sim_{args.speed_rpm:g}rpm_Fr{args.radial_load_n:g}.trace.h5"
@@ -124,9 +125,14 @@ def _run(args: argparse.Namespace, scene: Any, choice: Any, config: dict[str, An
 
     sim = Simulation(scene, par, Choices(method=args.solver, rtol=args.rtol, max_step=args.max_step,
                                          sample_rate_hz=args.sample_rate), model=choice)
-    config = {"command": "simulate", "set": args.set_values}
+    from cageless.calibrate import describe_calibration
+
+    note = describe_calibration(config.get("calibration"))
+    config = {"command": "simulate", "set": args.set_values, **({"calibration": note} if note else {})}
     if args.scheduler and args.ensemble == 1:
         raise UsageError("--scheduler runs an ensemble on a Dask cluster: give --ensemble N as well")
+    if note:
+        print(f"parameters: {note}")
     if args.ensemble == 1:
         trace = sim.run(out=out, progress=not args.quiet, config=config)
         print(f"effects: {', '.join(choice.active)}")

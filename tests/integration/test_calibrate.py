@@ -1,0 +1,120 @@
+"""`cageless calibrate`: its refusals, the parameter file it writes, that simulate/sweep take that file
+(``--set`` winning), that it runs the same on a LocalCluster, and (slow) that it recovers a known value."""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cageless.calibrate import Bound, calibrate, describe_calibration, parse_bounds, target_from_peak
+from cageless.cli import main
+from cageless.errors import ParameterError
+from cageless.trace import SimulationInfo, Trace, read_trace, write_trace
+
+sys.path.insert(0, str(Path(__file__).parent))
+from calibration_helpers import as_video_trace  # noqa: E402
+
+# A cheap scene for the CI share: 6000 rpm (a cage revolution is 25 ms), 5 ms after a 5 ms start-up.
+FAST = ["--speed-rpm", "6000", "--radial-load-n", "500", "--duration", "0.005", "--settle", "0.005"]
+
+
+def _fake_simulation_trace(path: Path) -> Path:
+    t = np.linspace(0.0, 0.01, 11)
+    z = np.zeros((11, 14))
+    tr = Trace(source="simulation", time=t, angle=z, speed=z, slip=z, valid=z == 0, speed_rpm=3000.0,
+               radial_load_n=500.0, axial_load_n=0.0, ball_diameter_m=9.525e-3, pitch_diameter_m=46.005e-3,
+               simulation=SimulationInfo("{}", "{}", "dp5", 1e-6, 1e-9, 1, 1, 0.0))
+    return write_trace(path, tr)
+
+
+@pytest.mark.parametrize("vary, message", [
+    ("cho_n_sm=2000:8000", "Did you mean 'cho_n_s_m'"),
+    ("cho_n_s_m=2000:12000", "leaves the documented range 0..10000"),
+    ("restitution=0.9:0.5", "LOW must be below HIGH"),
+    ("cho_n_s_m=2000", "write LOW:HIGH"),
+    ("strips=1:5", "has no documented physical range"),
+])
+def test_bad_vary_is_a_one_line_usage_error(vary, message, capsys):
+    assert main(["calibrate", "--speed-rpm", "3000", "--radial-load-n", "500", "--target-peak-slip-pct", "2",
+                 "--vary", vary]) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1 and "Traceback" not in err
+
+
+def test_a_trace_that_is_not_a_video_trace_is_refused(tmp_path, capsys):
+    path = _fake_simulation_trace(tmp_path / "sim.trace.h5")
+    assert main(["calibrate", str(path), "--vary", "cho_n_s_m=2000:8000"]) == 2
+    err = capsys.readouterr().err
+    assert "is a simulation trace" in err and str(path) in err and err.count("\n") == 1
+    assert main(["calibrate", str(tmp_path / "missing.trace.h5"), "--vary", "cho_n_s_m=2000:8000"]) == 2
+    assert main(["calibrate", "--speed-rpm", "3000", "--vary", "cho_n_s_m=2000:8000"]) == 2
+
+
+def test_ranges_are_canonical_and_aliases_accepted():
+    b = parse_bounds(["lubricant.viscosity=0.02:0.06", "cho_n_s_m=2000:8000"])
+    assert b == [Bound("lubricant.dynamic_viscosity_pa_s", 0.02, 0.06), Bound("cho_n_s_m", 2000.0, 8000.0)]
+    with pytest.raises(ParameterError, match="given twice"):
+        parse_bounds(["cho_n_s_m=2000:8000", "cho_n_s_m=3000:4000"])
+
+
+def test_calibrate_to_a_target_writes_a_parameter_file_that_simulate_takes(tmp_path, capsys):
+    out = tmp_path / "fit.toml"
+    rc = main(["calibrate", *FAST, "--target-peak-slip-pct", "1.0", "--vary", "cho_n_s_m=2000:8000",
+               "--budget", "3", "--seeds", "1", "-q", "-o", str(out)])
+    assert rc == 0, capsys.readouterr()
+    doc = tomllib.loads(out.read_text())
+    cal = doc["calibration"]
+    assert 2000 <= doc["parameters"]["cho_n_s_m"] <= 8000
+    assert doc["parameters"]["cho_n_s_m"] == cal["fitted"]["cho_n_s_m"]
+    assert cal["ranges"]["cho_n_s_m"] == [2000.0, 8000.0]
+    assert cal["evaluations_used"] == len(cal["evaluations"]) == 3 and cal["budget"] == 3
+    best = min(cal["evaluations"], key=lambda r: r["objective_pp"])
+    assert cal["objective_pp"] == best["objective_pp"] == pytest.approx(abs(best["peak_slip_pct"] - 1.0))
+    assert cal["condition"] == "6000 rpm, 500 N radial, 0 N axial" and cal["target_peak_slip_pct"] == 1.0
+    assert cal["seed_values"] == [0] and "Brent" in cal["method"] and cal["software_version"]
+    assert not list(tmp_path.glob("*.tmp*"))  # written atomically
+    capsys.readouterr()
+    trace = tmp_path / "run.trace.h5"
+    assert main(["simulate", "--speed-rpm", "6000", "--radial-load-n", "500", "--duration", "0.002", "-q",
+                 "--config", str(out), "-o", str(trace)]) == 0
+    printed = capsys.readouterr().out
+    assert "parameters: calibration (cho_n_s_m = " in printed and "fitted at 6000 rpm, 500 N radial" in printed
+    cfg = read_trace(trace).config
+    assert cfg["parameters"]["cho_n_s_m"] == cal["fitted"]["cho_n_s_m"] and "calibration" in cfg
+    assert main(["simulate", "--speed-rpm", "6000", "--radial-load-n", "500", "--duration", "0.002", "-q",
+                 "--config", str(out), "--set", "cho_n_s_m=1234", "-o", str(trace)]) == 0
+    assert read_trace(trace).config["parameters"]["cho_n_s_m"] == 1234.0  # --set wins over the file
+
+
+def test_a_bad_parameters_table_names_the_file(tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[parameters]\ncho_n_sm = 2500\n")
+    assert main(["sweep", *FAST[:4], "--vary", "cho_n_s_m=2500,7500", "--config", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert str(bad) in err and "Did you mean 'cho_n_s_m'" in err
+
+
+def test_describe_calibration_names_the_condition_and_the_trace():
+    text = describe_calibration({"fitted": {"cho_n_s_m": 3012.0}, "condition": "3000 rpm, 500 N radial, 0 N axial",
+                                 "trace_file": "/x/clip.trace.h5", "trace_sha256": "ab" * 32, "metric": "mae",
+                                 "objective_pp": 0.12, "evaluations_used": 12, "seeds": 2})
+    assert text.startswith("calibration (cho_n_s_m = 3012) fitted at 3000 rpm, 500 N radial, 0 N axial to trace "
+                           "clip.trace.h5 (sha256 abababababab)")
+    assert describe_calibration(None) is None
+
+
+def test_calibration_on_a_local_cluster_matches_the_local_run():
+    distributed = pytest.importorskip("distributed", reason="dask[distributed] (the test extra) is not installed")
+    target = target_from_peak(6000.0, 500.0, 1.0, duration_s=0.005)
+    kw = dict(budget=3, seeds=2, settle_s=0.005, progress=False)
+    local = calibrate(target, [Bound("restitution", 0.5, 0.95)], **kw)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cl:
+        remote = calibrate(target, [Bound("restitution", 0.5, 0.95)], scheduler=cl.scheduler_address, **kw)
+    assert json.dumps(local.evaluations) == json.dumps(remote.evaluations)
+    assert local.fitted == remote.fitted
