@@ -120,6 +120,27 @@ def test_calibration_on_a_local_cluster_matches_the_local_run():
     assert local.fitted == remote.fitted
 
 
+def test_report_takes_a_calibration_and_names_its_condition(tmp_path, capsys):
+    import shutil
+
+    lab = tmp_path / "lab"
+    lab.mkdir()
+    shutil.copy(Path(__file__).resolve().parents[2] / "sample_data" / "lab" / "n6000_Fr500_Fa0.cine", lab)
+    config = tmp_path / "fit.toml"
+    config.write_text('[parameters]\ncho_n_s_m = 2500.0\n\n[calibration]\n'
+                      'condition = "3000 rpm, 500 N radial, 0 N axial"\ntarget_peak_slip_pct = 2.2\n'
+                      'metric = "peak miss"\nobjective_pp = 0.01\nevaluations_used = 12\nseeds = 2\n'
+                      '[calibration.fitted]\ncho_n_s_m = 2500.0\n')
+    out = tmp_path / "out"
+    assert main(["report", str(lab), "-o", str(out), "-q", "--config", str(config), "--duration", "0.01",
+                 "--settle", "0.005"]) == 0
+    note = "calibration (cho_n_s_m = 2500) fitted at 3000 rpm, 500 N radial, 0 N axial to target peak slip 2.2 %"
+    assert f"parameters: {note}" in capsys.readouterr().out
+    assert note in (out / "report.html").read_text()
+    sim = read_trace(next((out / "simulations").glob("*.trace.h5")))
+    assert sim.config["parameters"]["cho_n_s_m"] == 2500.0
+
+
 # -- recovering a known value ------------------------------------------------------------------------------
 # The "measurement" is a simulation with traction_sliding_coefficient = 0.02 (seed 17, 20 ms start-up left out,
 # 50 ms kept, 6000 rpm, 500 N), written as a video trace; the calibration runs seeds 0..1, so it never sees the
