@@ -80,10 +80,13 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
 
     bearing = bearing_from_config(config)
     bounds = parse_bounds(args.vary, bearing)
-    fixed = parameter_values(args, config)
-    clash = [b.name for b in bounds if b.name in fixed]
+    from simulation.parameters import parse_set_overrides
+
+    clash = [b.name for b in bounds if b.name in parse_set_overrides(args.set_values)]
     if clash:
-        raise UsageError(f"calibrate: {', '.join(clash)} is both fixed (--set or [parameters]) and varied; drop one")
+        raise UsageError(f"calibrate: {', '.join(clash)} is both held (--set) and varied (--vary); drop one")
+    varied = {b.name for b in bounds}  # a varied value of a --config file's [parameters] is its start, not fixed
+    fixed = {k: v for k, v in parameter_values(args, config).items() if k not in varied}
     if args.workers < 1:
         raise UsageError(f"--workers must be >= 1, got {args.workers}")
     target = _target(args)

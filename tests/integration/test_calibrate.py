@@ -141,6 +141,22 @@ def test_report_takes_a_calibration_and_names_its_condition(tmp_path, capsys):
     assert sim.config["parameters"]["cho_n_s_m"] == 2500.0
 
 
+def test_several_parameters_use_a_design_then_nelder_mead(tmp_path, capsys):
+    out = tmp_path / "fit2.toml"
+    assert main(["calibrate", *FAST, "--target-peak-slip-pct", "1.0", "--vary", "restitution=0.5:0.95",
+                 "--vary", "lubricant.viscosity=0.02:0.06", "--budget", "5", "--seeds", "1", "-q",
+                 "-o", str(out)]) == 0
+    doc = tomllib.loads(out.read_text())
+    cal = doc["calibration"]
+    assert cal["evaluations_used"] == 5 and "Latin hypercube design of 3 points" in cal["method"]
+    assert 0.5 <= doc["parameters"]["restitution"] <= 0.95
+    assert 0.02 <= doc["bearing"]["lubricant"]["dynamic_viscosity_pa_s"] <= 0.06  # a bearing field: [bearing.*]
+    capsys.readouterr()
+    assert main(["calibrate", *FAST, "--target-peak-slip-pct", "1.0", "--vary", "restitution=0.5:0.95",
+                 "--set", "restitution=0.7"]) == 2
+    assert "both held (--set) and varied" in capsys.readouterr().err
+
+
 # -- recovering a known value ------------------------------------------------------------------------------
 # The "measurement" is a simulation with traction_sliding_coefficient = 0.02 (seed 17, 20 ms start-up left out,
 # 50 ms kept, 6000 rpm, 500 N), written as a video trace; the calibration runs seeds 0..1, so it never sees the
