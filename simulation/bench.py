@@ -75,7 +75,7 @@ def _settled_problem(rpm: float, load_n: float, settle_s: float, axial_n: float 
     z = scene.bearing.geometry.n_balls
     y0[5 * z + 4:5 * z + 6] = 0.0  # restart the work and dissipation counters (same slots in both layouts)
     cage = theoretical_cage_speed(scene.bearing.geometry, scene.conditions.speed_rad_s)
-    return replace(pr, y0=y0, aux=sol.extra["aux"], t0=0.0), cage
+    return replace(pr, y0=y0, log=sol.extra["log"], t0=0.0), cage
 
 
 def _errors(y: npt.NDArray[np.float64], ref: npt.NDArray[np.float64], z: int, cage: float,
@@ -96,7 +96,7 @@ def _best_wall(run: Any, repeats: int) -> tuple[Any, float]:
 
 
 def _numpy_lsoda(pr: Problem, t: npt.NDArray[np.float64], rtol: float) -> Any:
-    return step_scipy(pr, t, "LSODA", rtol, max_step=2e-6, fun=lambda tt, yy, aux: reference_rhs(tt, yy, pr.params, aux))
+    return step_scipy(pr, t, "LSODA", rtol, max_step=2e-6, fun=lambda tt, yy, log: reference_rhs(tt, yy, pr.params, log))
 
 
 def accuracy_study(rpm: float = 3000.0, load_n: float = 500.0, window_s: float = 0.005, settle_s: float = 0.03,
@@ -215,7 +215,7 @@ def model_study(window_s: float = 0.005, settle_s: float = 0.03, repeats: int = 
             pr = Simulation(scene, ModelParameters(strips=m), Choices(level=lvl, force=True)).build()
             n = len(pr.y0)  # the planar state is the first 5 Z + 6 entries of the spatial one
             y0 = np.concatenate([base.y0, np.zeros(max(0, n - len(base.y0)))])[:n]
-            pr = replace(pr, y0=y0, aux=base.aux.copy())
+            pr = replace(pr, y0=y0, log=base.log.copy())
             rtol = 1e-6 * RTOL_FACTOR.get(method, 1.0)
             sol, wall = _best_wall(lambda pr=pr, method=method, cap=cap, rtol=rtol: solve(
                 pr, t, method=method, rtol=rtol, max_step=cap), repeats)

@@ -20,13 +20,14 @@ from __future__ import annotations
 import json
 from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass
+from typing import Any
 
 from cageless.errors import UsageError, suggest
 from simulation.scene import Scene
 
 __all__ = [
     "EffectSpec", "EffectChoice", "ModelChoice", "EFFECTS", "LEVELS", "choose_model", "parse_effect_overrides",
-    "describe_table", "check_lubricant", "parameter_slots", "effect_flags",
+    "describe_table", "check_lubricant", "parameter_slots", "effect_flags", "register_effect",
 ]
 
 LEVELS = ("planar", "spatial")
@@ -45,6 +46,9 @@ class EffectSpec:
     #: Slots of the parameters the effect's unit reads (filled by the model from
     #: :class:`~simulation.parameters.ModelParameters` and the bearing).
     slots: tuple[str, ...] = ()
+    #: For an effect added by :func:`register_effect`: its slot values (name -> value) from the run's
+    #: :class:`~simulation.parameters.ModelParameters` (the built-in rows are filled by the models).
+    fill: Callable[[Any], Mapping[str, float]] | None = None
 
 
 def _always(what: str) -> Callable[[Scene], tuple[bool, str]]:
@@ -90,6 +94,23 @@ EFFECTS: tuple[EffectSpec, ...] = (
                "ball-ball contacts", _dry, flag="DRY", slots=("MU_DRY", "V_REG", "MU_STATIC", "V_STRIBECK")),
 )
 _BY_NAME = {e.name: e for e in EFFECTS}
+
+
+def register_effect(spec: EffectSpec) -> None:
+    """Add a row to the effects table (a new physics unit: see :mod:`simulation.models.race_laws`).
+
+    Raises
+    ------
+    ValueError
+        For a name, flag or slot already in the table.
+    """
+    global EFFECTS
+    taken = {n for e in EFFECTS for n in (e.name, e.flag, *e.slots)}
+    clash = {spec.name, spec.flag, *spec.slots} & taken
+    if clash or not spec.flag:
+        raise ValueError(f"effect {spec.name!r}: needs a flag slot and new names; taken: {sorted(clash)}")
+    EFFECTS = (*EFFECTS, spec)
+    _BY_NAME[spec.name] = spec
 
 
 @dataclass(frozen=True)

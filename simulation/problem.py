@@ -24,11 +24,16 @@ FloatArray = npt.NDArray[np.float64]
 
 @dataclass(frozen=True)
 class Problem:
-    """An initial-value problem: model, parameters, auxiliary state, start, absolute tolerances."""
+    """An initial-value problem: model, parameters, contact log, start, absolute tolerances.
+
+    ``log`` is the model's contact log, a float array the kernels update after each accepted step (per-pair
+    onset speeds and open contact episodes, then the logged episodes; see
+    :func:`simulation.models.planar.log_size`) with a scratch tail for the right-hand side.
+    """
 
     model_id: int
     params: FloatArray
-    aux: FloatArray
+    log: FloatArray
     y0: FloatArray
     t0: float
     atol: FloatArray
@@ -55,11 +60,11 @@ class Problem:
             raise KeyError(f"{self.name} has no named parameter slots")
         return self.layout.value(self.params, name)
 
-    def rhs(self, t: float, y: FloatArray, aux: FloatArray | None = None) -> FloatArray:
-        """dy/dt at (t, y), evaluated by the compiled kernel (``aux`` defaults to a copy of the problem's)."""
+    def rhs(self, t: float, y: FloatArray, log: FloatArray | None = None) -> FloatArray:
+        """dy/dt at (t, y), evaluated by the compiled kernel (``log`` defaults to a copy of the problem's)."""
         from simulation.kernels import model_rhs
 
         out = np.empty_like(np.asarray(y, dtype=np.float64))
         model_rhs(self.model_id, float(t), np.asarray(y, dtype=np.float64), self.params,
-                  self.aux.copy() if aux is None else aux, out)
+                  self.log.copy() if log is None else log, out)
         return out

@@ -180,7 +180,7 @@ def to_trace(scene: Scene, choice: ModelChoice, pr: Problem, sol: Solution, rtol
     alpha = nominal_contact_angle(scene, groups)
     provenance["config"]["nominal_contact_angle_rad"] = alpha
     omega_c = theoretical_cage_speed(g, scene.conditions.speed_rad_s, alpha)
-    events = P.contact_events(pr, sol.extra["aux"], float(sol.t[ok][-1]) if ok.any() else 0.0)
+    events = P.contact_events(pr, sol.extra["log"], float(sol.t[ok][-1]) if ok.any() else 0.0)
     status = "complete" if sol.success else f"incomplete: {sol.message} at t = {sol.t[ok][-1] if ok.any() else 0:g} s"
     return Trace(
         source="simulation", time=sol.t, angle=angle, speed=speed, slip=slip_rate(speed, omega_c),

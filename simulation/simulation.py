@@ -47,8 +47,8 @@ class Choices:
     force
         Allow overrides that contradict the scene.
     method
-        ``"auto"`` (compiled DP5, switching to a stiff solver when that pays: see
-        :mod:`simulation.auto_switch`) or a key of :data:`simulation.solve.METHODS`.
+        A key of :data:`simulation.solve.METHODS`: ``"auto"`` (compiled DP5, switching to a stiff solver when
+        that pays: see :mod:`simulation.auto_switch`), ``"dp5"``, ``"CVODE"``, or one of scipy's.
     rtol
         Relative tolerance; CVODE runs at ``rtol x 0.03`` to match DP5's accuracy
         (:data:`simulation.auto_switch.RTOL_FACTOR`).
@@ -75,9 +75,9 @@ class Choices:
 
     def check(self) -> None:
         """Refuse an unknown method or a bad step cap (before anything compiles)."""
-        if self.method != "auto" and self.method not in METHODS:
-            raise ParameterError("method", "is not a solver" + (suggest(self.method, [*METHODS, "auto"]) or
-                                                                f"; use auto or one of {list(METHODS)}"), self.method)
+        if self.method not in METHODS:
+            raise ParameterError("method", "is not a solver" + (suggest(self.method, METHODS) or
+                                                                f"; use one of {list(METHODS)}"), self.method)
         if self.max_step is not None and not (0 < self.max_step < np.inf):
             raise ParameterError("max_step", "must be a positive number of seconds, or None for the defaults",
                                  self.max_step)

@@ -27,8 +27,8 @@ def tangential_force(u_s: np.ndarray, u_r: np.ndarray, q: np.ndarray, p: np.ndar
 
 
 def reference_rhs(t: float, y: npt.NDArray[np.float64], p: npt.NDArray[np.float64],
-                  aux: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
-    """dy/dt of the planar model (numpy). ``aux`` holds the ball-ball approach speeds recorded at onset."""
+                  log: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    """dy/dt of the planar model (numpy). ``log`` holds the ball-ball approach speeds recorded at onset."""
     z = int(p[B.P_Z])
     d, m, m_ring = p[B.P_D], p[B.P_M], p[B.P_MR]
     half = 0.5 * d
@@ -84,7 +84,7 @@ def reference_rhs(t: float, y: npt.NDArray[np.float64], p: npt.NDArray[np.float6
         fz += gz
         ring -= [np.sum(gy), np.sum(gz)]
     if p[B.P_F_BB] > 0.5:
-        power += _pairs(y, p, aux, fy, fz, torque)
+        power += _pairs(y, p, log, fy, fz, torque)
     f_rad, f_tan = fy * c + fz * s, -fy * s + fz * c
     if p[B.P_F_DRAG] > 0.5:
         v = r * thd
@@ -103,7 +103,7 @@ def reference_rhs(t: float, y: npt.NDArray[np.float64], p: npt.NDArray[np.float6
     return out
 
 
-def _pairs(y: np.ndarray, p: np.ndarray, aux: np.ndarray, fy: np.ndarray, fz: np.ndarray,
+def _pairs(y: np.ndarray, p: np.ndarray, log: np.ndarray, fy: np.ndarray, fz: np.ndarray,
            torque: np.ndarray) -> float:
     """Ball-ball Hertz, friction and squeeze film into fy, fz, torque (in place); returns dissipated power."""
     z = int(p[B.P_Z])
@@ -120,7 +120,7 @@ def _pairs(y: np.ndarray, p: np.ndarray, aux: np.ndarray, fy: np.ndarray, fz: np
     ddot = -((vx[k] - vx) * nx + (vz[k] - vz) * nz)
     touching = delta > 0
     # recorded onset speed, else the current one; floored (ModelParameters.min_approach_speed_m_s)
-    speeds = np.maximum(np.where(aux[:z] > 0, aux[:z], ddot), p[B.P_V_IN_MIN])
+    speeds = np.maximum(np.where(log[:z] > 0, log[:z], ddot), p[B.P_V_IN_MIN])
     chi = p[B.P_CHI]
     el = p[B.P_KB] * np.clip(delta, 0, None) ** 1.5
     f = np.where(touching, np.maximum(el * (1 + (chi * ddot / np.where(speeds > 0, speeds, 1.0) if chi > 0 else 0)),

@@ -45,7 +45,7 @@ from simulation.forces import FASTMATH, hertz_damped
 from simulation.hertz import compliance, hertz_contact, race_curvatures
 from simulation.models import base as B
 from simulation.models import planar as P
-from simulation.models.contact_laws import tangential
+from simulation.models.contact_laws import RACE_LAWS, race_extra, tangential
 from simulation.problem import Problem
 
 __all__ = ["MODEL_ID", "SpatialLayout", "spatial_problem", "spatial_rhs", "spatial_signature", "race_geometry",
@@ -167,6 +167,11 @@ def _race(y, p, j, z, inner, w_i, rot, c, s, wt):  # pragma: no cover - compiled
         q_d = max(q + p[B.P_CHO] * ddot, 0.0)
         p_diss += (q_d - q) * ddot
         q = q_d
+    if RACE_LAWS:
+        ddot = rvx * nx + rvy * ny + rvz * nz
+        f_x = race_extra(delta, ddot, q, p)
+        p_diss += f_x * ddot
+        q += f_x
     fx, fy, fz = -q * nx, -q * ny, -q * nz
     mx = my = mz = 0.0
     t2x = t2y = t2z = 0.0
@@ -229,7 +234,7 @@ def _race(y, p, j, z, inner, w_i, rot, c, s, wt):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, fastmath=FASTMATH)
-def _pair(y, p, aux, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
+def _pair(y, p, log, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
     """Ball j against ball k along the 3-D line of centres: force on k (3), moment on both (3), dissipated power."""
     d = p[B.P_D]
     half = 0.5 * d
@@ -256,7 +261,7 @@ def _pair(y, p, aux, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
             f = 6.0 * np.pi * p[B.P_ETA0] * (0.25 * d) ** 2 * ddot / max(-delta, p[B.P_H0])
             return f * nx, f * ny, f * nz, 0.0, 0.0, 0.0, f * ddot
         return zero
-    v_in = max(aux[j] if aux[j] > 0.0 else ddot, p[B.P_V_IN_MIN])
+    v_in = max(log[j] if log[j] > 0.0 else ddot, p[B.P_V_IN_MIN])
     f = hertz_damped(delta, ddot, v_in, p[B.P_KB], p[B.P_CHI])
     p_diss = (f - p[B.P_KB] * delta * math.sqrt(delta)) * ddot
     fx, fy, fz = f * nx, f * ny, f * nz
@@ -280,7 +285,7 @@ def _pair(y, p, aux, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, fastmath=FASTMATH)
-def spatial_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
+def spatial_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
     z = int(p[B.P_Z])
     b = 5 * z + 6
     d, m, inertia, m_ring, g = p[B.P_D], p[B.P_M], p[B.P_I], p[B.P_MR], p[B.P_G]
@@ -292,12 +297,12 @@ def spatial_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     s_bz, c_bz = math.sin(p[P_TILT_Z] + y[tb + 1]), math.cos(p[P_TILT_Z] + y[tb + 1])
     wt = (-s_bz * y[tb + 2], c_bz * y[tb + 2], y[tb + 3])  # angular velocity of the tilting: bz' z + by' Rz y
     rmx = rmy = rmz = 0.0
-    trig = aux.shape[0] - 2 * z  # scratch: cos and sin of every ball's angle, once per call
+    trig = log.shape[0] - 2 * z  # scratch: cos and sin of every ball's angle, once per call
     for i in range(dydt.shape[0]):
         dydt[i] = 0.0
     for j in range(z):
-        aux[trig + j] = math.cos(y[z + j])
-        aux[trig + z + j] = math.sin(y[z + j])
+        log[trig + j] = math.cos(y[z + j])
+        log[trig + z + j] = math.sin(y[z + j])
     # accumulators: force (x in the axial slot, y and z in the planar acceleration slots), moments in spin slots
     for j in range(z):
         dydt[3 * z + j] = -m * grav
@@ -307,8 +312,8 @@ def spatial_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     if p[B.P_F_RACE] > 0.5:
         for j in range(z):
             for inner in (False, True):
-                fx, fy, fz, mx, my, mz, pin, pd, _, qx, qy, qz = _race(y, p, j, z, inner, w_i, rot, aux[trig + j],
-                                                                       aux[trig + z + j], wt)
+                fx, fy, fz, mx, my, mz, pin, pd, _, qx, qy, qz = _race(y, p, j, z, inner, w_i, rot, log[trig + j],
+                                                                       log[trig + z + j], wt)
                 dydt[b + z + j] += fx
                 dydt[2 * z + j] += fy
                 dydt[3 * z + j] += fz
@@ -323,8 +328,8 @@ def spatial_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     if p[B.P_F_BB] > 0.5:
         for j in range(z):
             k = j + 1 if j + 1 < z else 0
-            fx, fy, fz, mx, my, mz, pd = _pair(y, p, aux, j, k, z, aux[trig + j], aux[trig + z + j], aux[trig + k],
-                                               aux[trig + z + k])
+            fx, fy, fz, mx, my, mz, pd = _pair(y, p, log, j, k, z, log[trig + j], log[trig + z + j], log[trig + k],
+                                               log[trig + z + k])
             dydt[b + z + j] -= fx
             dydt[2 * z + j] -= fy
             dydt[3 * z + j] -= fz
@@ -338,7 +343,7 @@ def spatial_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     drag = 0.5 * p[B.P_CD] * p[B.P_RHO_MIX] * 0.25 * np.pi * d * d if p[B.P_F_DRAG] > 0.5 else 0.0
     for j in range(z):
         r, rd, thd = y[j], y[2 * z + j], y[3 * z + j]
-        c, s = aux[trig + j], aux[trig + z + j]
+        c, s = log[trig + j], log[trig + z + j]
         fy, fz = dydt[2 * z + j], dydt[3 * z + j]
         f_rad, f_tan = fy * c + fz * s, -fy * s + fz * c
         if drag > 0.0:
@@ -365,7 +370,7 @@ def spatial_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def spatial_ring_share(t, y, p, aux, j, out):  # pragma: no cover - compiled
+def spatial_ring_share(t, y, p, log, j, out):  # pragma: no cover - compiled
     """Ball j's share of the rows every ball reaches (see :mod:`simulation.jacobian`), in the order of
     :func:`spatial_ring_rows`: the ring's y'', z'', x'' and tilt accelerations from its inner-race contact,
     its race input power, and the dissipation that depends on its state (both race contacts, its drag
@@ -393,7 +398,7 @@ def spatial_ring_share(t, y, p, aux, j, out):  # pragma: no cover - compiled
     if p[B.P_F_BB] > 0.5:
         for a, b in ((j - 1 if j > 0 else z - 1, j), (j, j + 1 if j + 1 < z else 0)):
             ca, sa, cb, sb = math.cos(y[z + a]), math.sin(y[z + a]), math.cos(y[z + b]), math.sin(y[z + b])
-            out[6] += _pair(y, p, aux, a, b, z, ca, sa, cb, sb)[6]
+            out[6] += _pair(y, p, log, a, b, z, ca, sa, cb, sb)[6]
     if p[B.P_F_DRAG] > 0.5:
         v = y[j] * y[3 * z + j]
         out[6] += 0.5 * p[B.P_CD] * p[B.P_RHO_MIX] * 0.25 * np.pi * p[B.P_D] ** 2 * v * v * abs(v)
@@ -500,7 +505,7 @@ def spatial_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayL
     floor[sl["spin_y"]] = floor[sl["spin_z"]] = floor[sl["spin"]]
     floor[sl["ring_axial"]] = (0.0, floor[5 * z + 2])
     floor[sl["ring_tilt"]] = (0.0, 0.0, r_i / p[P_IR], r_i / p[P_IR])  # 1 N at the race
-    return Problem(model_id=MODEL_ID, params=p, aux=flat.aux, y0=y0, t0=0.0, atol=atol,
+    return Problem(model_id=MODEL_ID, params=p, log=flat.log, y0=y0, t0=0.0, atol=atol,
                    name="spatial cageless bearing", onset_step=flat.onset_step, jump_floor=floor, layout=LAYOUT,
                    effects=flat.effects, n_balls=z, n_gaps=flat.n_gaps)
 

@@ -50,7 +50,7 @@ def test_structured_jacobian_matches_plain_difference_quotients(level, axial_n, 
     n = len(pr.y0)
     floor = pr.atol / 1e-7
     jac = np.empty((n, n))
-    structure.evaluator(pr, pr.aux.copy(), floor)(0.01, pr.y0, jac)
+    structure.evaluator(pr, pr.log.copy(), floor)(0.01, pr.y0, jac)
     ref = dense_fd_jacobian(pr, 0.01, pr.y0, floor)
     assert np.all(ref[~structure.pattern] == 0.0)  # the claimed structure holds exactly
     z = pr.n_balls

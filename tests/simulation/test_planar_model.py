@@ -107,7 +107,7 @@ def test_compiled_and_numpy_right_hand_sides_agree(effects):
         y[3 * z:4 * z] = rng.normal(100.0, 5.0, z)
         y[4 * z:5 * z] = rng.normal(-500.0, 50.0, z)
         y[5 * z + 2:5 * z + 4] = rng.normal(0, 1e-3, 2)
-        aux_fast, aux_ref = pr.aux.copy(), pr.aux.copy()
+        aux_fast, aux_ref = pr.log.copy(), pr.log.copy()
         fast = pr.rhs(4e-4, y, aux_fast)
         ref = reference_rhs(4e-4, y, pr.params, aux_ref)
         # the compiled kernels reassociate sums (simulation.forces.FASTMATH): an acceleration that is the small
@@ -139,7 +139,7 @@ def test_dry_stribeck_right_hand_sides_agree():
         y[3 * z:4 * z] = rng.normal(100.0, 5.0, z)
         # spins that put the ball surfaces within a few v_s of rolling and far from it
         y[4 * z:5 * z] = rng.normal(-0.5 * G.pitch_diameter_m * 100.0 / (0.5 * G.ball_diameter_m), 30.0, z)
-        aux_fast, aux_ref = pr.aux.copy(), pr.aux.copy()
+        aux_fast, aux_ref = pr.log.copy(), pr.log.copy()
         np.testing.assert_allclose(pr.rhs(4e-4, y, aux_fast), reference_rhs(4e-4, y, pr.params, aux_ref),
                                    rtol=1e-10, atol=1e-8)
 
@@ -164,7 +164,7 @@ def test_contact_episodes_are_logged_and_classified():
     v = 0.3
     pr, t_end = _coasting_ball(v, restitution=0.9, effects=_on(lubricant_damping=False))
     sol = solve(pr, np.linspace(0, t_end, 11), rtol=1e-8)
-    events = contact_events(pr, sol.extra["aux"], t_end)
+    events = contact_events(pr, sol.extra["log"], t_end)
     assert len(events) >= 1
     first = events.iloc[0]
     assert first.pair == 3 and first.kind == "impact"
@@ -185,7 +185,7 @@ def test_sustained_contact_is_rubbing():
     pr = planar_problem(B, th, np.full(G.n_balls, 0.5 * G.pitch_diameter_m), (0.0, -2e-6), 500.0,
                         restitution=0.6, effects=CORE)
     sol = solve(pr, np.linspace(0, 5e-3, 11), rtol=1e-7)
-    events = contact_events(pr, sol.extra["aux"], 5e-3)
+    events = contact_events(pr, sol.extra["log"], 5e-3)
     assert (events.kind == "rubbing").sum() >= 3
     assert events.duration.max() > 4e-3
 
@@ -205,7 +205,7 @@ def test_contact_onset_is_not_stepped_over():
                                     ("uncontrolled", replace(pr, onset_step=0.0), 5e-4)):
         # force_jump=0 isolates the onset control (the force-jump control has its own test below)
         sol = solve(problem, np.linspace(0, t_end, 11), rtol=1e-6, max_step=max_step, force_jump=0.0)
-        ev = contact_events(problem, sol.extra["aux"], t_end)
+        ev = contact_events(problem, sol.extra["log"], t_end)
         peaks[name] = ev.peak_force.iloc[0] if len(ev) else 0.0
         if name == "controlled":
             assert sol.n_onset_retries >= 1 and sol.n_contact_changes >= 2
