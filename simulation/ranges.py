@@ -13,13 +13,13 @@ Sources
   brackets it by a factor 2 below and about 3 above.
 * ``restitution``: a coefficient of restitution lies in [0, 1] by definition.
 * traction coefficients: a choice bracketing the representative curve of
-  :mod:`simulation.parameters` (peak 0.06 at 2 %, sliding 0.04) by about a factor 5 to 6 each way;
+  :mod:`simulation.parameters` (peak 0.06 at 2 %, sliding 0.04) by a factor 5 to 10 each way;
   the model additionally needs the peak above the sliding value.
 * ``drag_coefficient``: the smooth-sphere drag curve runs from about 4 at Re = 10 through 0.47
   (subcritical) to about 0.1 past the drag crisis (F. M. White, *Fluid Mechanics*, Fig. 7.16);
   0.05-5 brackets it.
-* ``lubricant.dynamic_viscosity_pa_s``: 0.005-0.5 Pa s spans ISO 3448 viscosity grades VG 5 to
-  about VG 600 at 40 degC (kinematic viscosity in mm^2/s, times the paper's density 826 kg/m^3);
+* ``lubricant.dynamic_viscosity_pa_s``: 0.005-0.5 Pa s is about 6-600 mm^2/s at the paper's density
+  826 kg/m^3, inside the span of the ISO 3448 viscosity grades (VG 2 to VG 3200, mm^2/s at 40 degC);
   the paper's study range 0.02-0.06 Pa s lies inside.
 """
 
@@ -46,6 +46,6 @@ DOCUMENTED_RANGES: dict[str, DocumentedRange] = {
     "traction_peak_slide_roll": DocumentedRange(0.002, 0.1, "brackets the representative 2 % slide-to-roll"),
     "traction_sliding_coefficient": DocumentedRange(0.005, 0.2, "brackets the representative sliding value 0.04"),
     "drag_coefficient": DocumentedRange(0.05, 5.0, "the smooth-sphere drag curve, White Fig. 7.16"),
-    "lubricant.dynamic_viscosity_pa_s": DocumentedRange(0.005, 0.5, "ISO 3448 grades VG 5 to about VG 600 "
-                                                                    "at 40 degC"),
+    "lubricant.dynamic_viscosity_pa_s": DocumentedRange(0.005, 0.5, "about 6-600 mm^2/s, inside the ISO 3448 "
+                                                                    "grade span"),
 }

@@ -63,6 +63,13 @@ def test_ranges_are_canonical_and_aliases_accepted():
         parse_bounds(["cho_n_s_m=2000:8000", "cho_n_s_m=3000:4000"])
 
 
+def test_every_documented_range_names_a_parameter_and_is_accepted_whole():
+    from simulation.ranges import DOCUMENTED_RANGES
+
+    bounds = parse_bounds([f"{n}={r.low!r}:{r.high!r}" for n, r in DOCUMENTED_RANGES.items()])
+    assert [b.name for b in bounds] == list(DOCUMENTED_RANGES)
+
+
 def test_calibrate_to_a_target_writes_a_parameter_file_that_simulate_takes(tmp_path, capsys):
     out = tmp_path / "fit.toml"
     rc = main(["calibrate", *FAST, "--target-peak-slip-pct", "1.0", "--vary", "cho_n_s_m=2000:8000",
