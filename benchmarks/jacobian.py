@@ -19,7 +19,7 @@ import argparse
 import numpy as np
 
 from simulation.bench import _settled_problem
-from simulation.chunks import RTOL_FACTOR
+from simulation.auto_switch import RTOL_FACTOR
 from simulation.solve import JACOBIAN_DEFAULT, JACOBIANS, step_cvode
 
 SCENES = (("planar, 500 N", "planar", 500.0, 0.0), ("planar, 20 kN", "planar", 20000.0, 0.0),

@@ -65,11 +65,14 @@ class LabOptions:
     scheduler: str | None = None
     force: bool = False
     parameters: dict[str, float] = field(default_factory=dict)
+    #: Where the parameters came from when a calibration file gave them (one line), or None.
+    calibration: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready, without the scheduler address (it does not change results)."""
         return {"duration_s": self.duration_s, "settle_s": self.settle_s, "bin_deg": self.bin_deg, "rtol": self.rtol,
-                "force": self.force, "parameters": dict(self.parameters)}
+                "force": self.force, "parameters": dict(self.parameters),
+                **({"calibration": self.calibration} if self.calibration else {})}
 
 
 @dataclass
@@ -110,20 +113,19 @@ def _qc_files(trace_path: Path) -> list[Path]:
 
 def _simulate_job(conditions: OperatingConditions, bearing: Bearing, duration_s: float, parameters: dict[str, float],
                   rtol: float, out: str) -> tuple[str, str]:
-    from simulation.effects import choose_model
     from simulation.parameters import ModelParameters
-    from simulation.run import simulate
     from simulation.scene import Scene
+    from simulation.simulation import Choices, Simulation
 
     try:
         scene = Scene(conditions=OperatingConditions(conditions.speed_rpm, conditions.radial_load_n,
                                                      conditions.axial_load_n), bearing=bearing, duration_s=duration_s)
-        res = simulate(scene, choose_model(scene), parameters=ModelParameters().with_overrides(parameters), rtol=rtol,
-                       out=out, progress=False, config={"command": "report"})
+        sim = Simulation(scene, ModelParameters().with_overrides(parameters), Choices(rtol=rtol))
+        trace = sim.run(out=out, config={"command": "report"})
     except CagelessError as exc:
         return "failed", str(exc)
-    if not res.solution.success:
-        return "failed", f"the simulation stopped early: {res.trace.status}"
+    if not sim.solution.success:
+        return "failed", f"the simulation stopped early: {trace.status}"
     return "ok", out
 
 
@@ -288,7 +290,8 @@ def _run_lab(folder: str | Path, out: Path, options: LabOptions | None, bearing:
     rows = [d.row for d in descriptions] + failed
     tables = write_tables(rows, out / "slip_table")
     structure = build_report(descriptions, failed, reproduction={
-        "lab folder": str(folder), "configuration": options.to_dict(), "bearing": bearing.to_dict()}, timings=timings)
+        "lab folder": str(folder), **({"calibration": options.calibration} if options.calibration else {}),
+        "configuration": options.to_dict(), "bearing": bearing.to_dict()}, timings=timings)
     report = write_report(structure, out / "report.html")
     return LabResult(report=report, table=tables["csv"], rows=rows, n_failed=len(failed), timings=timings,
                      skipped=skipped)

@@ -32,15 +32,14 @@ import numpy.typing as npt
 
 from cageless.conditions import OperatingConditions
 from cageless.kinematics import theoretical_cage_speed
-from simulation.chunks import RTOL_FACTOR
+from simulation.auto_switch import RTOL_FACTOR
 from simulation.effects import choose_model
 from simulation.models.planar_reference import reference_rhs
 from simulation.problem import Problem
-from simulation.models import planar as P
 
 from simulation.parameters import ModelParameters
-from simulation.run import build_problem
 from simulation.scene import Scene
+from simulation.simulation import Choices, Simulation
 from simulation.solve import solve, step_cvode, step_scipy
 
 __all__ = ["accuracy_study", "format_accuracy", "plot_accuracy", "model_study", "format_models", "effects_study",
@@ -49,7 +48,7 @@ __all__ = ["accuracy_study", "format_accuracy", "plot_accuracy", "model_study", 
 #: (method, rtol, max_step in s). The step cap is an accuracy knob of its own for the implicit CVODE,
 #: whose steps are otherwise set by accuracy alone: the default 2 us keeps ~15 steps inside a ball-ball
 #: impact (29 us), the longer caps show what resolving contacts by error control alone buys and costs.
-#: CVODE at rtol 3e-8 and 5 us is how ``simulate`` runs it at rtol 1e-6 (simulation.chunks.RTOL_FACTOR).
+#: CVODE at rtol 3e-8 and 5 us is how ``simulate`` runs it at rtol 1e-6 (simulation.auto_switch.RTOL_FACTOR).
 CANDIDATES: tuple[tuple[str, float, float], ...] = (
     ("dp5", 1e-4, 2e-6), ("dp5", 1e-5, 2e-6), ("dp5", 1e-6, 2e-6), ("dp5", 1e-7, 2e-6), ("dp5", 1e-8, 2e-6),
     ("CVODE", 1e-6, 2e-6), ("CVODE", 1e-6, 5e-6), ("CVODE", 1e-7, 5e-6), ("CVODE", 3e-8, 5e-6),
@@ -70,13 +69,13 @@ _VARIANT_LABELS = {"dense": "CVODE's own Jacobian", "sparse": "structured Jacobi
 def _settled_problem(rpm: float, load_n: float, settle_s: float, axial_n: float = 0.0, level: str | None = None,
                      strips: int = 5) -> tuple[Problem, float]:
     scene = Scene(conditions=OperatingConditions(rpm, load_n, axial_n))
-    pr = build_problem(scene, choose_model(scene, level=level), ModelParameters(strips=strips))
+    pr = Simulation(scene, ModelParameters(strips=strips), Choices(level=level)).build()
     sol = solve(pr, np.array([settle_s]), rtol=1e-8, max_step=1e-6)
     y0 = sol.y[-1].copy()
     z = scene.bearing.geometry.n_balls
     y0[5 * z + 4:5 * z + 6] = 0.0  # restart the work and dissipation counters (same slots in both layouts)
     cage = theoretical_cage_speed(scene.bearing.geometry, scene.conditions.speed_rad_s)
-    return replace(pr, y0=y0, aux=sol.extra["aux"], t0=0.0), cage
+    return replace(pr, y0=y0, log=sol.extra["log"], t0=0.0), cage
 
 
 def _errors(y: npt.NDArray[np.float64], ref: npt.NDArray[np.float64], z: int, cage: float,
@@ -97,7 +96,7 @@ def _best_wall(run: Any, repeats: int) -> tuple[Any, float]:
 
 
 def _numpy_lsoda(pr: Problem, t: npt.NDArray[np.float64], rtol: float) -> Any:
-    return step_scipy(pr, t, "LSODA", rtol, max_step=2e-6, fun=lambda tt, yy, aux: reference_rhs(tt, yy, pr.params, aux))
+    return step_scipy(pr, t, "LSODA", rtol, max_step=2e-6, fun=lambda tt, yy, log: reference_rhs(tt, yy, pr.params, log))
 
 
 def accuracy_study(rpm: float = 3000.0, load_n: float = 500.0, window_s: float = 0.005, settle_s: float = 0.03,
@@ -110,7 +109,7 @@ def accuracy_study(rpm: float = 3000.0, load_n: float = 500.0, window_s: float =
     measured against the reference over that shorter window.
     """
     pr, cage = _settled_problem(rpm, load_n, settle_s)
-    z = int(pr.params[P.P_Z])
+    z = pr.n_balls
     radius = float(np.mean(pr.y0[:z]))
     t = np.linspace(0.0, window_s, 51)
     ref = solve(pr, t, rtol=1e-10, max_step=2.5e-7)
@@ -208,19 +207,19 @@ def model_study(window_s: float = 0.005, settle_s: float = 0.03, repeats: int = 
             ("500 N + 400 N axial", 400.0, "spatial", 21, (
                 ("spatial", 1, "dp5", 2e-6), ("spatial", 5, "dp5", 2e-6), ("spatial", 11, "dp5", 2e-6),
                 ("spatial", 21, "dp5", 2e-6), ("spatial", 5, "CVODE", 2e-6), ("spatial", 5, "CVODE", 5e-6)))):
-        # CVODE rows run as simulate runs them at rtol 1e-6 (rtol x 0.03, see simulation.chunks.RTOL_FACTOR)
+        # CVODE rows run as simulate runs them at rtol 1e-6 (rtol x 0.03, see simulation.auto_switch.RTOL_FACTOR)
         base, cage = _settled_problem(3000.0, 500.0, settle_s, axial, level, ref_strips)
         ref = solve(base, t, rtol=1e-9 if axial else 1e-10, max_step=5e-7)
         scene = Scene(conditions=OperatingConditions(3000.0, 500.0, axial))
         for lvl, m, method, cap in cases:
-            pr = build_problem(scene, choose_model(scene, level=lvl, force=True), ModelParameters(strips=m))
+            pr = Simulation(scene, ModelParameters(strips=m), Choices(level=lvl, force=True)).build()
             n = len(pr.y0)  # the planar state is the first 5 Z + 6 entries of the spatial one
             y0 = np.concatenate([base.y0, np.zeros(max(0, n - len(base.y0)))])[:n]
-            pr = replace(pr, y0=y0, aux=base.aux.copy())
+            pr = replace(pr, y0=y0, log=base.log.copy())
             rtol = 1e-6 * RTOL_FACTOR.get(method, 1.0)
             sol, wall = _best_wall(lambda pr=pr, method=method, cap=cap, rtol=rtol: solve(
                 pr, t, method=method, rtol=rtol, max_step=cap), repeats)
-            z = int(pr.params[P.P_Z])
+            z = pr.n_balls
             slip_pp, pos_um = _errors(sol.y[:, :5 * z + 6], ref.y[:, :5 * z + 6], z, cage, float(np.mean(pr.y0[:z])))
             label = lvl if lvl == "planar" else f"spatial, m = {m}"
             if method != "dp5":
@@ -256,7 +255,7 @@ def effects_study(rpm: float = 1800.0, radial_load_n: float = 500.0, axial_load_
     that is off for the scene (e.g. drag without an oil-air mixture) is listed as not applicable.
     """
     from cageless.profiles import angle_profile
-    from simulation.run import peak_unloaded_slip, simulate
+    from simulation.run import peak_unloaded_slip
 
     from cageless.bearing import default_bearing
     from cageless.kinematics import startup_duration
@@ -267,8 +266,8 @@ def effects_study(rpm: float = 1800.0, radial_load_n: float = 500.0, axial_load_
     full = choose_model(scene)
 
     def run(choice: Any) -> tuple[Any, float]:
-        res = simulate(scene, choice, progress=False)
-        return res.trace, res.trace.simulation.wall_s
+        trace = Simulation(scene, model=choice).run()
+        return trace, trace.simulation.wall_s
 
     def profile(trace: Any) -> npt.NDArray[np.float64]:
         keep = (trace.time >= settle_s)[:, None] & trace.valid

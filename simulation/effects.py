@@ -20,13 +20,14 @@ from __future__ import annotations
 import json
 from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass
+from typing import Any
 
 from cageless.errors import UsageError, suggest
 from simulation.scene import Scene
 
 __all__ = [
     "EffectSpec", "EffectChoice", "ModelChoice", "EFFECTS", "LEVELS", "choose_model", "parse_effect_overrides",
-    "describe_table",
+    "describe_table", "check_lubricant", "parameter_slots", "effect_flags", "register_effect",
 ]
 
 LEVELS = ("planar", "spatial")
@@ -40,6 +41,14 @@ class EffectSpec:
     physics: str
     rule: Callable[[Scene], tuple[bool, str]]
     needs_lubricant: bool = False
+    #: Slot of the effect's on/off flag in the models' parameter vector (:mod:`simulation.layout`).
+    flag: str = ""
+    #: Slots of the parameters the effect's unit reads (filled by the model from
+    #: :class:`~simulation.parameters.ModelParameters` and the bearing).
+    slots: tuple[str, ...] = ()
+    #: For an effect added by :func:`register_effect`: its slot values (name -> value) from the run's
+    #: :class:`~simulation.parameters.ModelParameters` (the built-in rows are filled by the models).
+    fill: Callable[[Any], Mapping[str, float]] | None = None
 
 
 def _always(what: str) -> Callable[[Scene], tuple[bool, str]]:
@@ -54,6 +63,11 @@ def _gravity(s: Scene) -> tuple[bool, str]:
     return (True, f"g = {s.gravity_m_s2:g} m/s^2") if s.gravity_m_s2 > 0 else (False, "g = 0")
 
 
+def _dry(s: Scene) -> tuple[bool, str]:
+    return (False, "the scene is lubricated: traction curve") if s.lubricated else (
+        True, "dry scene: bare steel contacts rub with Coulomb-Stribeck friction")
+
+
 def _drag(s: Scene) -> tuple[bool, str]:
     rho = s.oil_air_density_kg_m3
     return (True, f"oil-air mixture of {rho:g} kg/m^3") if rho is not None else (False, "no oil-air mixture given")
@@ -61,20 +75,42 @@ def _drag(s: Scene) -> tuple[bool, str]:
 
 EFFECTS: tuple[EffectSpec, ...] = (
     EffectSpec("race_contact", "Hertz point contact Q = K delta^1.5 between ball and inner/outer groove",
-               _always("balls always touch the races")),
+               _always("balls always touch the races"), flag="F_RACE", slots=("KI", "KO")),
     EffectSpec("lubricant_damping", "normal damping C_ho d(delta)/dt at race contacts, never tensile", _lubricated,
-               needs_lubricant=True),
+               needs_lubricant=True, flag="F_LUB", slots=("CHO",)),
     EffectSpec("race_traction", "traction mu(slip) at race contacts (dry: Coulomb-Stribeck)",
-               _always("traction drives the balls")),
+               _always("traction drives the balls"), flag="F_TRAC", slots=("TA", "TB", "TC", "TD", "U_FLOOR")),
     EffectSpec("ehl_film", "Hamrock-Dowson central and minimum film at race contacts", _lubricated,
-               needs_lubricant=True),
+               needs_lubricant=True, flag="F_FILM"),
     EffectSpec("ball_ball_contact", "Hertz contact between neighbours with hysteresis damping (restitution R) "
-               "and friction from the surface sliding speed", _always("no cage: neighbours meet")),
-    EffectSpec("ball_ball_film", "squeeze film between neighbouring balls", _lubricated, needs_lubricant=True),
-    EffectSpec("gravity", "m g on balls and ring", _gravity),
-    EffectSpec("drag", "1/2 C_D rho A V^2 against the orbital motion (no churning moment on the spin)", _drag),
+               "and friction from the surface sliding speed", _always("no cage: neighbours meet"), flag="F_BB",
+               slots=("KB", "CHI", "V_IN_MIN")),
+    EffectSpec("ball_ball_film", "squeeze film between neighbouring balls", _lubricated, needs_lubricant=True,
+               flag="F_BBFILM", slots=("ETA0", "H0")),
+    EffectSpec("gravity", "m g on balls and ring", _gravity, flag="F_GRAV", slots=("G",)),
+    EffectSpec("drag", "1/2 C_D rho A V^2 against the orbital motion (no churning moment on the spin)", _drag,
+               flag="F_DRAG", slots=("CD", "RHO_MIX")),
+    EffectSpec("dry_friction", "Coulomb-Stribeck friction of bare steel instead of the traction curve, at race and "
+               "ball-ball contacts", _dry, flag="DRY", slots=("MU_DRY", "V_REG", "MU_STATIC", "V_STRIBECK")),
 )
 _BY_NAME = {e.name: e for e in EFFECTS}
+
+
+def register_effect(spec: EffectSpec) -> None:
+    """Add a row to the effects table (a new physics unit: see :mod:`simulation.models.race_laws`).
+
+    Raises
+    ------
+    ValueError
+        For a name, flag or slot already in the table.
+    """
+    global EFFECTS
+    taken = {n for e in EFFECTS for n in (e.name, e.flag, *e.slots)}
+    clash = {spec.name, spec.flag, *spec.slots} & taken
+    if clash or not spec.flag:
+        raise ValueError(f"effect {spec.name!r}: needs a flag slot and new names; taken: {sorted(clash)}")
+    EFFECTS = (*EFFECTS, spec)
+    _BY_NAME[spec.name] = spec
 
 
 @dataclass(frozen=True)
@@ -160,8 +196,7 @@ def choose_model(scene: Scene, level: str | None = None, effects: Mapping[str, b
         on, reason = spec.rule(scene)
         if spec.name in overrides and overrides[spec.name] != on:
             want = overrides[spec.name]
-            if want and spec.needs_lubricant and not scene.lubricated:
-                raise UsageError(f"--effect {spec.name}=on needs a lubricant, and the bearing is dry.")
+            check_lubricant({spec.name: want}, scene.lubricated)
             if not force:
                 raise UsageError(f"--effect {spec.name}={'on' if want else 'off'} contradicts the scene "
                                  f"({reason}). Add --force to override.")
@@ -169,7 +204,49 @@ def choose_model(scene: Scene, level: str | None = None, effects: Mapping[str, b
                                         f"(the scene alone: {reason})", forced=True))
         else:
             choices.append(EffectChoice(spec.name, on, reason))
+    check_lubricant({c.name: c.on for c in choices}, scene.lubricated)
     return ModelChoice(level=chosen_level, level_reason=level_reason, effects=tuple(choices))
+
+
+def check_lubricant(on: Mapping[str, bool], lubricated: bool) -> None:
+    """The one check that the effects ``on`` (name -> on) fit the bearing: no lubricant effect on a dry bearing,
+    and no dry bearing without its dry friction while a friction law is needed.
+
+    Raises
+    ------
+    UsageError
+        Naming the effect and the override that fixes it.
+    """
+    if lubricated:
+        return
+    for spec in EFFECTS:
+        if spec.needs_lubricant and on.get(spec.name, False):
+            raise UsageError(f"--effect {spec.name}=on needs a lubricant, and the bearing is dry: "
+                             f"drop it (--effect {spec.name}=off) or add a lubricant.")
+    if on.get("race_traction", False) and not on.get("dry_friction", False):
+        raise UsageError("race traction on a dry bearing needs the dry_friction effect (--effect dry_friction=on): "
+                         "the traction curve is a lubricated law.")
+
+
+def parameter_slots(body: tuple[str, ...]) -> tuple[str, ...]:
+    """A model's parameter slots: its ``body`` slots, then each effect's flag and parameter slots in table order
+    (a slot two effects read is listed once)."""
+    names = list(body)
+    for spec in EFFECTS:
+        for name in (spec.flag, *spec.slots):
+            if name not in names:
+                names.append(name)
+    return tuple(names)
+
+
+def effect_flags(on: Mapping[str, bool]) -> dict[str, float]:
+    """Flag slot -> 1.0 or 0.0 for every effect of the table; an effect ``on`` does not name is off."""
+    unknown = set(on) - set(_BY_NAME)
+    if unknown:
+        name = sorted(unknown)[0]
+        raise UsageError(f"--effect {name}: unknown effect." + (suggest(name, _BY_NAME) or
+                         f" Effects: {', '.join(_BY_NAME)}."))
+    return {spec.flag: float(bool(on.get(spec.name, False))) for spec in EFFECTS}
 
 
 def parse_effect_overrides(items: list[str]) -> dict[str, bool]:

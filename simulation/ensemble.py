@@ -10,13 +10,11 @@ pool does not survive a fork).
 
 from __future__ import annotations
 
-import dataclasses
 from pathlib import Path
 from typing import Any
 
 from cageless.parallel import gather, job_pool
-from simulation.effects import ModelChoice
-from simulation.scene import Scene
+from simulation.simulation import Simulation
 
 __all__ = ["run_ensemble", "seed_path"]
 
@@ -29,27 +27,29 @@ def seed_path(out: str | Path, seed: int) -> Path:
     return out.with_name(f"{stem}_seed{seed}{suffix}")
 
 
-def _one(scene: Scene, choice: ModelChoice, out: str, kw: dict[str, Any]) -> dict[str, Any]:
-    from simulation.run import peak_unloaded_slip, simulate
+def _one(sim: Simulation, out: str, config: dict[str, Any] | None) -> dict[str, Any]:
+    from simulation.run import peak_unloaded_slip
 
-    res = simulate(scene, choice, out=out, progress=False, **kw)
-    tr, sol = res.trace, res.solution
+    tr = sim.run(out=out, progress=False, config=config)
+    sol = sim.solution
+    assert sol is not None
     peak = peak_unloaded_slip(tr)
-    return {"seed": scene.seed, "success": sol.success, "path": out, "peak_unloaded_slip": peak,
+    return {"seed": sim.scene.seed, "success": sol.success, "path": out, "peak_unloaded_slip": peak,
             "summary": f"{tr.status}, {sol.n_steps} steps, {tr.simulation.wall_s:.1f} s wall, "
                        f"peak unloaded slip {100 * peak:.2f}% -> {out}"}
 
 
-def run_ensemble(scene: Scene, choice: ModelChoice, n_seeds: int, out: str | Path, workers: int = 2,
-                 progress: bool = True, scheduler: str | None = None, **kw: Any) -> list[dict[str, Any]]:
-    """Run seeds 0..n_seeds-1 of ``scene``; one row per seed, in seed order.
+def run_ensemble(sim: Simulation, n_seeds: int, out: str | Path, workers: int = 2, progress: bool = True,
+                 scheduler: str | None = None, config: dict[str, Any] | None = None) -> list[dict[str, Any]]:
+    """Run seeds 0..n_seeds-1 of ``sim`` (:meth:`~simulation.simulation.Simulation.with_seed`); one row per seed,
+    in seed order. ``config`` adds to each trace's recorded configuration.
 
     Locally the seeds run in ``workers`` spawned processes; with ``scheduler`` (a Dask scheduler
     address) each seed is one task on that cluster, and the traces are written by the workers (so
     ``out`` must be on storage they share).
     """
-    scenes = [dataclasses.replace(scene, seed=k) for k in range(n_seeds)]
+    members = [sim.with_seed(k) for k in range(n_seeds)]
     paths = [str(Path(seed_path(out, k)).resolve()) for k in range(n_seeds)]
     with job_pool(min(workers, n_seeds), scheduler) as pool:
-        return gather([pool.submit(_one, s, choice, p, kw) for s, p in zip(scenes, paths, strict=True)], "seeds",
+        return gather([pool.submit(_one, m, p, config) for m, p in zip(members, paths, strict=True)], "seeds",
                       progress)

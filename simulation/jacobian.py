@@ -67,14 +67,14 @@ def ball_colours(n_balls: int) -> IntArray:
 
 
 @numba.njit(cache=True)
-def _structured_fd(model_id, t, y, p, aux, ball_cols, groups, ring_rows, other_cols, floor, jac,
+def _structured_fd(model_id, t, y, p, log, ball_cols, groups, ring_rows, other_cols, floor, jac,
                    y_work, f0, f1, share0, share1):  # pragma: no cover - compiled
     """Fill ``jac`` (n x n, dense storage) with the grouped difference quotients."""
     n, n_fields, z, n_ring = y.shape[0], ball_cols.shape[0], ball_cols.shape[1], ring_rows.shape[0]
     jac[:, :] = 0.0
-    model_rhs(model_id, t, y, p, aux, f0)
+    model_rhs(model_id, t, y, p, log, f0)
     for j in range(z):
-        model_ring_share(model_id, t, y, p, aux, j, share0[j])
+        model_ring_share(model_id, t, y, p, log, j, share0[j])
     y_work[:] = y
     for f in range(n_fields):
         for c in range(groups.shape[0]):
@@ -84,7 +84,7 @@ def _structured_fd(model_id, t, y, p, aux, ball_cols, groups, ring_rows, other_c
                     break
                 col = ball_cols[f, j]
                 y_work[col] = y[col] + _SRUR * max(abs(y[col]), floor[col])
-            model_rhs(model_id, t, y_work, p, aux, f1)
+            model_rhs(model_id, t, y_work, p, log, f1)
             for m in range(groups.shape[1]):
                 j = groups[c, m]
                 if j < 0:
@@ -96,7 +96,7 @@ def _structured_fd(model_id, t, y, p, aux, ball_cols, groups, ring_rows, other_c
                     for ff in range(n_fields):
                         row = ball_cols[ff, jj]
                         jac[row, col] = (f1[row] - f0[row]) / h
-                model_ring_share(model_id, t, y_work, p, aux, j, share1)
+                model_ring_share(model_id, t, y_work, p, log, j, share1)
                 for q in range(n_ring):
                     jac[ring_rows[q], col] = (share1[q] - share0[j, q]) / h
                 y_work[col] = y[col]
@@ -104,7 +104,7 @@ def _structured_fd(model_id, t, y, p, aux, ball_cols, groups, ring_rows, other_c
         col = other_cols[k]
         y_work[col] = y[col] + _SRUR * max(abs(y[col]), floor[col])
         h = y_work[col] - y[col]
-        model_rhs(model_id, t, y_work, p, aux, f1)
+        model_rhs(model_id, t, y_work, p, log, f1)
         for i in range(n):
             jac[i, col] = (f1[i] - f0[i]) / h
         y_work[col] = y[col]
@@ -131,7 +131,7 @@ class JacobianStructure:
         """The structure of ``problem``'s model, or None for a model without one (the test models)."""
         if problem.model_id not in (PLANAR, SPATIAL):
             return None
-        z = int(problem.params[planar.P_Z])
+        z = problem.n_balls
         n = len(problem.y0)
         if problem.model_id == PLANAR:
             fields = [list(range(f * z, (f + 1) * z)) for f in range(5)]
@@ -166,7 +166,7 @@ class JacobianStructure:
         """Right-hand sides per Jacobian: one per (field, colour), one per ring state, one at the base point."""
         return self.ball_cols.shape[0] * self.groups.shape[0] + len(self.other_cols) + 1
 
-    def evaluator(self, problem: Problem, aux: FloatArray, floor: FloatArray):  # noqa: ANN201 - a closure
+    def evaluator(self, problem: Problem, log: FloatArray, floor: FloatArray):  # noqa: ANN201 - a closure
         """A function ``(t, y, jac)`` filling ``jac`` (n x n) for ``problem`` with this structure.
 
         ``floor`` (per state) sets the smallest perturbation scale: the increment of state i is
@@ -180,7 +180,7 @@ class JacobianStructure:
 
         def evaluate(t: float, y: FloatArray, jac: FloatArray) -> None:
             work[3][:] = y
-            _structured_fd(problem.model_id, float(t), work[3], problem.params, aux, self.ball_cols, self.groups,
+            _structured_fd(problem.model_id, float(t), work[3], problem.params, log, self.ball_cols, self.groups,
                            self.ring_rows, self.other_cols, floor, jac, work[0], work[1], work[2],
                            share0, share1)
 

@@ -19,27 +19,27 @@ OSCILLATOR, RICCATI = textbook.OSCILLATOR, textbook.RICCATI
 
 
 @numba.njit(cache=True)
-def model_rhs(model_id, t, y, p, aux, dydt):  # pragma: no cover - compiled
+def model_rhs(model_id, t, y, p, log, dydt):  # pragma: no cover - compiled
     """dy/dt of model ``model_id`` into ``dydt``."""
     if model_id == PLANAR:
-        planar.planar_rhs(t, y, p, aux, dydt)
+        planar.planar_rhs(t, y, p, log, dydt)
     elif model_id == SPATIAL:
-        spatial.spatial_rhs(t, y, p, aux, dydt)
+        spatial.spatial_rhs(t, y, p, log, dydt)
     elif model_id == TWO_BALLS:
-        two_balls.two_ball_rhs(t, y, p, aux, dydt)
+        two_balls.two_ball_rhs(t, y, p, log, dydt)
     elif model_id == OSCILLATOR:
-        textbook.oscillator_rhs(t, y, p, aux, dydt)
+        textbook.oscillator_rhs(t, y, p, log, dydt)
     else:
-        textbook.riccati_rhs(t, y, p, aux, dydt)
+        textbook.riccati_rhs(t, y, p, log, dydt)
 
 
 @numba.njit(cache=True)
-def model_post(model_id, t, y, p, aux):  # pragma: no cover - compiled
+def model_post(model_id, t, y, p, log):  # pragma: no cover - compiled
     """Bookkeeping after an accepted step (contact episodes)."""
     if model_id == PLANAR or model_id == SPATIAL:
-        planar.planar_post(t, y, p, aux)
+        planar.planar_post(t, y, p, log)
     elif model_id == TWO_BALLS:
-        two_balls.two_ball_post(t, y, p, aux)
+        two_balls.two_ball_post(t, y, p, log)
 
 
 @numba.njit(cache=True)
@@ -63,10 +63,10 @@ def model_gaps(model_id, y, p, out):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def model_ring_share(model_id, t, y, p, aux, j, out):  # pragma: no cover - compiled
+def model_ring_share(model_id, t, y, p, log, j, out):  # pragma: no cover - compiled
     """Ball j's additive share of the rows every ball reaches (the ring's accelerations), for the structured
     Jacobian of :mod:`simulation.jacobian`. Only the ball-bearing models have one."""
     if model_id == PLANAR:
-        planar.planar_ring_share(t, y, p, aux, j, out)
+        planar.planar_ring_share(t, y, p, log, j, out)
     elif model_id == SPATIAL:
-        spatial.spatial_ring_share(t, y, p, aux, j, out)
+        spatial.spatial_ring_share(t, y, p, log, j, out)

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import math
-import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -18,26 +17,23 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from cageless.errors import ParameterError, UsageError, suggest
+from cageless.errors import UsageError
 from cageless.kinematics import slip_rate, theoretical_cage_speed
 from cageless.profiles import angle_profile
-from cageless.provenance import Provenance
-from cageless.trace import SimulationInfo, Trace, write_trace
+from cageless.trace import SimulationInfo, Trace
 from simulation.effects import ModelChoice
 from simulation.hertz import compliance, hertz_contact, race_curvatures
-from simulation.models.planar_reference import tangential_force
-from simulation.traction import film_coefficient
 from simulation.models import planar as P
 from simulation.models import spatial as S
+from simulation.models.observables import observables
 from simulation.parameters import ModelParameters
 from simulation.quasistatic import radial_load_distribution
 from simulation.scene import Scene
 from simulation.problem import Problem
-from simulation.chunks import CONTACT_MAX_STEP_S, MAX_STEP_S, RTOL_FACTOR, solve_chunks
-from simulation.solve import FORCE_JUMP, METHODS, Solution
+from simulation.solve import FORCE_JUMP, Solution
 
 __all__ = ["SimulationResult", "EnergyBalance", "build_problem", "check_supported", "energy_balance", "initial_state",
-           "simulate",
+           "simulate", "to_trace",
            "peak_unloaded_slip",
            "UNLOADED_ZONE_DEG"]
 
@@ -117,82 +113,6 @@ def build_problem(scene: Scene, choice: ModelChoice, parameters: ModelParameters
     return P.planar_problem(scene.bearing, theta, radius, ring, scene.conditions.radial_load_n, **kw)
 
 
-def _observables(pr: Problem, y: npt.NDArray[np.float64], scene: Scene,
-                 film_on: bool) -> dict[str, dict[str, np.ndarray]]:
-    """Contact forces (elastic normal part and traction), films, positions and spins along the samples."""
-    p = pr.params
-    z = int(p[P.P_Z])
-    d, half = p[P.P_D], 0.5 * p[P.P_D]
-    r, th, rd, thd, om = (y[:, i * z:(i + 1) * z] for i in range(5))
-    cy, cz, cvy, cvz = (y[:, 5 * z + i][:, None] for i in range(4))
-    w_i = p[P.P_WI]
-    outer = p[P.P_KO] * np.clip(r + half - 0.5 * p[P.P_DO], 0, None) ** 1.5
-    sx, sz = r * np.cos(th) - cy, r * np.sin(th) - cz
-    ln = np.hypot(sx, sz)
-    inner = p[P.P_KI] * np.clip(0.5 * p[P.P_DI] + half - ln, 0, None) ** 1.5
-    spatial = pr.model_id == S.MODEL_ID
-    axial, axial_dot = ((y[:, S.SpatialLayout(z).slices()[k]] for k in ("axial", "axial_dot")) if spatial
-                        else (np.zeros_like(r), np.zeros_like(r)))
-    bb = p[P.P_KB] * np.clip(d - _centre_gap(r, th, axial), 0, None) ** 1.5
-    u_o = r * thd + half * om
-    ur_o = 0.5 * np.abs(u_o - p[P.P_DO] * thd)
-    vt = (rd * np.sin(th) + r * thd * np.cos(th) - cvz) * sx / ln - (rd * np.cos(th) - r * thd * np.sin(th) - cvy) * sz / ln
-    r_i = 0.5 * p[P.P_DI]
-    u_i = vt - half * om - w_i * r_i
-    ur_i = 0.5 * np.abs(vt * (1 - 2 * r_i / ln) - half * om + w_i * r_i)
-    contacts = {"inner_normal": inner, "outer_normal": outer, "ball_ball_normal": bb}
-    if p[P.P_F_TRAC] > 0.5:
-        contacts["inner_traction"] = -tangential_force(u_i, ur_i, inner, p)
-        contacts["outer_traction"] = -tangential_force(u_o, ur_o, outer, p)
-    if film_on:
-        contacts.update(_films(scene, inner, outer, ur_i, ur_o))
-    spin = np.zeros((len(y), z, 3))
-    spin[:, :, 0] = om
-    ring = np.column_stack([np.zeros(len(y)), cy[:, 0], cz[:, 0]])
-    tilt = np.zeros((len(y), 2))
-    if spatial:
-        tilt = y[:, -4:-2] + pr.params[[S.P_TILT_Y, S.P_TILT_Z]]  # about y and z: misalignment plus the free tilt
-        sl = S.SpatialLayout(z).slices()
-        spin[:, :, 1], spin[:, :, 2] = y[:, sl["spin_y"]], y[:, sl["spin_z"]]
-        ring[:, 0] = y[:, sl["ring_axial"]][:, 0]
-        for race, (overlap, angle, point) in S.race_geometry(pr, y).items():
-            k_n = p[P.P_KI] if race == "inner" else p[P.P_KO]
-            contacts[f"{race}_normal"] = k_n * overlap**1.5
-            contacts[f"{race}_angle"] = angle
-            contacts[f"{race}_point"] = point
-    if p[P.P_F_TRAC] > 0.5:
-        contacts["ball_ball_traction"] = _ball_ball_traction(p, r, th, rd, thd, axial, axial_dot, spin, bb)
-    return {
-        "balls": {"radius": r, "axial": axial, "spin": spin},
-        "contacts": contacts,
-        "inner_ring": {"position": ring, "tilt": tilt},
-    }
-
-
-def _centre_gap(r: np.ndarray, th: np.ndarray, axial: np.ndarray) -> np.ndarray:
-    """Distance (m) between the centres of ball j and ball j+1 (T, Z)."""
-    pos = np.stack([axial, r * np.cos(th), r * np.sin(th)], axis=-1)
-    return np.linalg.norm(np.roll(pos, -1, axis=1) - pos, axis=-1)
-
-
-def _ball_ball_traction(p: np.ndarray, r: np.ndarray, th: np.ndarray, rd: np.ndarray, thd: np.ndarray,
-                        axial: np.ndarray, axial_dot: np.ndarray, spin: np.ndarray, normal: np.ndarray) -> np.ndarray:
-    """Magnitude (N) of the friction between ball j and ball j+1 (T, Z), from the sliding of their surfaces
-    along the contact plane, as in the models' pair forces (elastic normal force; 0 where apart)."""
-    z = r.shape[1]
-    half = 0.5 * p[P.P_D]
-    pos = np.stack([axial, r * np.cos(th), r * np.sin(th)], axis=-1)
-    vel = np.stack([axial_dot, rd * np.cos(th) - r * thd * np.sin(th), rd * np.sin(th) + r * thd * np.cos(th)], -1)
-    k = np.roll(np.arange(z), -1)
-    n = pos[:, k] - pos
-    n /= np.linalg.norm(n, axis=-1, keepdims=True)
-    u = vel - vel[:, k] + np.cross(spin + spin[:, k], half * n)  # surface of j against j+1
-    u -= np.sum(u * n, axis=-1, keepdims=True) * n
-    u_s = np.linalg.norm(u, axis=-1)
-    u_r = 0.5 * half * np.linalg.norm(np.cross(spin - spin[:, k], n), axis=-1)
-    return np.abs(tangential_force(u_s, u_r, normal, p))
-
-
 @dataclass(frozen=True)
 class EnergyBalance:
     """The energy account along a solution's samples (J): the drive's input work, the energy dissipated, and
@@ -210,8 +130,7 @@ class EnergyBalance:
 
 def energy_balance(problem: Problem, y: npt.NDArray[np.float64]) -> EnergyBalance:
     """The energy account of ``problem`` along samples ``y`` (T, n), planar or spatial."""
-    z = int(problem.params[P.P_Z])
-    sl = P.PlanarLayout(z).slices()  # the counters sit at the same slots in the spatial layout
+    sl = P.PlanarLayout(problem.n_balls).slices()  # the counters sit at the same slots in the spatial layout
     work, lost = y[:, sl["input_work"]][:, 0], y[:, sl["dissipated"]][:, 0]
     energy = S.spatial_energy(problem, y) if problem.model_id == S.MODEL_ID else P.planar_energy(problem, y)
     return EnergyBalance(balance=energy + lost - work, input_work=work, dissipated=lost)
@@ -229,74 +148,27 @@ def nominal_contact_angle(scene: Scene, groups: dict[str, dict[str, np.ndarray]]
     return float(np.median(np.abs(angle[loaded]))) if loaded.any() else 0.0
 
 
-def _films(scene: Scene, inner: np.ndarray, outer: np.ndarray, ur_i: np.ndarray,
-           ur_o: np.ndarray) -> dict[str, np.ndarray]:
-    """Hamrock-Dowson central film (m) at the race contacts (NaN where a contact is open)."""
-    b = scene.bearing
-    g, lub = b.geometry, b.lubricant
-    assert lub is not None
-    eta = compliance(b.material)
-    rc = race_curvatures(g)
-    d = g.ball_diameter_m
-    rx = {"inner": 1.0 / (2.0 / d + 2.0 / g.inner_race_diameter_m), "outer": 1.0 / (2.0 / d - 2.0 / g.outer_race_diameter_m)}
-    out = {}
-    for race, q, u in (("inner", inner, ur_i), ("outer", outer, ur_o)):
-        c_h = film_coefficient(hertz_contact(*rc[race], eta), rx[race], lub.dynamic_viscosity_pa_s,
-                               lub.pressure_viscosity_coefficient_1_pa, 2.0 / eta)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            out[f"{race}_film"] = np.where(q > 0, c_h * np.maximum(u, 1e-6) ** 0.67 * q ** -0.067, np.nan)
-    return out
-
-
 def simulate(scene: Scene, choice: ModelChoice, parameters: ModelParameters | None = None, rtol: float = 1e-6,
              sample_rate_hz: float = 10_000.0, method: str = "auto", max_step: float | None = None,
              out: str | Path | None = None, progress: bool = True, config: dict[str, Any] | None = None,
              max_steps: int = 50_000_000, force_jump: float = FORCE_JUMP) -> SimulationResult:
-    """Run ``scene`` with the model ``choice`` and (with ``out``) write the trace atomically.
-
-    ``method`` is ``"auto"`` (compiled DP5, switching to a stiff solver when that pays: see
-    :mod:`simulation.chunks`) or a key of :data:`simulation.solve.METHODS`. ``max_step`` (s) caps every
-    step; None gives each method its default (:func:`simulation.chunks.default_max_step`: 2 us, 5 us
-    for CVODE, also after an automatic switch); CVODE runs at ``rtol x 0.03`` to match DP5's accuracy
-    (:data:`simulation.chunks.RTOL_FACTOR`). ``max_steps`` bounds the
-    accepted plus rejected steps of the whole run; ``force_jump`` is the force-jump fraction of
-    :func:`simulation.solve.solve`.
+    """Run ``scene`` with the model ``choice``: :class:`simulation.simulation.Simulation` with these settings
+    (see :class:`~simulation.simulation.Choices` for them), its solution, trace and problem together.
 
     A solver failure does not raise: the result's ``solution.success`` is False and the trace's
     ``status`` says ``"incomplete: <why>"``; samples after the failure are NaN.
     """
-    check_supported(scene, choice)
-    if method != "auto" and method not in METHODS:
-        raise ParameterError("method", "is not a solver" + (suggest(method, [*METHODS, "auto"]) or
-                                                            f"; use auto or one of {list(METHODS)}"), method)
-    if max_step is not None and not (0 < max_step < np.inf):
-        raise ParameterError("max_step", "must be a positive number of seconds, or None for the defaults", max_step)
-    par = parameters or ModelParameters()
-    prov = Provenance.start(config={"scene": scene.to_dict(), "model": json.loads(choice.to_json()),
-                                    "solver": {"method": method, "rtol": rtol, "max_step": max_step,
-                                               "default_max_step_s": {**MAX_STEP_S, "others": CONTACT_MAX_STEP_S},
-                                               "rtol_factor": RTOL_FACTOR,
-                                               "force_jump": force_jump},
-                                    "parameters": par.to_dict(), **(config or {})})
-    pr = build_problem(scene, choice, par)
-    t = np.arange(0.0, scene.duration_s + 0.5 / sample_rate_hz, 1.0 / sample_rate_hz)
-    start = time.perf_counter()
-    sol = solve_chunks(pr, t, rtol, method, max_step, min(50, len(t) - 1), progress, max_steps, force_jump)
-    wall = time.perf_counter() - start
-    provenance = prov.finish().to_dict()
-    provenance["solver_stats"] = {"n_steps": sol.n_steps, "n_rejected": sol.n_rejected, "n_rhs": sol.n_rhs,
-                                  "n_onset_retries": sol.n_onset_retries, "n_contact_changes": sol.n_contact_changes,
-                                  "n_force_jump_retries": sol.n_force_jump_retries,
-                                  "n_stiff_steps": sol.n_stiff_steps, "method": sol.method,
-                                  "switch_probes": sol.extra.get("switches", []),
-                                  "onset_step_s": pr.onset_step, "wall_s": wall}
-    trace = _to_trace(scene, choice, pr, sol, rtol, wall, provenance)
-    if out is not None:
-        write_trace(out, trace)
-    return SimulationResult(solution=sol, trace=trace, problem=pr)
+    from simulation.simulation import Choices, Simulation
+
+    sim = Simulation(scene, parameters, Choices(method=method, rtol=rtol, max_step=max_step,
+                                                sample_rate_hz=sample_rate_hz, max_steps=max_steps,
+                                                force_jump=force_jump), model=choice)
+    trace = sim.run(out=out, progress=progress, config=config)
+    assert sim.solution is not None and sim.problem is not None
+    return SimulationResult(solution=sim.solution, trace=trace, problem=sim.problem)
 
 
-def _to_trace(scene: Scene, choice: ModelChoice, pr: Problem, sol: Solution, rtol: float, wall: float,
+def to_trace(scene: Scene, choice: ModelChoice, pr: Problem, sol: Solution, rtol: float, wall: float,
               provenance: dict[str, Any]) -> Trace:
     g = scene.bearing.geometry
     z = g.n_balls
@@ -304,11 +176,11 @@ def _to_trace(scene: Scene, choice: ModelChoice, pr: Problem, sol: Solution, rto
     ok = np.all(np.isfinite(y), axis=1)
     angle, speed = y[:, z:2 * z], y[:, 3 * z:4 * z]
     film_on = any(e.name == "ehl_film" and e.on for e in choice.effects)
-    groups = _observables(pr, np.where(ok[:, None], y, np.nan), scene, film_on)
+    groups = observables(pr, np.where(ok[:, None], y, np.nan), scene, film_on)
     alpha = nominal_contact_angle(scene, groups)
     provenance["config"]["nominal_contact_angle_rad"] = alpha
     omega_c = theoretical_cage_speed(g, scene.conditions.speed_rad_s, alpha)
-    events = P.contact_events(pr, sol.extra["aux"], float(sol.t[ok][-1]) if ok.any() else 0.0)
+    events = P.contact_events(pr, sol.extra["log"], float(sol.t[ok][-1]) if ok.any() else 0.0)
     status = "complete" if sol.success else f"incomplete: {sol.message} at t = {sol.t[ok][-1] if ok.any() else 0:g} s"
     return Trace(
         source="simulation", time=sol.t, angle=angle, speed=speed, slip=slip_rate(speed, omega_c),

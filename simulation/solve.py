@@ -8,10 +8,11 @@
 * ``"CVODE"``: SUNDIALS CVODE's variable-order BDF (orders 1-5, Newton iteration) through
   scikit-sundae, on the compiled right-hand side, with the structured Jacobian of
   :mod:`simulation.jacobian` (see :data:`JACOBIANS`): the stiff backend the automatic switch of
-  :mod:`simulation.chunks` goes to. Its loop is compiled C, so a step costs the right-hand-side calls
+  :mod:`simulation.auto_switch` goes to. Its loop is compiled C, so a step costs the right-hand-side calls
   plus 17 us (planar) to 30 us (spatial) of Python and dense linear algebra;
 * ``"RK45"``, ``"DOP853"``, ``"LSODA"``, ``"BDF"``, ``"Radau"``: scipy's ``solve_ivp`` steppers on the
-  same compiled right-hand side, as references; the implicit ones get the structured Jacobian too.
+  same compiled right-hand side, as references; the implicit ones get the structured Jacobian too;
+* ``"auto"``: compiled DP5 switching to CVODE where that pays (:mod:`simulation.auto_switch`).
 
 CVODE and scipy's steppers are stepped one accepted step at a time here, so the accepted-step
 bookkeeping (contact episodes) runs after every step as it does in the compiled loop. They cannot
@@ -30,7 +31,7 @@ import time
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Protocol
 
 import numba
 import numpy as np
@@ -40,11 +41,10 @@ from scipy.integrate import BDF, DOP853, LSODA, RK45, Radau
 from cageless.errors import ParameterError, suggest
 from simulation.integrators.dp5 import STATUS_OK, dp5_integrate
 from simulation.jacobian import JacobianStructure
-from simulation.kernels import PLANAR, SPATIAL, model_gaps, model_post, model_rhs
-from simulation.models.planar import P_Z
+from simulation.kernels import model_gaps, model_post, model_rhs
 from simulation.problem import Problem
 
-__all__ = ["FORCE_JUMP", "Problem", "Solution", "METHODS", "CvodeSession", "solve", "step_scipy", "step_cvode"]
+__all__ = ["FORCE_JUMP", "Problem", "Solution", "Method", "METHODS", "CvodeSession", "solve", "step_scipy", "step_cvode"]
 
 FloatArray = npt.NDArray[np.float64]
 _SCIPY = {"RK45": RK45, "DOP853": DOP853, "LSODA": LSODA, "BDF": BDF, "Radau": Radau}
@@ -90,17 +90,17 @@ def _compiled(name: str, integrate: Callable[..., int]) -> Callable[..., Solutio
         out = np.full((len(t_eval), len(pr.y0)), np.nan)
         stats = np.zeros(8)
         floor = np.zeros(len(pr.y0)) if pr.jump_floor is None else pr.jump_floor.astype(np.float64)
-        aux = pr.aux.copy()
+        log = pr.log.copy()
         h0 = first_step or min(max_step, 1e-3 * max(t_eval[-1] - pr.t0, 1e-12))
         t0 = time.perf_counter()
-        status = integrate(pr.model_id, pr.params, aux, pr.y0.astype(np.float64), float(pr.t0), t_eval, float(rtol),
+        status = integrate(pr.model_id, pr.params, log, pr.y0.astype(np.float64), float(pr.t0), t_eval, float(rtol),
                            pr.atol.astype(np.float64), float(h0), float(max_step), int(max_steps), out, stats,
                            float(pr.onset_step), floor, float(force_jump if pr.jump_floor is not None else 0.0))
         return Solution(t=t_eval, y=out, status=int(status), message=_MESSAGES[int(status)], method=name,
                         n_steps=int(stats[0]), n_rejected=int(stats[1]), n_rhs=int(stats[2]),
                         wall_s=time.perf_counter() - t0, n_onset_retries=int(stats[4]),
                         n_contact_changes=int(stats[5]), n_force_jump_retries=int(stats[6]),
-                        n_stiff_steps=int(stats[7]), extra={"aux": aux, "last_h": float(stats[3])})
+                        n_stiff_steps=int(stats[7]), extra={"log": log, "last_h": float(stats[3])})
 
     return run
 
@@ -110,28 +110,28 @@ def step_scipy(pr: Problem, t_eval: FloatArray, method: str, rtol: float, max_st
                fun: Callable[[float, FloatArray, FloatArray], FloatArray] | None = None) -> Solution:
     """Step one of scipy's ``solve_ivp`` steppers, running the model's accepted-step bookkeeping after each step.
 
-    ``fun(t, y, aux)`` replaces the compiled right-hand side (the benchmarks pass the numpy reference).
+    ``fun(t, y, log)`` replaces the compiled right-hand side (the benchmarks pass the numpy reference).
     """
-    aux = pr.aux.copy()
+    log = pr.log.copy()
     buf = np.empty(len(pr.y0))
     count = [0]
 
-    def compiled(t: float, y: FloatArray, aux: FloatArray) -> FloatArray:
-        model_rhs(pr.model_id, t, y, pr.params, aux, buf)
+    def compiled(t: float, y: FloatArray, log: FloatArray) -> FloatArray:
+        model_rhs(pr.model_id, t, y, pr.params, log, buf)
         return buf.copy()
 
     rhs = fun or compiled
 
     def counted(t: float, y: FloatArray) -> FloatArray:
         count[0] += 1
-        return rhs(t, y, aux)
+        return rhs(t, y, log)
 
     kw: dict[str, Any] = {"max_step": max_step}
     if first_step:
         kw["first_step"] = first_step
     structure = JacobianStructure.for_problem(pr) if fun is None and method in _IMPLICIT else None
     if structure is not None:  # the compiled path gets the structured Jacobian (DESIGN §7: its sparsity)
-        evaluate, jac = structure.evaluator(pr, aux, pr.atol / rtol), np.empty((len(pr.y0), len(pr.y0)))
+        evaluate, jac = structure.evaluator(pr, log, pr.atol / rtol), np.empty((len(pr.y0), len(pr.y0)))
 
         def jacobian(t: float, y: FloatArray) -> FloatArray:
             count[0] += structure.rhs_per_jacobian
@@ -155,14 +155,14 @@ def step_scipy(pr: Problem, t_eval: FloatArray, method: str, rtol: float, max_st
             status, message = 3, str(msg)
             break
         steps += 1
-        model_post(pr.model_id, solver.t, solver.y, pr.params, aux)  # accepted-step bookkeeping
+        model_post(pr.model_id, solver.t, solver.y, pr.params, log)  # accepted-step bookkeeping
         if k < len(t_eval) and (t_eval[k] <= solver.t or solver.status == "finished"):
             dense = solver.dense_output()
             while k < len(t_eval) and (t_eval[k] <= solver.t or solver.status == "finished"):
                 y[k] = dense(t_eval[k])
                 k += 1
     return Solution(t=t_eval, y=y, status=status, message=message, method=method, n_steps=steps, n_rhs=count[0],
-                    wall_s=time.perf_counter() - start, extra={"aux": aux})
+                    wall_s=time.perf_counter() - start, extra={"log": log})
 
 
 def _cvode_status(y: FloatArray, status: int) -> int:
@@ -194,7 +194,7 @@ def _jacobian_options(pr: Problem, session: CvodeSession, jacobian: str, rtol: f
     structure = JacobianStructure.for_problem(pr) if jacobian != "dense" else None
     if structure is None:
         return {"linsolver": "dense"}
-    evaluate = structure.evaluator(pr, session.aux, pr.atol / rtol)
+    evaluate = structure.evaluator(pr, session.log, pr.atol / rtol)
     per_jacobian = structure.rhs_per_jacobian  # counted with the right-hand sides, for the cost model
     n = len(pr.y0)
     full = np.empty((n, n))
@@ -229,7 +229,7 @@ class CvodeSession:
     solver: Any
     model_id: int
     params: FloatArray
-    aux: FloatArray
+    log: FloatArray
     #: CVODE's own time and state: the end of its last internal step (at or past the last sample).
     t: float
     state: FloatArray
@@ -256,17 +256,17 @@ class CvodeSession:
             raise ParameterError("method", "CVODE needs scikit-sundae; install it (pip install scikit-sundae) "
                                  "or choose dp5 or LSODA", "CVODE") from exc
         buf = np.empty(len(pr.y0))  # CVODE's y is read-only; a writable copy avoids a second compiled variant
-        session = cls(None, pr.model_id, pr.params, pr.aux.copy(), float(pr.t0), pr.y0.astype(np.float64))
+        session = cls(None, pr.model_id, pr.params, pr.log.copy(), float(pr.t0), pr.y0.astype(np.float64))
 
         def rhs(t: float, y: FloatArray, yp: FloatArray) -> None:
             session.n_rhs += 1
             buf[:] = y
-            model_rhs(session.model_id, t, buf, session.params, session.aux, yp)
+            model_rhs(session.model_id, t, buf, session.params, session.log, yp)
 
         options = _jacobian_options(pr, session, jacobian, rtol)
-        if pr.onset_step > 0 and pr.model_id in (PLANAR, SPATIAL):  # contact changes are counted either way
+        if pr.onset_step > 0 and pr.n_gaps > 0:  # contact changes are counted either way
             session.onset_step, session.onset_control = pr.onset_step, onset_control
-            session.gaps = np.empty(3 * int(pr.params[P_Z]))
+            session.gaps = np.empty(pr.n_gaps)
             model_gaps(pr.model_id, session.state, pr.params, session.gaps)
             session.gaps_before = session.gaps.copy()
         with warnings.catch_warnings():  # sparsity with a jacfn: scikit-sundae notes its own routine is unused
@@ -335,7 +335,7 @@ def step_cvode(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float = n
     overlaps: at a located root the overlap is exactly zero and stays so at float resolution a few
     ulps of time later, which CVODE rejects ("root found at and very near t"). After every step the
     model's bookkeeping runs on its end state. ``session`` continues an earlier call's integrator (whose
-    last sample was ``pr``'s start; ``pr.y0`` and ``pr.aux`` are then its own); the solution's
+    last sample was ``pr``'s start; ``pr.y0`` and ``pr.log`` are then its own); the solution's
     ``extra["cvode"]`` is the session to continue with.
     """
     start = time.perf_counter()
@@ -363,14 +363,14 @@ def step_cvode(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float = n
         if session.after_step(now, state):
             changes += 1
             long_steps += now - t_last > session.onset_step * (1.0 + 1e-9)
-        model_post(session.model_id, now, state, session.params, session.aux)  # accepted-step bookkeeping
+        model_post(session.model_id, now, state, session.params, session.log)  # accepted-step bookkeeping
         while k < len(t_eval) and t_eval[k] <= now:
             y[k] = state if t_eval[k] == now else session.sample(t_eval[k])
             k += 1
     return Solution(t=t_eval, y=y, status=status, message=message, method="CVODE", n_steps=steps,
                     n_rhs=session.n_rhs - rhs_before, n_contact_changes=changes,
                     wall_s=time.perf_counter() - start,
-                    extra={"aux": session.aux, "cvode": session, "long_onset_steps": long_steps})
+                    extra={"log": session.log, "cvode": session, "long_onset_steps": long_steps})
 
 
 def _scipy(method: str) -> Callable[..., Solution]:
@@ -381,11 +381,36 @@ def _scipy(method: str) -> Callable[..., Solution]:
     return run
 
 
-METHODS: dict[str, Callable[..., Solution]] = {
+def _auto(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float, first_step: float | None,
+          max_steps: int, force_jump: float) -> Solution:
+    """The automatic switch (:mod:`simulation.auto_switch`): compiled DP5, then CVODE where that pays, in up to
+    50 chunks. An infinite ``max_step`` gives each method its default cap; ``first_step`` is not used."""
+    from simulation.auto_switch import solve_chunks
+
+    cap = max_step if np.isfinite(max_step) else None
+    start = t_eval if t_eval[0] == pr.t0 else np.concatenate([[pr.t0], t_eval])
+    sol = solve_chunks(pr, start, rtol, "auto", cap, min(50, len(start) - 1), False, max_steps, force_jump)
+    if start is not t_eval:
+        sol.t, sol.y = t_eval, sol.y[1:]
+    return sol
+
+
+class Method(Protocol):
+    """What every entry of :data:`METHODS` is: a function from a problem and its sample times to a
+    :class:`Solution` (the arguments of :func:`solve`, checked there). A method sees the right-hand side, the
+    contact hooks and the Jacobian structure through :mod:`simulation.kernels` and
+    :mod:`simulation.jacobian`, never the model's parameter layout."""
+
+    def __call__(self, pr: Problem, t_eval: FloatArray, rtol: float, max_step: float, first_step: float | None,
+                 max_steps: int, force_jump: float) -> Solution: ...
+
+
+METHODS: dict[str, Method] = {
     "dp5": _compiled("dp5", dp5_integrate),
     "CVODE": lambda pr, t, rtol, max_step, first_step, max_steps, force_jump: step_cvode(pr, t, rtol, max_step,
                                                                                        first_step, max_steps),
     **{m: _scipy(m) for m in ("RK45", "DOP853", "LSODA", "BDF", "Radau")},
+    "auto": _auto,
 }
 
 

@@ -22,7 +22,7 @@ from cageless.errors import CagelessError, ParameterError, UsageError
 
 __all__ = ["main", "entry_point", "build_parser", "SUBCOMMANDS"]
 
-SUBCOMMANDS: tuple[str, ...] = ("info", "track", "simulate", "compare", "report", "sweep", "sample", "bench")
+SUBCOMMANDS: tuple[str, ...] = ("info", "track", "simulate", "compare", "report", "sweep", "calibrate", "sample", "bench")
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 

@@ -13,7 +13,7 @@ from cageless.config import load_config
 from cageless.errors import UsageError, suggest
 
 __all__ = [
-    "ArgumentParser", "common_options", "apply_config_defaults", "setup_logging", "finite_float",
+    "ArgumentParser", "common_options", "apply_config_defaults", "setup_logging", "finite_float", "parameter_values",
 ]
 
 
@@ -85,3 +85,24 @@ def setup_logging(quiet: bool, verbose: int) -> None:
     """Configure the root logger for the CLI."""
     level = logging.WARNING if quiet or verbose == 0 else (logging.INFO if verbose == 1 else logging.DEBUG)
     logging.basicConfig(level=level, format="%(levelname)s: %(message)s", force=True)
+
+
+def parameter_values(args: argparse.Namespace, config: dict[str, Any]) -> dict[str, Any]:
+    """The model-parameter changes of a run: the ``[parameters]`` table of ``--config`` (e.g. a file
+    written by ``cageless calibrate``), then ``--set`` on the command line, which wins. Checked by name
+    and value; a bad file entry names the file."""
+    from cageless.errors import CagelessError
+    from simulation.parameters import ModelParameters, parse_set_overrides
+
+    table = config.get("parameters", {})
+    if not isinstance(table, dict) or any(isinstance(v, bool) or not isinstance(v, int | float)
+                                          for v in table.values()):
+        raise UsageError(f"--config {args.config}: [parameters] must hold name = number entries "
+                         "(e.g. cho_n_s_m = 2500)")
+    try:
+        ModelParameters().with_overrides(table)
+    except CagelessError as exc:
+        raise UsageError(f"--config {args.config}: [parameters]: {exc}") from None
+    values = {**table, **parse_set_overrides(getattr(args, "set_values", []))}
+    ModelParameters().with_overrides(values)
+    return values

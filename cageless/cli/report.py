@@ -13,6 +13,7 @@ _EXAMPLES = """\
 examples:
   cageless report sample_data/lab -o report
   cageless report lab -o out --duration 0.2 --set cho_n_s_m=2500
+  cageless report lab -o out --config fitted.toml     parameters from `cageless calibrate`
   cageless report lab -o out --scheduler tcp://10.0.0.5:8786     the same workflow on a Dask cluster
 """
 
@@ -47,17 +48,20 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Run the workflow and print where the report is."""
     from cageless.config import bearing_from_config
     from cageless.lab import LabOptions, run_lab
-    from simulation.parameters import ModelParameters, parse_set_overrides
+    from cageless.calibrate import describe_calibration
+    from cageless.cli.common import parameter_values
 
     from cageless.outputs import check_output_dir
     from cageless.validate import check_options
 
-    values = parse_set_overrides(args.set_values)
-    ModelParameters().with_overrides(values)  # validated before any work starts
+    values = parameter_values(args, config)  # [parameters] of --config, then --set; before any work starts
     check_options(args, ("duration", "settle", "rtol", "workers"))
     check_output_dir(args.out, "-o")
+    note = describe_calibration(config.get("calibration"))
     options = LabOptions(duration_s=args.duration, settle_s=args.settle, rtol=args.rtol, workers=args.workers,
-                         scheduler=args.scheduler, force=args.force, parameters=values)
+                         scheduler=args.scheduler, force=args.force, parameters=values, calibration=note)
+    if note:
+        print(f"parameters: {note}")
     res = run_lab(args.lab, args.out, options, bearing_from_config(config), progress=not args.quiet)
     for row in res.rows:
         if row.status == "failed":

@@ -127,10 +127,11 @@ def _validate(args: argparse.Namespace, bearing: Any) -> None:
                           overwrite=args.overwrite)
 
 
-def _parameters(args: argparse.Namespace) -> Any:
-    from simulation.parameters import ModelParameters, parse_set_overrides
+def _parameters(args: argparse.Namespace, config: dict[str, Any]) -> Any:
+    from cageless.cli.common import parameter_values
+    from simulation.parameters import ModelParameters
 
-    values = parse_set_overrides(args.set_values)
+    values = parameter_values(args, config)  # [parameters] of --config, then --set
     if args.restitution is not None:
         values["restitution"] = args.restitution
     return ModelParameters().with_overrides(values)
@@ -141,24 +142,30 @@ def _run(args: argparse.Namespace, scene: Any, choice: Any, config: dict[str, An
     from simulation.run import check_supported
 
     check_supported(scene, choice)
-    par = _parameters(args)  # validated before anything compiles
+    par = _parameters(args, config)  # validated before anything compiles
     if args.ensemble < 1:
         raise UsageError(f"--ensemble must be >= 1, got {args.ensemble}")
     out = args.out or f"sim_{args.speed_rpm:g}rpm_Fr{args.radial_load_n:g}.trace.h5"
-    kw = {"parameters": par, "rtol": args.rtol, "sample_rate_hz": args.sample_rate, "method": args.solver,
-          "max_step": args.max_step, "config": {"command": "simulate", "set": args.set_values}}
+    from simulation.simulation import Choices, Simulation
+
+    sim = Simulation(scene, par, Choices(method=args.solver, rtol=args.rtol, max_step=args.max_step,
+                                         sample_rate_hz=args.sample_rate), model=choice)
+    from cageless.calibrate import describe_calibration
+
+    note = describe_calibration(config.get("calibration"))
+    config = {"command": "simulate", "set": args.set_values, **({"calibration": note} if note else {})}
     if args.scheduler and args.ensemble == 1:
         raise UsageError("--scheduler runs an ensemble on a Dask cluster: give --ensemble N as well")
+    if note:
+        print(f"parameters: {note}")
     if args.ensemble == 1:
-        from simulation.run import simulate
-
-        res = simulate(scene, choice, out=out, progress=not args.quiet, **kw)
+        trace = sim.run(out=out, progress=not args.quiet, config=config)
         print(f"effects: {', '.join(choice.active)}")
-        print(_summary_line(res.trace, res.solution, out))
-        return 0 if res.solution.success else 1
+        print(_summary_line(trace, sim.solution, out))
+        return 0 if sim.solution.success else 1
     from simulation.ensemble import run_ensemble
 
-    rows = run_ensemble(scene, choice, args.ensemble, out, progress=not args.quiet, scheduler=args.scheduler, **kw)
+    rows = run_ensemble(sim, args.ensemble, out, progress=not args.quiet, scheduler=args.scheduler, config=config)
     print(f"effects: {', '.join(choice.active)}")
     for row in rows:
         print(f"seed {row['seed']}: {row['summary']}")

@@ -46,8 +46,9 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Run the sweep and print the summary."""
     from cageless.config import bearing_from_config
     from cageless.errors import UsageError
-    from cageless.sweep import parse_vary, run_sweep, summarise, write_sweep
-    from simulation.parameters import ModelParameters, parse_set_overrides
+    from simulation.sweep import parse_vary, run_sweep, summarise, write_sweep
+    from cageless.calibrate import describe_calibration
+    from cageless.cli.common import parameter_values
 
     if args.seeds < 1:
         raise UsageError(f"--seeds must be >= 1, got {args.seeds}")
@@ -58,11 +59,13 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     check_output_dir(args.out, "-o")
     bearing = bearing_from_config(config)
     vary = parse_vary(args.vary, bearing)
-    fixed = parse_set_overrides(args.set_values)
-    ModelParameters().with_overrides(fixed)
+    fixed = parameter_values(args, config)  # [parameters] of --config, then --set
     runs = run_sweep(vary, args.seeds, args.speed_rpm, args.radial_load_n, args.axial_load_n, args.duration,
                      args.settle, fixed, bearing, args.workers, args.scheduler, progress=not args.quiet)
     paths = write_sweep(runs, list(vary), args.out)
+    note = describe_calibration(config.get("calibration"))
+    if note:
+        print(f"parameters: {note}")
     print(summarise(runs, list(vary)).to_string(index=False, float_format=lambda v: f"{v:.4g}"))
     failed = runs[runs.status != "ok"]
     for _, r in failed.iterrows():

@@ -14,7 +14,7 @@ below the tolerance at the small steps contact problems take.
 The right-hand side is the compiled kernel of the problem's model
 (:func:`simulation.kernels.model_rhs`, writing into ``dydt``, no allocation);
 :func:`~simulation.kernels.model_post` runs after every accepted step and may
-update the auxiliary state ``aux`` (contact bookkeeping). The kernels are
+update the contact log ``log`` (contact bookkeeping). The kernels are
 reached by a static switch on the model id, so this loop is cached on disk.
 """
 
@@ -44,7 +44,7 @@ E1, E3, E4, E5, E6, E7 = 71 / 57600, -71 / 16695, 71 / 1920, -17253 / 339200, 22
 
 
 @numba.njit(cache=True)
-def dp5_integrate(model_id, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, max_steps, out, stats, h_onset,
+def dp5_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_steps, out, stats, h_onset,
                   jump_floor, force_jump):
     """Integrate from ``t0`` and write ``y`` at each ``t_out[k]`` (increasing, >= t0) into ``out[k]``.
 
@@ -72,7 +72,7 @@ def dp5_integrate(model_id, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, max_st
     yt = np.empty(n)
     ynew = np.empty(n)
     t = t0
-    model_rhs(model_id, t, y, p, aux, k1)
+    model_rhs(model_id, t, y, p, log, k1)
     sig = model_signature(model_id, y, p) if h_onset > 0.0 else 0.0
     n_onset = 0
     n_jumps = 0
@@ -105,22 +105,22 @@ def dp5_integrate(model_id, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, max_st
             break
         for i in range(n):
             yt[i] = y[i] + h * A21 * k1[i]
-        model_rhs(model_id, t + C2 * h, yt, p, aux, k2)
+        model_rhs(model_id, t + C2 * h, yt, p, log, k2)
         for i in range(n):
             yt[i] = y[i] + h * (A31 * k1[i] + A32 * k2[i])
-        model_rhs(model_id, t + C3 * h, yt, p, aux, k3)
+        model_rhs(model_id, t + C3 * h, yt, p, log, k3)
         for i in range(n):
             yt[i] = y[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
-        model_rhs(model_id, t + C4 * h, yt, p, aux, k4)
+        model_rhs(model_id, t + C4 * h, yt, p, log, k4)
         for i in range(n):
             yt[i] = y[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
-        model_rhs(model_id, t + C5 * h, yt, p, aux, k5)
+        model_rhs(model_id, t + C5 * h, yt, p, log, k5)
         for i in range(n):
             yt[i] = y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i])
-        model_rhs(model_id, t + h, yt, p, aux, k6)
+        model_rhs(model_id, t + h, yt, p, log, k6)
         for i in range(n):
             ynew[i] = y[i] + h * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
-        model_rhs(model_id, t + h, ynew, p, aux, k7)
+        model_rhs(model_id, t + h, ynew, p, log, k7)
         n_rhs += 6
         err = 0.0
         finite = True
@@ -175,7 +175,7 @@ def dp5_integrate(model_id, p, aux, y0, t0, t_out, rtol, atol, h0, h_max, max_st
                 y[i] = ynew[i]
                 k1[i] = k7[i]
             n_steps += 1
-            model_post(model_id, t, y, p, aux)
+            model_post(model_id, t, y, p, log)
             h = h / fac
         else:
             n_rej += 1

@@ -46,9 +46,14 @@ from cageless.bearing import Bearing
 from cageless.errors import ParameterError
 from simulation.forces import FASTMATH, damping_factor, hertz_damped, hertz_impact_duration
 from simulation.hertz import ball_ball_contact, compliance, hertz_contact, race_curvatures
+from simulation import effects as effects_table
+from simulation.effects import check_lubricant, effect_flags
 from simulation.parameters import ModelParameters
 from simulation.problem import Problem
-from simulation.traction import dry_friction, regression_traction
+from simulation.models.base import (LAYOUT, P_CD, P_CHI, P_CHO, P_D, P_DI, P_DO, P_DRY, P_ETA0, P_FR,
+                                    P_F_BB, P_F_BBFILM, P_F_DRAG, P_F_GRAV, P_F_LUB, P_F_RACE, P_F_TRAC, P_G, P_H0,
+                                    P_I, P_KB, P_KI, P_KO, P_M, P_MR, P_RAMP, P_RHO_MIX, P_V_IN_MIN, P_WI, P_Z)
+from simulation.models.contact_laws import RACE_LAWS, race_extra, tangential
 
 __all__ = [
     "PlanarLayout", "planar_problem", "planar_energy", "packed_start", "contact_events", "DEFAULT_CHO_N_S_M",
@@ -57,15 +62,6 @@ __all__ = [
 
 #: Id of this model in :mod:`simulation.kernels`.
 MODEL_ID = 0
-
-# Parameter vector layout.
-P_Z, P_D, P_M, P_I, P_MR, P_DI, P_DO, P_KI, P_KO, P_KB, P_CHI, P_G, P_FR, P_WI = range(14)
-P_F_RACE, P_F_BB, P_F_GRAV, P_F_LUB, P_CHO = 14, 15, 16, 17, 18
-P_F_TRAC, P_F_FILM, P_F_BBFILM, P_F_DRAG, P_DRY = 19, 20, 21, 22, 23
-P_ETA0, P_H0, P_TA, P_TB, P_TC, P_TD = range(24, 30)
-P_MU_DRY, P_V_REG, P_CD, P_RHO_MIX, P_RAMP, P_U_FLOOR, P_V_IN_MIN = range(30, 37)
-P_MU_STATIC, P_V_STRIBECK = 37, 38
-N_PARAMS = 39
 
 #: Lubricant damping coefficient at the race contacts (N s/m): the middle of the paper's 2500-7500 range.
 DEFAULT_CHO_N_S_M = ModelParameters().cho_n_s_m
@@ -90,14 +86,6 @@ class PlanarLayout:
                 "input_work": slice(5 * z + 4, 5 * z + 5), "dissipated": slice(5 * z + 5, 5 * z + 6)}
 
 
-@numba.njit(cache=True, inline="always")
-def _tangential(u_s, u_r, q, p):  # pragma: no cover - compiled
-    """Signed tangential force (N) at a contact sliding at u_s: lubricated traction, or dry friction."""
-    if p[P_DRY] > 0.5:
-        return dry_friction(u_s, q, p[P_MU_DRY], p[P_V_REG], p[P_MU_STATIC], p[P_V_STRIBECK])
-    return regression_traction(u_s, u_r, q, p[P_TA], p[P_TB], p[P_TC], p[P_TD], p[P_U_FLOOR])
-
-
 @numba.njit(cache=True, fastmath=FASTMATH)
 def _race_forces(y, p, j, z, w_i, c, s):  # pragma: no cover - compiled
     """Race forces on ball j: (f_y, f_z, spin torque, ring f_y, ring f_z, input power, dissipated power)."""
@@ -114,11 +102,15 @@ def _race_forces(y, p, j, z, w_i, c, s):  # pragma: no cover - compiled
             q_d = max(q + p[P_CHO] * rd, 0.0)  # d(delta_o)/dt = r'; never tensile
             p_diss += (q_d - q) * rd
             q = q_d
+        if RACE_LAWS:
+            f_x = race_extra(d_o, rd, q, p)
+            p_diss += f_x * rd
+            q += f_x
         f_t = 0.0
         if trac:
             u = r * thd + half * om  # ball surface against the fixed outer race, along e_theta
             u_r = 0.5 * abs(r * thd + half * om - p[P_DO] * thd)
-            f_t = -_tangential(u, u_r, q, p)
+            f_t = -tangential(u, u_r, q, p)
             p_diss -= f_t * u
             torque += half * f_t
         fy += -q * c - f_t * s
@@ -137,13 +129,18 @@ def _race_forces(y, p, j, z, w_i, c, s):  # pragma: no cover - compiled
             q_d = max(q + p[P_CHO] * ddot, 0.0)
             p_diss += (q_d - q) * ddot
             q = q_d
+        if RACE_LAWS:
+            ddot = -(vx * nx + vz * nz)
+            f_x = race_extra(d_i, ddot, q, p)
+            p_diss += f_x * ddot
+            q += f_x
         f_t = 0.0
         if trac:
             r_i = 0.5 * p[P_DI]
             vt = vx * tx + vz * tz
             u = vt - half * om - w_i * r_i  # ball surface against the ring surface, along t
             u_r = 0.5 * abs(vt * (1.0 - 2.0 * r_i / ln) - half * om + w_i * r_i)
-            f_t = -_tangential(u, u_r, q, p)
+            f_t = -tangential(u, u_r, q, p)
             p_diss -= f_t * u
             p_in += w_i * r_i * f_t
             torque -= half * f_t
@@ -156,7 +153,7 @@ def _race_forces(y, p, j, z, w_i, c, s):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, fastmath=FASTMATH)
-def _pair_forces(y, p, aux, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
+def _pair_forces(y, p, log, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
     """Forces between balls j and k: (f_y on k, f_z on k, spin torque on both, dissipated power)."""
     d = p[P_D]
     rj, rk = y[j], y[k]
@@ -182,7 +179,7 @@ def _pair_forces(y, p, aux, j, k, z, cj, sj, ck, sk):  # pragma: no cover - comp
     # approach speed at onset: recorded after the first accepted step in contact (planar_post); until
     # then the current approach speed, so the force depends on no trial stage of any step
     # (floored: see ModelParameters.min_approach_speed_m_s)
-    v_in = max(aux[j] if aux[j] > 0.0 else delta_dot, p[P_V_IN_MIN])
+    v_in = max(log[j] if log[j] > 0.0 else delta_dot, p[P_V_IN_MIN])
     f = hertz_damped(delta, delta_dot, v_in, p[P_KB], p[P_CHI])
     p_diss = (f - p[P_KB] * delta * np.sqrt(delta)) * delta_dot
     f_t = torque = 0.0
@@ -191,7 +188,7 @@ def _pair_forces(y, p, aux, j, k, z, cj, sj, ck, sk):  # pragma: no cover - comp
         om_j, om_k = y[4 * z + j], y[4 * z + k]
         u = (vjx - vkx) * tx + (vjz - vkz) * tz + 0.5 * d * (om_j + om_k)  # surface of j against k, along t
         u_r = 0.25 * d * abs(om_j - om_k)
-        f_t = -_tangential(u, u_r, f, p)  # on j, along t
+        f_t = -tangential(u, u_r, f, p)  # on j, along t
         p_diss -= f_t * u
         torque = 0.5 * d * f_t
         return f * nx - f_t * tx, f * nz - f_t * tz, torque, p_diss
@@ -199,7 +196,7 @@ def _pair_forces(y, p, aux, j, k, z, cj, sj, ck, sk):  # pragma: no cover - comp
 
 
 @numba.njit(cache=True, fastmath=FASTMATH)
-def planar_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
+def planar_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
     z = int(p[P_Z])
     d, m, inertia, m_ring, g = p[P_D], p[P_M], p[P_I], p[P_MR], p[P_G]
     grav_on = p[P_F_GRAV] > 0.5
@@ -207,10 +204,10 @@ def planar_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     w_i = p[P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
     power_in, power = 0.0, 0.0
     fy_ring, fz_ring = 0.0, -p[P_FR] - (m_ring * g if grav_on else 0.0)
-    trig = aux.shape[0] - 2 * z  # scratch: cos and sin of every ball's angle, computed once per call
+    trig = log.shape[0] - 2 * z  # scratch: cos and sin of every ball's angle, computed once per call
     for j in range(z):
-        aux[trig + j] = np.cos(y[z + j])
-        aux[trig + z + j] = np.sin(y[z + j])
+        log[trig + j] = np.cos(y[z + j])
+        log[trig + z + j] = np.sin(y[z + j])
         dydt[j] = y[2 * z + j]
         dydt[z + j] = y[3 * z + j]
         dydt[2 * z + j] = 0.0  # force accumulators (Cartesian y, z) held in the acceleration slots for now
@@ -218,7 +215,7 @@ def planar_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
         dydt[4 * z + j] = 0.0  # torque accumulator
     if p[P_F_RACE] > 0.5:
         for j in range(z):
-            fy, fz, torque, ry, rz, p_in, p_diss = _race_forces(y, p, j, z, w_i, aux[trig + j], aux[trig + z + j])
+            fy, fz, torque, ry, rz, p_in, p_diss = _race_forces(y, p, j, z, w_i, log[trig + j], log[trig + z + j])
             dydt[2 * z + j] += fy
             dydt[3 * z + j] += fz
             dydt[4 * z + j] += torque
@@ -229,8 +226,8 @@ def planar_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     if p[P_F_BB] > 0.5:
         for j in range(z):
             k = j + 1 if j + 1 < z else 0
-            fy, fz, torque, p_diss = _pair_forces(y, p, aux, j, k, z, aux[trig + j], aux[trig + z + j], aux[trig + k],
-                                                 aux[trig + z + k])
+            fy, fz, torque, p_diss = _pair_forces(y, p, log, j, k, z, log[trig + j], log[trig + z + j], log[trig + k],
+                                                 log[trig + z + k])
             dydt[2 * z + j] -= fy
             dydt[3 * z + j] -= fz
             dydt[2 * z + k] += fy
@@ -241,7 +238,7 @@ def planar_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
     drag = 0.5 * p[P_CD] * p[P_RHO_MIX] * 0.25 * np.pi * d * d if p[P_F_DRAG] > 0.5 else 0.0
     for j in range(z):
         r = y[j]
-        c, s = aux[trig + j], aux[trig + z + j]
+        c, s = log[trig + j], log[trig + z + j]
         fy, fz = dydt[2 * z + j], dydt[3 * z + j]
         rd, thd = y[2 * z + j], y[3 * z + j]
         f_rad = fy * c + fz * s
@@ -263,7 +260,7 @@ def planar_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def planar_ring_share(t, y, p, aux, j, out):  # pragma: no cover - compiled
+def planar_ring_share(t, y, p, log, j, out):  # pragma: no cover - compiled
     """Ball j's share of the rows every ball reaches (see :mod:`simulation.jacobian`), in the order of
     :func:`planar_ring_rows`: its inner-race force on the ring over the ring's mass (y'', z''), its
     race input power, and the dissipation that depends on its state (its race contacts, its drag and
@@ -281,7 +278,7 @@ def planar_ring_share(t, y, p, aux, j, out):  # pragma: no cover - compiled
     if p[P_F_BB] > 0.5:
         for a, b in ((j - 1 if j > 0 else z - 1, j), (j, j + 1 if j + 1 < z else 0)):
             ca, sa, cb, sb = np.cos(y[z + a]), np.sin(y[z + a]), np.cos(y[z + b]), np.sin(y[z + b])
-            out[3] += _pair_forces(y, p, aux, a, b, z, ca, sa, cb, sb)[3]
+            out[3] += _pair_forces(y, p, log, a, b, z, ca, sa, cb, sb)[3]
     if p[P_F_DRAG] > 0.5:
         v = y[j] * y[3 * z + j]
         out[3] += 0.5 * p[P_CD] * p[P_RHO_MIX] * 0.25 * np.pi * p[P_D] * p[P_D] * v * v * abs(v)
@@ -336,12 +333,12 @@ def planar_gaps(y, p, out):  # pragma: no cover - compiled
         out[2 * z + j] = d - np.sqrt(d * d - pair)  # in metres, as the race overlaps, so they extrapolate alike
 
 
-# Auxiliary array layout: per pair j (between ball j and j+1):
-#   aux[j]           approach speed recorded at contact onset (used by the damping term)
-#   aux[Z + 4j + 0]  onset time (NaN when apart)
-#   aux[Z + 4j + 1]  peak force so far
-#   aux[Z + 4j + 2]  orbital angle of the pair's midpoint at the peak
-#   aux[Z + 4j + 3]  approach speed at onset (kept for classification)
+# The contact log (a float array, ``Problem.log``): per pair j (between ball j and j+1):
+#   log[j]           approach speed recorded at contact onset (used by the damping term)
+#   log[Z + 4j + 0]  onset time (NaN when apart)
+#   log[Z + 4j + 1]  peak force so far
+#   log[Z + 4j + 2]  orbital angle of the pair's midpoint at the peak
+#   log[Z + 4j + 3]  approach speed at onset (kept for classification)
 # then the event count and EVENT_FIELDS values per logged episode.
 EVENT_FIELDS = 6  # time, pair, angle, peak_force, duration, kind (0 impact, 1 rubbing)
 #: An episode longer than this many Hertz impact durations (at its approach speed) is rubbing.
@@ -350,19 +347,19 @@ RUBBING_FACTOR = 3.0
 ONSET_RESOLUTION = 20.0
 
 
-def aux_size(n_balls: int, capacity: int) -> int:
-    """Length of the auxiliary array for ``capacity`` logged contact episodes."""
+def log_size(n_balls: int, capacity: int) -> int:
+    """Length of the contact log for ``capacity`` logged contact episodes."""
     return 5 * n_balls + 1 + EVENT_FIELDS * capacity + 2 * n_balls  # last 2 Z: the RHS's trig scratch
 
 
 @numba.njit(cache=True)
-def planar_post(t, y, p, aux):  # pragma: no cover - compiled
+def planar_post(t, y, p, log):  # pragma: no cover - compiled
     z = int(p[P_Z])
     if p[P_F_BB] < 0.5:
         return
     d, k_b, m = p[P_D], p[P_KB], p[P_M]
     base = 5 * z + 1
-    cap = (aux.shape[0] - base - 2 * z) // EVENT_FIELDS
+    cap = (log.shape[0] - base - 2 * z) // EVENT_FIELDS
     spatial = y.shape[0] > 5 * z + 6
     for j in range(z):
         k = j + 1 if j + 1 < z else 0
@@ -375,83 +372,84 @@ def planar_post(t, y, p, aux):  # pragma: no cover - compiled
         ln = np.sqrt(dx * dx + dz * dz + da * da)
         delta = d - ln
         slot = z + 4 * j
-        if delta > 0.0 and aux[j] <= 0.0:
+        if delta > 0.0 and log[j] <= 0.0:
             vx = y[2 * z + k] * np.cos(tk) - rk * y[3 * z + k] * np.sin(tk) - (
                 y[2 * z + j] * np.cos(tj) - rj * y[3 * z + j] * np.sin(tj))
             vz = y[2 * z + k] * np.sin(tk) + rk * y[3 * z + k] * np.cos(tk) - (
                 y[2 * z + j] * np.sin(tj) + rj * y[3 * z + j] * np.cos(tj))
-            aux[j] = max(-(vx * dx + vz * dz + dva * da) / ln, 1e-9)
+            log[j] = max(-(vx * dx + vz * dz + dva * da) / ln, 1e-9)
         elif delta <= 0.0:
-            aux[j] = 0.0
+            log[j] = 0.0
         if delta > 0.0:
             f = k_b * delta**1.5
-            if np.isnan(aux[slot]):
-                aux[slot] = t
-                aux[slot + 1] = 0.0
-                aux[slot + 3] = aux[j]
-            if f > aux[slot + 1]:
-                aux[slot + 1] = f
-                aux[slot + 2] = 0.5 * (tj + tk + (2.0 * np.pi if k == 0 else 0.0))
-        elif not np.isnan(aux[slot]):
-            n = int(aux[base - 1])
+            if np.isnan(log[slot]):
+                log[slot] = t
+                log[slot + 1] = 0.0
+                log[slot + 3] = log[j]
+            if f > log[slot + 1]:
+                log[slot + 1] = f
+                log[slot + 2] = 0.5 * (tj + tk + (2.0 * np.pi if k == 0 else 0.0))
+        elif not np.isnan(log[slot]):
+            n = int(log[base - 1])
             if n < cap:
                 e = base + EVENT_FIELDS * n
-                duration = t - aux[slot]
-                t_hertz = hertz_impact_duration(aux[slot + 3], 0.5 * m, k_b)
-                aux[e] = aux[slot]
-                aux[e + 1] = j
-                aux[e + 2] = aux[slot + 2] % (2.0 * np.pi)
-                aux[e + 3] = aux[slot + 1]
-                aux[e + 4] = duration
-                aux[e + 5] = 1.0 if duration > RUBBING_FACTOR * t_hertz else 0.0
-            aux[base - 1] = n + 1
-            aux[slot] = np.nan
+                duration = t - log[slot]
+                t_hertz = hertz_impact_duration(log[slot + 3], 0.5 * m, k_b)
+                log[e] = log[slot]
+                log[e + 1] = j
+                log[e + 2] = log[slot + 2] % (2.0 * np.pi)
+                log[e + 3] = log[slot + 1]
+                log[e + 4] = duration
+                log[e + 5] = 1.0 if duration > RUBBING_FACTOR * t_hertz else 0.0
+            log[base - 1] = n + 1
+            log[slot] = np.nan
 
 
-def _contact_params(bearing: Bearing, p: npt.NDArray[np.float64]) -> None:
-    """Hertz stiffnesses of the inner, outer and ball-ball contacts."""
+def _contact_params(bearing: Bearing) -> dict[str, float]:
+    """Hertz stiffnesses of the inner, outer and ball-ball contacts, and the lubricant's viscosity."""
     g, mat = bearing.geometry, bearing.material
     eta = compliance(mat)
     rc = race_curvatures(g)
-    p[P_KI] = hertz_contact(*rc["inner"], eta).stiffness
-    p[P_KO] = hertz_contact(*rc["outer"], eta).stiffness
-    p[P_KB] = ball_ball_contact(g, mat).stiffness
+    out = {"KI": hertz_contact(*rc["inner"], eta).stiffness, "KO": hertz_contact(*rc["outer"], eta).stiffness,
+           "KB": ball_ball_contact(g, mat).stiffness}
     if bearing.lubricant is not None:
-        p[P_ETA0] = bearing.lubricant.dynamic_viscosity_pa_s
+        out["ETA0"] = bearing.lubricant.dynamic_viscosity_pa_s
+    return out
 
 
 def _params(bearing: Bearing, radial_load_n: float, gravity_m_s2: float, inner_speed: float,
             effects: dict[str, bool], par: ModelParameters, speed_ramp_s: float,
             oil_air_density_kg_m3: float | None) -> npt.NDArray[np.float64]:
+    """The parameter vector: the named slots of :data:`LAYOUT` filled from the bearing, the scene and ``par``;
+    the effect flags from ``effects`` alone (an effect it does not name is off)."""
     g, masses = bearing.geometry, bearing.masses
-    p = np.zeros(N_PARAMS)
-    p[P_Z], p[P_D], p[P_M] = g.n_balls, g.ball_diameter_m, masses.ball_mass_kg
-    p[P_I] = 0.1 * masses.ball_mass_kg * g.ball_diameter_m**2
-    p[P_MR] = masses.ring_translational_mass_kg
-    p[P_DI], p[P_DO] = g.inner_race_diameter_m, g.outer_race_diameter_m
-    _contact_params(bearing, p)
-    p[P_CHI] = damping_factor(par.restitution)
-    p[P_G], p[P_FR], p[P_WI], p[P_RAMP] = gravity_m_s2, radial_load_n, inner_speed, speed_ramp_s
     lubricated = bearing.lubricant is not None
-    flags = {P_F_RACE: ("race_contact", True), P_F_BB: ("ball_ball_contact", True), P_F_GRAV: ("gravity", True),
-             P_F_LUB: ("lubricant_damping", lubricated), P_F_TRAC: ("race_traction", False),
-             P_F_FILM: ("ehl_film", False), P_F_BBFILM: ("ball_ball_film", False), P_F_DRAG: ("drag", False)}
-    for slot, (name, default) in flags.items():
-        p[slot] = float(effects.get(name, default))
-    if not lubricated and (p[P_F_LUB] or p[P_F_FILM] or p[P_F_BBFILM]):
-        raise ParameterError("effects", "a lubricant effect is on but the bearing has no lubricant")
-    p[P_CHO], p[P_H0] = par.cho_n_s_m, par.film_thickness_m
-    p[P_TA], p[P_TB], p[P_TC], p[P_TD] = par.traction_coefficients
-    p[P_V_REG], p[P_U_FLOOR], p[P_CD] = par.slip_regularisation_m_s, par.min_entrainment_m_s, par.drag_coefficient
-    p[P_V_IN_MIN] = par.min_approach_speed_m_s
-    if p[P_F_TRAC] and not lubricated:
+    check_lubricant(effects, lubricated)
+    p = LAYOUT.zeros()
+    LAYOUT.fill(p, {"Z": g.n_balls, "D": g.ball_diameter_m, "M": masses.ball_mass_kg,
+                    "I": 0.1 * masses.ball_mass_kg * g.ball_diameter_m**2, "MR": masses.ring_translational_mass_kg,
+                    "DI": g.inner_race_diameter_m, "DO": g.outer_race_diameter_m})
+    LAYOUT.fill(p, _contact_params(bearing))
+    LAYOUT.fill(p, {"CHI": damping_factor(par.restitution), "G": gravity_m_s2, "FR": radial_load_n,
+                    "WI": inner_speed, "RAMP": speed_ramp_s})
+    LAYOUT.fill(p, effect_flags(effects))
+    for spec in effects_table.EFFECTS:  # rows registered with their own parameters (models/race_laws.py)
+        if spec.fill is not None:
+            LAYOUT.fill(p, spec.fill(par))
+    ta, tb, tc, td = par.traction_coefficients
+    LAYOUT.fill(p, {"CHO": par.cho_n_s_m, "H0": par.film_thickness_m, "TA": ta, "TB": tb, "TC": tc, "TD": td,
+                    "V_REG": par.slip_regularisation_m_s, "U_FLOOR": par.min_entrainment_m_s,
+                    "CD": par.drag_coefficient, "V_IN_MIN": par.min_approach_speed_m_s})
+    if p[P_DRY] and p[P_F_TRAC]:
         if par.dry_friction_coefficient is None:
             raise ParameterError("dry_friction_coefficient", "a dry scene needs the Coulomb friction of the bare "
                                  "steel contacts, which has no cited default: give it with "
                                  "--set dry_friction_coefficient=VALUE (or add a lubricant)")
-        p[P_DRY], p[P_MU_DRY] = 1.0, par.dry_friction_coefficient
-        p[P_MU_STATIC] = par.dry_static_coefficient or par.dry_friction_coefficient
-        p[P_V_STRIBECK] = par.stribeck_speed_m_s
+        LAYOUT.fill(p, {"MU_DRY": par.dry_friction_coefficient,
+                        "MU_STATIC": par.dry_static_coefficient or par.dry_friction_coefficient,
+                        "V_STRIBECK": par.stribeck_speed_m_s})
+    else:
+        p[P_DRY] = 0.0  # no friction law is evaluated: nothing to switch
     if p[P_F_DRAG]:
         if oil_air_density_kg_m3 is None:
             raise ParameterError("oil_air_density_kg_m3", "drag is on but no oil-air mixture density is given")
@@ -468,8 +466,8 @@ def planar_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLi
                    oil_air_density_kg_m3: float | None = None, spin0: npt.ArrayLike | None = None) -> Problem:
     """The planar model from a given state, as a :class:`~simulation.solve.Problem`.
 
-    Effects missing from ``effects`` take their defaults: contacts and gravity on, lubricant
-    damping on for a lubricated bearing, and traction, films and drag off. ``parameters`` holds
+    ``effects`` (name -> on, names of :data:`simulation.effects.EFFECTS`) says which effects are on; an
+    effect it does not name is off (:func:`simulation.effects.choose_model` gives a scene's choice). ``parameters`` holds
     the open model parameters; ``restitution`` and ``cho_n_s_m``, when given, replace theirs.
     The absolute tolerances (0.1 nm on positions, 0.1 um/s on speeds) are multiplied by ``atol_scale``;
     contact overlaps are micrometres, so energy-level checks want a smaller scale.
@@ -500,15 +498,17 @@ def planar_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLi
     atol *= atol_scale
     p = _params(bearing, radial_load_n, gravity_m_s2, inner_speed_rad_s, effects or {}, par, speed_ramp_s,
                 oil_air_density_kg_m3)
-    aux = np.zeros(aux_size(g.n_balls, event_capacity))
-    aux[g.n_balls:5 * g.n_balls] = np.nan  # no contact episode open
-    aux[g.n_balls + 1:5 * g.n_balls:4] = 0.0
-    aux[g.n_balls + 2:5 * g.n_balls:4] = 0.0
-    aux[g.n_balls + 3:5 * g.n_balls:4] = 0.0
+    log = np.zeros(log_size(g.n_balls, event_capacity))
+    log[g.n_balls:5 * g.n_balls] = np.nan  # no contact episode open
+    log[g.n_balls + 1:5 * g.n_balls:4] = 0.0
+    log[g.n_balls + 2:5 * g.n_balls:4] = 0.0
+    log[g.n_balls + 3:5 * g.n_balls:4] = 0.0
     # An impact at 1 m/s approach lasts t_H; contact onsets are resolved to t_H / ONSET_RESOLUTION.
     onset = hertz_impact_duration(1.0, 0.5 * p[P_M], p[P_KB]) / ONSET_RESOLUTION
-    return Problem(model_id=MODEL_ID, params=p, aux=aux, y0=y0, t0=0.0, atol=atol, name="planar cageless bearing",
-                   onset_step=onset, jump_floor=planar_jump_floor(p, lay))
+    on = frozenset(name for name, value in (effects or {}).items() if value)
+    return Problem(model_id=MODEL_ID, params=p, log=log, y0=y0, t0=0.0, atol=atol, name="planar cageless bearing",
+                   onset_step=onset, jump_floor=planar_jump_floor(p, lay), layout=LAYOUT, effects=on,
+                   n_balls=g.n_balls, n_gaps=3 * g.n_balls)
 
 
 def planar_jump_floor(p: npt.NDArray[np.float64], lay: PlanarLayout) -> npt.NDArray[np.float64]:
@@ -524,7 +524,7 @@ def planar_jump_floor(p: npt.NDArray[np.float64], lay: PlanarLayout) -> npt.NDAr
     return floor
 
 
-def contact_events(problem: Problem, aux: npt.NDArray[np.float64], t_end: float) -> pd.DataFrame:
+def contact_events(problem: Problem, log: npt.NDArray[np.float64], t_end: float) -> pd.DataFrame:
     """The ball-ball contact episodes as the trace's event table (DESIGN §4, ``EVENT_COLUMNS``).
 
     Episodes still open at ``t_end`` are closed there (their duration is a lower bound). If more
@@ -534,16 +534,16 @@ def contact_events(problem: Problem, aux: npt.NDArray[np.float64], t_end: float)
     p = problem.params
     z = int(p[P_Z])
     base = 5 * z + 1
-    n = int(aux[base - 1])
-    cap = (aux.shape[0] - base - 2 * z) // EVENT_FIELDS
-    rows = aux[base:base + EVENT_FIELDS * min(n, cap)].reshape(-1, EVENT_FIELDS)
+    n = int(log[base - 1])
+    cap = (log.shape[0] - base - 2 * z) // EVENT_FIELDS
+    rows = log[base:base + EVENT_FIELDS * min(n, cap)].reshape(-1, EVENT_FIELDS)
     still_open = []
     for j in range(z):
         slot = z + 4 * j
-        if not np.isnan(aux[slot]):
-            t_hertz = hertz_impact_duration(aux[slot + 3], 0.5 * p[P_M], p[P_KB])
-            duration = t_end - aux[slot]
-            still_open.append([aux[slot], j, aux[slot + 2] % (2 * np.pi), aux[slot + 1], duration,
+        if not np.isnan(log[slot]):
+            t_hertz = hertz_impact_duration(log[slot + 3], 0.5 * p[P_M], p[P_KB])
+            duration = t_end - log[slot]
+            still_open.append([log[slot], j, log[slot + 2] % (2 * np.pi), log[slot + 1], duration,
                                float(duration > RUBBING_FACTOR * t_hertz)])
     if still_open:
         rows = np.vstack([rows, np.array(still_open)])

@@ -10,43 +10,43 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from simulation.models import planar as P
+from simulation.models import base as B
 
 __all__ = ["reference_rhs", "tangential_force"]
 
 
 def tangential_force(u_s: np.ndarray, u_r: np.ndarray, q: np.ndarray, p: np.ndarray) -> np.ndarray:
     """Signed tangential force (N): the traction regression, or dry Coulomb-Stribeck friction."""
-    if p[P.P_DRY] > 0.5:
-        mu_c, mu_s = p[P.P_MU_DRY], p[P.P_MU_STATIC]
-        mu = mu_c + (mu_s - mu_c) * np.exp(-(u_s / p[P.P_V_STRIBECK]) ** 2)
-        return np.where(q > 0, mu * q * np.tanh(u_s / p[P.P_V_REG]), 0.0)
-    sr = np.abs(u_s) / np.maximum(np.abs(u_r), p[P.P_U_FLOOR])
-    mu = (p[P.P_TA] + p[P.P_TB] * sr) * np.exp(-p[P.P_TC] * sr) + p[P.P_TD]
+    if p[B.P_DRY] > 0.5:
+        mu_c, mu_s = p[B.P_MU_DRY], p[B.P_MU_STATIC]
+        mu = mu_c + (mu_s - mu_c) * np.exp(-(u_s / p[B.P_V_STRIBECK]) ** 2)
+        return np.where(q > 0, mu * q * np.tanh(u_s / p[B.P_V_REG]), 0.0)
+    sr = np.abs(u_s) / np.maximum(np.abs(u_r), p[B.P_U_FLOOR])
+    mu = (p[B.P_TA] + p[B.P_TB] * sr) * np.exp(-p[B.P_TC] * sr) + p[B.P_TD]
     return np.where((q > 0) & (u_s != 0), np.sign(u_s) * mu * q, 0.0)
 
 
 def reference_rhs(t: float, y: npt.NDArray[np.float64], p: npt.NDArray[np.float64],
-                  aux: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
-    """dy/dt of the planar model (numpy). ``aux`` holds the ball-ball approach speeds recorded at onset."""
-    z = int(p[P.P_Z])
-    d, m, m_ring = p[P.P_D], p[P.P_M], p[P.P_MR]
+                  log: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    """dy/dt of the planar model (numpy). ``log`` holds the ball-ball approach speeds recorded at onset."""
+    z = int(p[B.P_Z])
+    d, m, m_ring = p[B.P_D], p[B.P_M], p[B.P_MR]
     half = 0.5 * d
-    g = p[P.P_G] if p[P.P_F_GRAV] > 0.5 else 0.0
-    w_i = p[P.P_WI] * (min(t / p[P.P_RAMP], 1.0) if p[P.P_RAMP] > 0 else 1.0)
-    trac = p[P.P_F_TRAC] > 0.5
+    g = p[B.P_G] if p[B.P_F_GRAV] > 0.5 else 0.0
+    w_i = p[B.P_WI] * (min(t / p[B.P_RAMP], 1.0) if p[B.P_RAMP] > 0 else 1.0)
+    trac = p[B.P_F_TRAC] > 0.5
     r, th, rd, thd, om = y[:z], y[z:2 * z], y[2 * z:3 * z], y[3 * z:4 * z], y[4 * z:5 * z]
     cy, cz, cvy, cvz = y[5 * z:5 * z + 4]
     c, s = np.cos(th), np.sin(th)
     fy = np.zeros(z)
     fz = np.full(z, -m * g)
     torque = np.zeros(z)
-    ring = np.array([0.0, -p[P.P_FR] - m_ring * g])
+    ring = np.array([0.0, -p[B.P_FR] - m_ring * g])
     power, power_in = 0.0, 0.0
-    lub, c_ho = p[P.P_F_LUB] > 0.5, p[P.P_CHO]
-    if p[P.P_F_RACE] > 0.5:
-        d_o = r + half - 0.5 * p[P.P_DO]
-        q = np.where(d_o > 0, p[P.P_KO] * np.clip(d_o, 0, None) ** 1.5, 0.0)
+    lub, c_ho = p[B.P_F_LUB] > 0.5, p[B.P_CHO]
+    if p[B.P_F_RACE] > 0.5:
+        d_o = r + half - 0.5 * p[B.P_DO]
+        q = np.where(d_o > 0, p[B.P_KO] * np.clip(d_o, 0, None) ** 1.5, 0.0)
         if lub:
             qd = np.where(d_o > 0, np.maximum(q + c_ho * rd, 0.0), 0.0)
             power += np.sum((qd - q) * rd)
@@ -54,17 +54,17 @@ def reference_rhs(t: float, y: npt.NDArray[np.float64], p: npt.NDArray[np.float6
         f_t = np.zeros(z)
         if trac:
             u = r * thd + half * om
-            f_t = -tangential_force(u, 0.5 * np.abs(u - p[P.P_DO] * thd), q, p)
+            f_t = -tangential_force(u, 0.5 * np.abs(u - p[B.P_DO] * thd), q, p)
             power -= np.sum(f_t * u)
             torque += half * f_t
         fy += -q * c - f_t * s
         fz += -q * s + f_t * c
         sx, sz = r * c - cy, r * s - cz
         ln = np.hypot(sx, sz)
-        d_i = 0.5 * p[P.P_DI] + half - ln
+        d_i = 0.5 * p[B.P_DI] + half - ln
         nx, nz = sx / ln, sz / ln
         vx, vz = rd * c - r * thd * s - cvy, rd * s + r * thd * c - cvz
-        q = np.where(d_i > 0, p[P.P_KI] * np.clip(d_i, 0, None) ** 1.5, 0.0)
+        q = np.where(d_i > 0, p[B.P_KI] * np.clip(d_i, 0, None) ** 1.5, 0.0)
         if lub:
             ddot = -(vx * nx + vz * nz)
             qd = np.where(d_i > 0, np.maximum(q + c_ho * ddot, 0.0), 0.0)
@@ -72,7 +72,7 @@ def reference_rhs(t: float, y: npt.NDArray[np.float64], p: npt.NDArray[np.float6
             q = qd
         f_t = np.zeros(z)
         if trac:
-            r_i = 0.5 * p[P.P_DI]
+            r_i = 0.5 * p[B.P_DI]
             vt = -vx * nz + vz * nx
             u = vt - half * om - w_i * r_i
             f_t = -tangential_force(u, 0.5 * np.abs(vt * (1 - 2 * r_i / ln) - half * om + w_i * r_i), q, p)
@@ -83,19 +83,19 @@ def reference_rhs(t: float, y: npt.NDArray[np.float64], p: npt.NDArray[np.float6
         fy += gy
         fz += gz
         ring -= [np.sum(gy), np.sum(gz)]
-    if p[P.P_F_BB] > 0.5:
-        power += _pairs(y, p, aux, fy, fz, torque)
+    if p[B.P_F_BB] > 0.5:
+        power += _pairs(y, p, log, fy, fz, torque)
     f_rad, f_tan = fy * c + fz * s, -fy * s + fz * c
-    if p[P.P_F_DRAG] > 0.5:
+    if p[B.P_F_DRAG] > 0.5:
         v = r * thd
-        k_d = 0.5 * p[P.P_CD] * p[P.P_RHO_MIX] * 0.25 * np.pi * d * d
+        k_d = 0.5 * p[B.P_CD] * p[B.P_RHO_MIX] * 0.25 * np.pi * d * d
         f_tan = f_tan - k_d * v * np.abs(v)
         power += np.sum(k_d * v * v * np.abs(v))
     out = np.empty_like(y)
     out[:z], out[z:2 * z] = rd, thd
     out[2 * z:3 * z] = f_rad / m + r * thd**2
     out[3 * z:4 * z] = (f_tan / m - 2 * rd * thd) / r
-    out[4 * z:5 * z] = torque / p[P.P_I]
+    out[4 * z:5 * z] = torque / p[B.P_I]
     out[5 * z:5 * z + 2] = cvy, cvz
     out[5 * z + 2:5 * z + 4] = ring / m_ring
     out[5 * z + 4] = power_in
@@ -103,11 +103,11 @@ def reference_rhs(t: float, y: npt.NDArray[np.float64], p: npt.NDArray[np.float6
     return out
 
 
-def _pairs(y: np.ndarray, p: np.ndarray, aux: np.ndarray, fy: np.ndarray, fz: np.ndarray,
+def _pairs(y: np.ndarray, p: np.ndarray, log: np.ndarray, fy: np.ndarray, fz: np.ndarray,
            torque: np.ndarray) -> float:
     """Ball-ball Hertz, friction and squeeze film into fy, fz, torque (in place); returns dissipated power."""
-    z = int(p[P.P_Z])
-    d = p[P.P_D]
+    z = int(p[B.P_Z])
+    d = p[B.P_D]
     r, th, rd, thd, om = y[:z], y[z:2 * z], y[2 * z:3 * z], y[3 * z:4 * z], y[4 * z:5 * z]
     c, s = np.cos(th), np.sin(th)
     x, zz = r * c, r * s
@@ -120,23 +120,23 @@ def _pairs(y: np.ndarray, p: np.ndarray, aux: np.ndarray, fy: np.ndarray, fz: np
     ddot = -((vx[k] - vx) * nx + (vz[k] - vz) * nz)
     touching = delta > 0
     # recorded onset speed, else the current one; floored (ModelParameters.min_approach_speed_m_s)
-    speeds = np.maximum(np.where(aux[:z] > 0, aux[:z], ddot), p[P.P_V_IN_MIN])
-    chi = p[P.P_CHI]
-    el = p[P.P_KB] * np.clip(delta, 0, None) ** 1.5
+    speeds = np.maximum(np.where(log[:z] > 0, log[:z], ddot), p[B.P_V_IN_MIN])
+    chi = p[B.P_CHI]
+    el = p[B.P_KB] * np.clip(delta, 0, None) ** 1.5
     f = np.where(touching, np.maximum(el * (1 + (chi * ddot / np.where(speeds > 0, speeds, 1.0) if chi > 0 else 0)),
                                       0), 0.0)
     power = np.sum((f - el) * ddot * touching)
     ft = np.zeros(z)
-    if p[P.P_F_TRAC] > 0.5:
+    if p[B.P_F_TRAC] > 0.5:
         u = (vx - vx[k]) * -nz + (vz - vz[k]) * nx + 0.5 * d * (om + om[k])
         ft = np.where(touching, -tangential_force(u, 0.25 * d * np.abs(om - om[k]), f, p), 0.0)
         power -= np.sum(ft * u)
         torque += 0.5 * d * ft
         np.add.at(torque, k, 0.5 * d * ft)
     film = np.zeros(z)
-    if p[P.P_F_BBFILM] > 0.5:
-        near = (~touching) & (-delta < 4.0 / 3.0 * p[P.P_H0]) & (ddot > 0)
-        film = np.where(near, 6 * np.pi * p[P.P_ETA0] * (0.25 * d) ** 2 * ddot / np.maximum(-delta, p[P.P_H0]), 0.0)
+    if p[B.P_F_BBFILM] > 0.5:
+        near = (~touching) & (-delta < 4.0 / 3.0 * p[B.P_H0]) & (ddot > 0)
+        film = np.where(near, 6 * np.pi * p[B.P_ETA0] * (0.25 * d) ** 2 * ddot / np.maximum(-delta, p[B.P_H0]), 0.0)
         power += np.sum(film * ddot)
     on_k_y = (f + film) * nx + ft * nz
     on_k_z = (f + film) * nz - ft * nx

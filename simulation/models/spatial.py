@@ -43,15 +43,22 @@ import numpy.typing as npt
 from cageless.bearing import Bearing
 from simulation.forces import FASTMATH, hertz_damped
 from simulation.hertz import compliance, hertz_contact, race_curvatures
+from simulation.models import base as B
 from simulation.models import planar as P
+from simulation.models.contact_laws import RACE_LAWS, race_extra, tangential
 from simulation.problem import Problem
 
 __all__ = ["MODEL_ID", "SpatialLayout", "spatial_problem", "spatial_rhs", "spatial_signature", "race_geometry",
            "spatial_energy", "spatial_ring_share", "spatial_ring_rows", "spatial_gaps"]
 
 MODEL_ID = 4
-P_RGI, P_RGO, P_FA, P_TILT_Y, P_TILT_Z, P_STRIPS, P_AI, P_AO, P_IR, P_MY, P_GAX = range(P.N_PARAMS, P.N_PARAMS + 11)
-N_PARAMS = P.N_PARAMS + 11
+#: The planar slots, then the groove curvature radii, the axial load, the prescribed misalignment (about y and
+#: z), the strip count, the contact-ellipse coefficients a / Q^(1/3), the ring's tilt inertia, the moment load
+#: and gravity along the shaft.
+LAYOUT = B.LAYOUT.extend(("RGI", "RGO", "FA", "TILT_Y", "TILT_Z", "STRIPS", "AI", "AO", "IR", "MY", "GAX"))
+P_RGI, P_RGO, P_FA, P_TILT_Y, P_TILT_Z, P_STRIPS, P_AI, P_AO, P_IR, P_MY, P_GAX = LAYOUT.slots(
+    "RGI", "RGO", "FA", "TILT_Y", "TILT_Z", "STRIPS", "AI", "AO", "IR", "MY", "GAX")
+N_PARAMS = len(LAYOUT)
 
 
 class SpatialLayout(P.PlanarLayout):
@@ -98,26 +105,26 @@ def _groove(y, p, j, z, inner, rot, c, s):  # pragma: no cover - compiled
     px, py, pz = y[b + j], r * c, r * s
     if inner:
         cx, cy, cz = y[b + 4 * z], y[5 * z], y[5 * z + 1]
-        rho, rg = 0.5 * p[P.P_DI] + p[P_RGI], p[P_RGI]
+        rho, rg = 0.5 * p[B.P_DI] + p[P_RGI], p[P_RGI]
         dx, dy, dz = px - cx, py - cy, pz - cz
         # ball centre in the ring frame (R^T (P - C))
         qx = rot[0] * dx + rot[3] * dy + rot[6] * dz
         qy = rot[1] * dx + rot[4] * dy + rot[7] * dz
         qz = rot[2] * dx + rot[5] * dy + rot[8] * dz
     else:
-        rho, rg = 0.5 * p[P.P_DO] - p[P_RGO], p[P_RGO]
+        rho, rg = 0.5 * p[B.P_DO] - p[P_RGO], p[P_RGO]
         qx, qy, qz = px, py, pz
     rq = math.sqrt(qy * qy + qz * qz)
     ex, er = qx, rq - rho  # from the groove centre to the ball centre, in the (x, radial) plane of the ring
     ln = math.sqrt(ex * ex + er * er)
-    return rq, qy / rq, qz / rq, ex, er, ln, ln - (rg - 0.5 * p[P.P_D]), rho, rg
+    return rq, qy / rq, qz / rq, ex, er, ln, ln - (rg - 0.5 * p[B.P_D]), rho, rg
 
 
 @numba.njit(cache=True, fastmath=FASTMATH)
 def _race(y, p, j, z, inner, w_i, rot, c, s, wt):  # pragma: no cover - compiled
     """One race contact of ball j: force (3), torque (3) on the ball, input and dissipated power, overlap, and
     the moment (3) on the inner ring about its centre. ``wt`` is the ring's tilting angular velocity (3)."""
-    d = p[P.P_D]
+    d = p[B.P_D]
     half = 0.5 * d
     b = 5 * z + 6
     if not inner:
@@ -131,10 +138,10 @@ def _race(y, p, j, z, inner, w_i, rot, c, s, wt):  # pragma: no cover - compiled
     ox, oy, oz = y[4 * z + j], y[b + 2 * z + j], y[b + 3 * z + j]
     if inner:
         vcx, vcy, vcz = y[b + 4 * z + 1], y[5 * z + 2], y[5 * z + 3]
-        k_n, a_c = p[P.P_KI], p[P_AI]
+        k_n, a_c = p[B.P_KI], p[P_AI]
     else:
         vcx = vcy = vcz = 0.0
-        k_n, a_c = p[P.P_KO], p[P_AO]
+        k_n, a_c = p[B.P_KO], p[P_AO]
     nrx, nrr = ex / ln, er / ln
     # normal, radial and azimuthal directions in the fixed frame
     nx0, ny0, nz0 = nrx, nrr * cq, nrr * sq
@@ -155,16 +162,21 @@ def _race(y, p, j, z, inner, w_i, rot, c, s, wt):  # pragma: no cover - compiled
         vcx, vcy, vcz = vcx + ttx, vcy + tty, vcz + ttz
     rvx, rvy, rvz = vx - vcx, vy - vcy, vz - vcz
     p_diss = 0.0
-    if p[P.P_F_LUB] > 0.5:
+    if p[B.P_F_LUB] > 0.5:
         ddot = rvx * nx + rvy * ny + rvz * nz
-        q_d = max(q + p[P.P_CHO] * ddot, 0.0)
+        q_d = max(q + p[B.P_CHO] * ddot, 0.0)
         p_diss += (q_d - q) * ddot
         q = q_d
+    if RACE_LAWS:
+        ddot = rvx * nx + rvy * ny + rvz * nz
+        f_x = race_extra(delta, ddot, q, p)
+        p_diss += f_x * ddot
+        q += f_x
     fx, fy, fz = -q * nx, -q * ny, -q * nz
     mx = my = mz = 0.0
     t2x = t2y = t2z = 0.0
     p_in = 0.0
-    if p[P.P_F_TRAC] > 0.5 and q > 0.0:
+    if p[B.P_F_TRAC] > 0.5 and q > 0.0:
         # the ring's spin vector (the drive), and its whole angular velocity
         wx, wy, wz = (w_i * rot[0], w_i * rot[3], w_i * rot[6]) if inner else (0.0, 0.0, 0.0)
         awx, awy, awz = (wx + wt[0], wy + wt[1], wz + wt[2]) if inner else (0.0, 0.0, 0.0)
@@ -198,7 +210,7 @@ def _race(y, p, j, z, inner, w_i, rot, c, s, wt):  # pragma: no cover - compiled
             if us2 <= 0.0:
                 continue
             us = math.sqrt(us2)
-            f = P._tangential(us, u_r, w * q, p) / us
+            f = tangential(us, u_r, w * q, p) / us
             s0 += f
             s1 += f * xi
             s2 += f * xi * xi
@@ -222,9 +234,9 @@ def _race(y, p, j, z, inner, w_i, rot, c, s, wt):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, fastmath=FASTMATH)
-def _pair(y, p, aux, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
+def _pair(y, p, log, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
     """Ball j against ball k along the 3-D line of centres: force on k (3), moment on both (3), dissipated power."""
-    d = p[P.P_D]
+    d = p[B.P_D]
     half = 0.5 * d
     b = 5 * z + 6
     dx = y[b + k] - y[b + j]
@@ -233,7 +245,7 @@ def _pair(y, p, aux, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
     ln = math.sqrt(dx * dx + dy * dy + dz * dz)
     delta = d - ln
     zero = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-    film = p[P.P_F_BBFILM] > 0.5 and -delta < 4.0 / 3.0 * p[P.P_H0]
+    film = p[B.P_F_BBFILM] > 0.5 and -delta < 4.0 / 3.0 * p[B.P_H0]
     if delta <= 0.0 and not film:
         return zero
     nx, ny, nz = dx / ln, dy / ln, dz / ln
@@ -246,15 +258,15 @@ def _pair(y, p, aux, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
     ddot = -((vkx - vjx) * nx + (vky - vjy) * ny + (vkz - vjz) * nz)
     if delta <= 0.0:
         if ddot > 0.0:
-            f = 6.0 * np.pi * p[P.P_ETA0] * (0.25 * d) ** 2 * ddot / max(-delta, p[P.P_H0])
+            f = 6.0 * np.pi * p[B.P_ETA0] * (0.25 * d) ** 2 * ddot / max(-delta, p[B.P_H0])
             return f * nx, f * ny, f * nz, 0.0, 0.0, 0.0, f * ddot
         return zero
-    v_in = max(aux[j] if aux[j] > 0.0 else ddot, p[P.P_V_IN_MIN])
-    f = hertz_damped(delta, ddot, v_in, p[P.P_KB], p[P.P_CHI])
-    p_diss = (f - p[P.P_KB] * delta * math.sqrt(delta)) * ddot
+    v_in = max(log[j] if log[j] > 0.0 else ddot, p[B.P_V_IN_MIN])
+    f = hertz_damped(delta, ddot, v_in, p[B.P_KB], p[B.P_CHI])
+    p_diss = (f - p[B.P_KB] * delta * math.sqrt(delta)) * ddot
     fx, fy, fz = f * nx, f * ny, f * nz
     mx = my = mz = 0.0
-    if p[P.P_F_TRAC] > 0.5:
+    if p[B.P_F_TRAC] > 0.5:
         ojx, ojy, ojz = y[4 * z + j], y[b + 2 * z + j], y[b + 3 * z + j]
         okx, oky, okz = y[4 * z + k], y[b + 2 * z + k], y[b + 3 * z + k]
         sx, sy, sz = _cross(ojx + okx, ojy + oky, ojz + okz, half * nx, half * ny, half * nz)
@@ -265,7 +277,7 @@ def _pair(y, p, aux, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
         if us > 0.0:
             rx, ry, rz = _cross(ojx - okx, ojy - oky, ojz - okz, nx, ny, nz)
             u_r = 0.25 * d * math.sqrt(rx * rx + ry * ry + rz * rz)
-            g = P._tangential(us, u_r, f, p) / us  # friction on j is -g u
+            g = tangential(us, u_r, f, p) / us  # friction on j is -g u
             p_diss += g * us * us
             fx, fy, fz = fx + g * ux, fy + g * uy, fz + g * uz  # on k: +g u
             mx, my, mz = _cross(half * nx, half * ny, half * nz, -g * ux, -g * uy, -g * uz)
@@ -273,35 +285,35 @@ def _pair(y, p, aux, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, fastmath=FASTMATH)
-def spatial_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
-    z = int(p[P.P_Z])
+def spatial_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
+    z = int(p[B.P_Z])
     b = 5 * z + 6
-    d, m, inertia, m_ring, g = p[P.P_D], p[P.P_M], p[P.P_I], p[P.P_MR], p[P.P_G]
-    grav = g if p[P.P_F_GRAV] > 0.5 else 0.0
-    ramp = p[P.P_RAMP]
-    w_i = p[P.P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
+    d, m, inertia, m_ring, g = p[B.P_D], p[B.P_M], p[B.P_I], p[B.P_MR], p[B.P_G]
+    grav = g if p[B.P_F_GRAV] > 0.5 else 0.0
+    ramp = p[B.P_RAMP]
+    w_i = p[B.P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
     rot = _tilt(y, p)
     tb = y.shape[0] - 4  # tilt states: beta_y, beta_z, their rates
     s_bz, c_bz = math.sin(p[P_TILT_Z] + y[tb + 1]), math.cos(p[P_TILT_Z] + y[tb + 1])
     wt = (-s_bz * y[tb + 2], c_bz * y[tb + 2], y[tb + 3])  # angular velocity of the tilting: bz' z + by' Rz y
     rmx = rmy = rmz = 0.0
-    trig = aux.shape[0] - 2 * z  # scratch: cos and sin of every ball's angle, once per call
+    trig = log.shape[0] - 2 * z  # scratch: cos and sin of every ball's angle, once per call
     for i in range(dydt.shape[0]):
         dydt[i] = 0.0
     for j in range(z):
-        aux[trig + j] = math.cos(y[z + j])
-        aux[trig + z + j] = math.sin(y[z + j])
+        log[trig + j] = math.cos(y[z + j])
+        log[trig + z + j] = math.sin(y[z + j])
     # accumulators: force (x in the axial slot, y and z in the planar acceleration slots), moments in spin slots
     for j in range(z):
         dydt[3 * z + j] = -m * grav
         dydt[b + z + j] = -m * p[P_GAX]  # gravity along the shaft (vertical shaft)
-    rfx, rfy, rfz = p[P_FA] - m_ring * p[P_GAX], 0.0, -p[P.P_FR] - m_ring * grav
+    rfx, rfy, rfz = p[P_FA] - m_ring * p[P_GAX], 0.0, -p[B.P_FR] - m_ring * grav
     power_in = power = 0.0
-    if p[P.P_F_RACE] > 0.5:
+    if p[B.P_F_RACE] > 0.5:
         for j in range(z):
             for inner in (False, True):
-                fx, fy, fz, mx, my, mz, pin, pd, _, qx, qy, qz = _race(y, p, j, z, inner, w_i, rot, aux[trig + j],
-                                                                       aux[trig + z + j], wt)
+                fx, fy, fz, mx, my, mz, pin, pd, _, qx, qy, qz = _race(y, p, j, z, inner, w_i, rot, log[trig + j],
+                                                                       log[trig + z + j], wt)
                 dydt[b + z + j] += fx
                 dydt[2 * z + j] += fy
                 dydt[3 * z + j] += fz
@@ -313,11 +325,11 @@ def spatial_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
                     rmx, rmy, rmz = rmx + qx, rmy + qy, rmz + qz
                 power_in += pin
                 power += pd
-    if p[P.P_F_BB] > 0.5:
+    if p[B.P_F_BB] > 0.5:
         for j in range(z):
             k = j + 1 if j + 1 < z else 0
-            fx, fy, fz, mx, my, mz, pd = _pair(y, p, aux, j, k, z, aux[trig + j], aux[trig + z + j], aux[trig + k],
-                                               aux[trig + z + k])
+            fx, fy, fz, mx, my, mz, pd = _pair(y, p, log, j, k, z, log[trig + j], log[trig + z + j], log[trig + k],
+                                               log[trig + z + k])
             dydt[b + z + j] -= fx
             dydt[2 * z + j] -= fy
             dydt[3 * z + j] -= fz
@@ -328,10 +340,10 @@ def spatial_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
                 dydt[o + j] += mo
                 dydt[o + k] += mo
             power += pd
-    drag = 0.5 * p[P.P_CD] * p[P.P_RHO_MIX] * 0.25 * np.pi * d * d if p[P.P_F_DRAG] > 0.5 else 0.0
+    drag = 0.5 * p[B.P_CD] * p[B.P_RHO_MIX] * 0.25 * np.pi * d * d if p[B.P_F_DRAG] > 0.5 else 0.0
     for j in range(z):
         r, rd, thd = y[j], y[2 * z + j], y[3 * z + j]
-        c, s = aux[trig + j], aux[trig + z + j]
+        c, s = log[trig + j], log[trig + z + j]
         fy, fz = dydt[2 * z + j], dydt[3 * z + j]
         f_rad, f_tan = fy * c + fz * s, -fy * s + fz * c
         if drag > 0.0:
@@ -358,38 +370,38 @@ def spatial_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def spatial_ring_share(t, y, p, aux, j, out):  # pragma: no cover - compiled
+def spatial_ring_share(t, y, p, log, j, out):  # pragma: no cover - compiled
     """Ball j's share of the rows every ball reaches (see :mod:`simulation.jacobian`), in the order of
     :func:`spatial_ring_rows`: the ring's y'', z'', x'' and tilt accelerations from its inner-race contact,
     its race input power, and the dissipation that depends on its state (both race contacts, its drag
     and the two ball-ball contacts it takes part in)."""
-    z = int(p[P.P_Z])
+    z = int(p[B.P_Z])
     for i in range(7):
         out[i] = 0.0
     th = y[z + j]
     c, s = math.cos(th), math.sin(th)
-    if p[P.P_F_RACE] > 0.5:
-        ramp = p[P.P_RAMP]
-        w_i = p[P.P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
+    if p[B.P_F_RACE] > 0.5:
+        ramp = p[B.P_RAMP]
+        w_i = p[B.P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
         tb = y.shape[0] - 4
         s_bz, c_bz = math.sin(p[P_TILT_Z] + y[tb + 1]), math.cos(p[P_TILT_Z] + y[tb + 1])
         wt = (-s_bz * y[tb + 2], c_bz * y[tb + 2], y[tb + 3])
         rot = _tilt(y, p)
         fx, fy, fz, _, _, _, pin, pd, _, qx, qy, qz = _race(y, p, j, z, True, w_i, rot, c, s, wt)
-        m_ring = p[P.P_MR]
+        m_ring = p[B.P_MR]
         out[0], out[1], out[2] = -fy / m_ring, -fz / m_ring, -fx / m_ring
         out[3], out[4] = (-s_bz * qx + c_bz * qy) / p[P_IR], qz / p[P_IR]
         out[5], out[6] = pin, pd
         pin_o, pd_o = _race(y, p, j, z, False, w_i, rot, c, s, wt)[6:8]
         out[5] += pin_o
         out[6] += pd_o
-    if p[P.P_F_BB] > 0.5:
+    if p[B.P_F_BB] > 0.5:
         for a, b in ((j - 1 if j > 0 else z - 1, j), (j, j + 1 if j + 1 < z else 0)):
             ca, sa, cb, sb = math.cos(y[z + a]), math.sin(y[z + a]), math.cos(y[z + b]), math.sin(y[z + b])
-            out[6] += _pair(y, p, aux, a, b, z, ca, sa, cb, sb)[6]
-    if p[P.P_F_DRAG] > 0.5:
+            out[6] += _pair(y, p, log, a, b, z, ca, sa, cb, sb)[6]
+    if p[B.P_F_DRAG] > 0.5:
         v = y[j] * y[3 * z + j]
-        out[6] += 0.5 * p[P.P_CD] * p[P.P_RHO_MIX] * 0.25 * np.pi * p[P.P_D] ** 2 * v * v * abs(v)
+        out[6] += 0.5 * p[B.P_CD] * p[B.P_RHO_MIX] * 0.25 * np.pi * p[B.P_D] ** 2 * v * v * abs(v)
 
 
 def spatial_ring_rows(n_balls: int) -> list[int]:
@@ -410,13 +422,13 @@ def _overlaps(y, p, j, z, rot):  # pragma: no cover - compiled
     dy = y[k] * math.cos(y[z + k]) - y[j] * c
     dz = y[k] * math.sin(y[z + k]) - y[j] * s
     return (_groove(y, p, j, z, False, rot, c, s)[6], _groove(y, p, j, z, True, rot, c, s)[6],
-            p[P.P_D] ** 2 - (dx * dx + dy * dy + dz * dz))
+            p[B.P_D] ** 2 - (dx * dx + dy * dy + dz * dz))
 
 
 @numba.njit(cache=True)
 def spatial_signature(y, p):  # pragma: no cover - compiled
     """Which contacts are closed, as a number (see :func:`simulation.models.planar.planar_signature`)."""
-    z = int(p[P.P_Z])
+    z = int(p[B.P_Z])
     rot = _tilt(y, p)
     sig = 0.0
     for j in range(z):
@@ -434,9 +446,9 @@ def spatial_signature(y, p):  # pragma: no cover - compiled
 def spatial_gaps(y, p, out):  # pragma: no cover - compiled
     """Every contact's overlap (m), as :func:`simulation.models.planar.planar_gaps` orders them, in three
     dimensions (the quantities :func:`spatial_signature` tests)."""
-    z = int(p[P.P_Z])
+    z = int(p[B.P_Z])
     rot = _tilt(y, p)
-    d = p[P.P_D]
+    d = p[B.P_D]
     for j in range(z):
         out[j], out[z + j], pair = _overlaps(y, p, j, z, rot)
         out[2 * z + j] = d - math.sqrt(d * d - pair)
@@ -474,8 +486,8 @@ def spatial_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayL
     atol[sl["axial_dot"]] = 1e-7 * scale
     atol[sl["spin_y"]] = atol[sl["spin_z"]] = flat.atol[4 * z]
     atol[sl["ring_axial"]] = (1e-10 * scale, 1e-7 * scale)
-    p = np.zeros(N_PARAMS)
-    p[: P.N_PARAMS] = flat.params
+    p = LAYOUT.zeros()
+    p[: len(B.LAYOUT)] = flat.params
     eta = compliance(bearing.material)
     rc = race_curvatures(g)
     p[P_RGI] = g.inner_curvature_factor * g.ball_diameter_m
@@ -493,8 +505,9 @@ def spatial_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayL
     floor[sl["spin_y"]] = floor[sl["spin_z"]] = floor[sl["spin"]]
     floor[sl["ring_axial"]] = (0.0, floor[5 * z + 2])
     floor[sl["ring_tilt"]] = (0.0, 0.0, r_i / p[P_IR], r_i / p[P_IR])  # 1 N at the race
-    return Problem(model_id=MODEL_ID, params=p, aux=flat.aux, y0=y0, t0=0.0, atol=atol,
-                   name="spatial cageless bearing", onset_step=flat.onset_step, jump_floor=floor)
+    return Problem(model_id=MODEL_ID, params=p, log=flat.log, y0=y0, t0=0.0, atol=atol,
+                   name="spatial cageless bearing", onset_step=flat.onset_step, jump_floor=floor, layout=LAYOUT,
+                   effects=flat.effects, n_balls=z, n_gaps=flat.n_gaps)
 
 
 def ring_tilt_inertia(bearing: Bearing) -> float:
@@ -515,15 +528,15 @@ def race_geometry(problem: Problem,
     its path is the contact trajectory of the paper's figure 13.
     """
     p = problem.params
-    z = int(p[P.P_Z])
+    z = int(p[B.P_Z])
     b = 5 * z + 6
     r, th, ax = y[:, :z], y[:, z:2 * z], y[:, b:b + z]
-    half = 0.5 * p[P.P_D]
+    half = 0.5 * p[B.P_D]
     out = {}
     ball = np.stack([ax, r * np.cos(th), r * np.sin(th)], axis=-1)  # (T, Z, 3) in the fixed frame
     for race, rho, rg, centre, frame in (
-            ("outer", 0.5 * p[P.P_DO] - p[P_RGO], p[P_RGO], np.zeros((len(y), 1, 3)), np.broadcast_to(np.eye(3), (len(y), 3, 3))),
-            ("inner", 0.5 * p[P.P_DI] + p[P_RGI], p[P_RGI],
+            ("outer", 0.5 * p[B.P_DO] - p[P_RGO], p[P_RGO], np.zeros((len(y), 1, 3)), np.broadcast_to(np.eye(3), (len(y), 3, 3))),
+            ("inner", 0.5 * p[B.P_DI] + p[P_RGI], p[P_RGI],
              np.stack([y[:, b + 4 * z], y[:, 5 * z], y[:, 5 * z + 1]], axis=-1)[:, None, :], ring_rotations(problem, y))):
         q = np.einsum("tzi,tij->tzj", ball - centre, frame)  # R^T (P - C): the ball centre in the race's frame
         rq = np.hypot(q[..., 1], q[..., 2])
@@ -547,24 +560,24 @@ def spatial_energy(problem: Problem, y: npt.NDArray[np.float64]) -> npt.NDArray[
     load potentials, the ring's tilt. With the dissipated energy added and the drive's input work taken away it
     is conserved."""
     p = problem.params
-    z = int(p[P.P_Z])
+    z = int(p[B.P_Z])
     b = 5 * z + 6
-    m, m_ring, g, d = p[P.P_M], p[P.P_MR], p[P.P_G] * (p[P.P_F_GRAV] > 0.5), p[P.P_D]
+    m, m_ring, g, d = p[B.P_M], p[B.P_MR], p[B.P_G] * (p[B.P_F_GRAV] > 0.5), p[B.P_D]
     r, th, rd, thd = y[:, :z], y[:, z:2 * z], y[:, 2 * z:3 * z], y[:, 3 * z:4 * z]
     ax, axd = y[:, b:b + z], y[:, b + z:b + 2 * z]
     spin2 = y[:, 4 * z:5 * z] ** 2 + y[:, b + 2 * z:b + 3 * z] ** 2 + y[:, b + 3 * z:b + 4 * z] ** 2
     cvy, cvz, cvx = y[:, 5 * z + 2], y[:, 5 * z + 3], y[:, b + 4 * z + 1]
-    ke = (0.5 * m * np.sum(rd**2 + (r * thd) ** 2 + axd**2, axis=1) + 0.5 * p[P.P_I] * np.sum(spin2, axis=1)
+    ke = (0.5 * m * np.sum(rd**2 + (r * thd) ** 2 + axd**2, axis=1) + 0.5 * p[B.P_I] * np.sum(spin2, axis=1)
           + 0.5 * m_ring * (cvx**2 + cvy**2 + cvz**2) + 0.5 * p[P_IR] * (y[:, -2] ** 2 + y[:, -1] ** 2))
-    pe = m * g * np.sum(r * np.sin(th), axis=1) + (m_ring * g + p[P.P_FR]) * y[:, 5 * z + 1] - p[P_FA] * y[:, b + 4 * z]
+    pe = m * g * np.sum(r * np.sin(th), axis=1) + (m_ring * g + p[B.P_FR]) * y[:, 5 * z + 1] - p[P_FA] * y[:, b + 4 * z]
     pe -= p[P_MY] * y[:, -4]  # the moment load's work on the tilt beta_y
     pe += p[P_GAX] * (m * np.sum(ax, axis=1) + m_ring * y[:, b + 4 * z])  # gravity along the shaft
-    if p[P.P_F_RACE] > 0.5:
+    if p[B.P_F_RACE] > 0.5:
         for race, (overlap, _, _) in race_geometry(problem, y).items():
-            pe += 0.4 * (p[P.P_KI] if race == "inner" else p[P.P_KO]) * np.sum(overlap**2.5, axis=1)
-    if p[P.P_F_BB] > 0.5:
+            pe += 0.4 * (p[B.P_KI] if race == "inner" else p[B.P_KO]) * np.sum(overlap**2.5, axis=1)
+    if p[B.P_F_BB] > 0.5:
         x, zz = r * np.cos(th), r * np.sin(th)
         gap = np.sqrt((np.roll(x, -1, axis=1) - x) ** 2 + (np.roll(zz, -1, axis=1) - zz) ** 2
                       + (np.roll(ax, -1, axis=1) - ax) ** 2)
-        pe += 0.4 * p[P.P_KB] * np.sum(np.clip(d - gap, 0, None) ** 2.5, axis=1)
+        pe += 0.4 * p[B.P_KB] * np.sum(np.clip(d - gap, 0, None) ** 2.5, axis=1)
     return ke + pe

@@ -17,23 +17,23 @@ OSCILLATOR, RICCATI = 2, 3
 
 
 @numba.njit(cache=True)
-def oscillator_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
+def oscillator_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
     dydt[0] = y[1]
     dydt[1] = -p[0] * p[0] * y[0]
 
 
 @numba.njit(cache=True)
-def riccati_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
+def riccati_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
     dydt[0] = p[0] * y[0] * y[0]
 
 
 def oscillator_problem(w: float) -> Problem:
     """x'' = -w^2 x from x = 1, x' = 0."""
-    return Problem(model_id=OSCILLATOR, params=np.array([w]), aux=np.zeros(1), y0=np.array([1.0, 0.0]), t0=0.0,
+    return Problem(model_id=OSCILLATOR, params=np.array([w]), log=np.zeros(1), y0=np.array([1.0, 0.0]), t0=0.0,
                    atol=np.array([1e-12, 1e-12 * w]), name="harmonic oscillator")
 
 
 def riccati_problem(k: float, y0: float) -> Problem:
     """y' = k y^2 from y0 (blows up at t = 1 / (k y0))."""
-    return Problem(model_id=RICCATI, params=np.array([k]), aux=np.zeros(1), y0=np.array([y0]), t0=0.0,
+    return Problem(model_id=RICCATI, params=np.array([k]), log=np.zeros(1), y0=np.array([y0]), t0=0.0,
                    atol=np.array([1e-9]), name="Riccati")

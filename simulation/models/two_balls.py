@@ -1,7 +1,7 @@
 """Two free balls colliding head-on: the validation problem for the ball-ball contact law.
 
 States: x1, x2, v1, v2 (m, m/s); ball 2 starts to the right of ball 1 and they
-approach. ``aux[0]`` holds the approach speed recorded when contact begins
+approach. ``log[0]`` holds the approach speed recorded when contact begins
 (reset when it ends), for the Flores damping term.
 """
 
@@ -20,15 +20,15 @@ MODEL_ID = 1
 
 
 @numba.njit(cache=True)
-def two_ball_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
+def two_ball_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
     diameter, mass1, mass2, stiffness, chi = p[0], p[1], p[2], p[3], p[4]
     delta = diameter - (y[1] - y[0])
     delta_dot = y[2] - y[3]
-    if delta > 0.0 and aux[0] <= 0.0:
-        aux[0] = max(delta_dot, 1e-12)
+    if delta > 0.0 and log[0] <= 0.0:
+        log[0] = max(delta_dot, 1e-12)
     elif delta <= 0.0:
-        aux[0] = 0.0
-    f = hertz_damped(delta, delta_dot, aux[0], stiffness, chi)
+        log[0] = 0.0
+    f = hertz_damped(delta, delta_dot, log[0], stiffness, chi)
     dydt[0] = y[2]
     dydt[1] = y[3]
     dydt[2] = -f / mass1
@@ -36,9 +36,9 @@ def two_ball_rhs(t, y, p, aux, dydt):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def two_ball_post(t, y, p, aux):  # pragma: no cover - compiled
+def two_ball_post(t, y, p, log):  # pragma: no cover - compiled
     if p[0] - (y[1] - y[0]) <= 0.0:
-        aux[0] = 0.0
+        log[0] = 0.0
 
 
 def two_ball_problem(diameter_m: float, mass_kg: float, stiffness: float, restitution: float,
@@ -48,4 +48,4 @@ def two_ball_problem(diameter_m: float, mass_kg: float, stiffness: float, restit
     y0 = np.array([0.0, diameter_m + gap_m, v, -v])
     p = np.array([diameter_m, mass_kg, mass_kg, stiffness, damping_factor(restitution)])
     atol = np.array([1e-12, 1e-12, 1e-9, 1e-9])
-    return Problem(model_id=MODEL_ID, params=p, aux=np.zeros(1), y0=y0, t0=0.0, atol=atol, name="two balls")
+    return Problem(model_id=MODEL_ID, params=p, log=np.zeros(1), y0=y0, t0=0.0, atol=atol, name="two balls")

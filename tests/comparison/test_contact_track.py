@@ -27,10 +27,10 @@ def spatial():
 
 def test_contact_points_lie_on_the_ball_surface_at_the_contact_angle(spatial):
     tr, pr = spatial.trace, spatial.problem
-    k, d = pr.params, pr.params[1]
+    d = pr.parameter("D")
     c, balls = tr.groups["contacts"], tr.groups["balls"]
     centre = np.stack([balls["axial"], balls["radius"] * np.cos(tr.angle), balls["radius"] * np.sin(tr.angle)], -1)
-    for race, stiffness in (("inner", k[7]), ("outer", k[8])):
+    for race, stiffness in (("inner", pr.parameter("KI")), ("outer", pr.parameter("KO"))):
         arm = c[f"{race}_point"] - centre
         loaded = c[f"{race}_normal"] > 1.0
         assert loaded.mean() > 0.3  # the axial load presses many balls on both races

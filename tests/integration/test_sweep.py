@@ -7,7 +7,7 @@ import pytest
 
 from cageless.cli import main
 from cageless.errors import ParameterError
-from cageless.sweep import parse_vary, run_sweep, sweep_grid
+from simulation.sweep import parse_vary, run_sweep, sweep_grid
 
 
 def test_vary_specs_and_grid():

@@ -1,4 +1,4 @@
-"""The automatic switch to the stiff backend (simulation.chunks): deterministic, recorded, and taken only
+"""The automatic switch to the stiff backend (simulation.auto_switch): deterministic, recorded, and taken only
 where the cost model says it pays.
 
 Measured on 50 ms runs at 3000 rpm (wall time, auto against DP5 throughout): with R = 0 (ball-ball
@@ -46,12 +46,12 @@ def test_a_switch_that_stops_paying_is_undone(monkeypatch):
     of the last two costs more per simulated second than DP5 did on the probed chunk, and the run goes
     back to DP5 for good at 4.8 ms (4.9 s against 4.7 s with DP5 throughout). Without the way back
     CVODE ran to the end at 1.7 times DP5's wall time. Dry scenes do not switch at all by default
-    (simulation.chunks.SWITCH_WHEN_DRY: CVODE's energy balance drifts there), so the test allows it."""
+    (simulation.auto_switch.SWITCH_WHEN_DRY: CVODE's energy balance drifts there), so the test allows it."""
     from dataclasses import replace
 
-    import simulation.chunks
+    import simulation.auto_switch
 
-    monkeypatch.setattr(simulation.chunks, "SWITCH_WHEN_DRY", True)
+    monkeypatch.setattr(simulation.auto_switch, "SWITCH_WHEN_DRY", True)
 
     scene = Scene(conditions=OperatingConditions(3000.0, 500.0), duration_s=0.02)
     scene = replace(scene, bearing=replace(scene.bearing, lubricant=None))
@@ -77,7 +77,7 @@ def test_the_default_scene_switches_once_past_its_start_up():
 
 
 def test_a_dry_scene_stays_on_dp5():
-    """CVODE's energy balance drifts in dry scenes (simulation.chunks.SWITCH_WHEN_DRY), so the switch leaves
+    """CVODE's energy balance drifts in dry scenes (simulation.auto_switch.SWITCH_WHEN_DRY), so the switch leaves
     them on DP5: the dry spatial scene above probes nothing and runs DP5 throughout."""
     from dataclasses import replace
 

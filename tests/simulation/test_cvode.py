@@ -24,7 +24,7 @@ def settled():
 
 def test_cvode_follows_a_tight_reference_through_impacts(settled):
     pr, cage = settled
-    z = int(pr.params[P.P_Z])
+    z = pr.n_balls
     t = np.linspace(0.0, 0.005, 51)
     ref = solve(pr, t, rtol=1e-10, max_step=2.5e-7)
     sol = solve(pr, t, method="CVODE", rtol=1e-6, max_step=2e-6)
@@ -33,17 +33,17 @@ def test_cvode_follows_a_tight_reference_through_impacts(settled):
     assert slip_error_pp < 0.02
     assert sol.n_steps < 0.8 * solve(pr, t, rtol=1e-6, max_step=2e-6).n_steps  # not held by stability as DP5 is
     episodes = 5 * z  # the logged-episode counter (simulation.models.planar, auxiliary layout)
-    assert sol.extra["aux"][episodes] == ref.extra["aux"][episodes] > 0
+    assert sol.extra["log"][episodes] == ref.extra["log"][episodes] > 0
 
 
 def test_a_run_in_chunks_keeps_one_warm_integrator(settled):
     """In chunks, CVODE continues one integrator (simulation.solve.CvodeSession) instead of restarting cold
     at order 1 with a new Jacobian each time; measured over 20 ms at the spatial level, 50 cold restarts
     cost 35 % more right-hand-side calls (18506 against 13663), warm chunks 13657."""
-    from simulation.chunks import solve_chunks
+    from simulation.auto_switch import solve_chunks
 
     pr, cage = settled
-    z = int(pr.params[P.P_Z])
+    z = pr.n_balls
     t = np.linspace(0.0, 0.005, 51)
     one = solve(pr, t, method="CVODE", rtol=3e-8, max_step=5e-6)
     # rtol x 0.03 and the 5 us cap

@@ -32,7 +32,7 @@ def test_scene_rules():
     dry = scene(bearing=dataclasses.replace(default_bearing(), lubricant=None), gravity_m_s2=0.0,
                 oil_air_density_kg_m3=4.0)
     c = choose_model(dry)
-    assert set(c.active) == {"race_contact", "race_traction", "ball_ball_contact", "drag"}
+    assert set(c.active) == {"race_contact", "race_traction", "ball_ball_contact", "drag", "dry_friction"}
     axial = choose_model(scene(conditions=OperatingConditions(3000.0, 500.0, 300.0)))
     assert axial.level == "spatial" and "axial load 300 N" in axial.level_reason
     assert choose_model(scene(misalignment_rad=1e-3)).level == "spatial"
@@ -50,6 +50,12 @@ def test_overrides():
     with pytest.raises(UsageError, match="needs a lubricant"):
         choose_model(scene(bearing=dataclasses.replace(default_bearing(), lubricant=None)),
                      effects={"ehl_film": True}, force=True)
+    with pytest.raises(UsageError, match="needs the dry_friction effect"):  # the traction curve is lubricated
+        choose_model(scene(bearing=dataclasses.replace(default_bearing(), lubricant=None)),
+                     effects={"dry_friction": False}, force=True)
+    with pytest.raises(UsageError, match="contradicts the scene"):
+        choose_model(scene(), effects={"dry_friction": True})
+    assert "dry_friction" in choose_model(scene(), effects={"dry_friction": True}, force=True).active
     axial = scene(conditions=OperatingConditions(3000.0, 0.0, 300.0))
     with pytest.raises(UsageError, match="--level planar contradicts the scene"):
         choose_model(axial, level="planar")
@@ -68,8 +74,22 @@ def test_impossible_scenes_fail_before_anything_runs():
         scene(gravity_m_s2=-1.0)
 
 
+def test_the_parameter_layout_comes_from_the_table():
+    """Every effect's flag and parameter slots are named slots of both models' parameter vectors, and the
+    flags a builder writes are those of the effects it is given (an unnamed effect is off)."""
+    from simulation.effects import effect_flags
+    from simulation.models import planar, spatial
+
+    for layout in (planar.LAYOUT, spatial.LAYOUT):
+        for e in EFFECTS:
+            assert e.flag in layout and all(s in layout for s in e.slots)
+    assert effect_flags({"drag": True}) == {e.flag: float(e.name == "drag") for e in EFFECTS}
+    with pytest.raises(UsageError, match="Did you mean 'drag'"):
+        effect_flags({"drga": True})
+
+
 def test_every_effect_has_a_rule_and_physics():
-    assert len({e.name for e in EFFECTS}) == len(EFFECTS) == 8
+    assert len({e.name for e in EFFECTS}) == len(EFFECTS) == 9
     for e in EFFECTS:
         on, reason = e.rule(scene())
         assert isinstance(on, bool) and reason and e.physics
@@ -79,7 +99,7 @@ def test_simulate_explain_cli(capsys):
     assert main(["simulate", "--speed-rpm", "3000", "--radial-load-n", "500", "--axial-load-n", "400",
                  "--explain", "--json"]) == 0
     d = json.loads(capsys.readouterr().out)
-    assert d["level"] == "spatial" and len(d["effects"]) == 8
+    assert d["level"] == "spatial" and len(d["effects"]) == 9
     assert main(["simulate", "--speed-rpm", "3000", "--effect", "drag=maybe", "--explain"]) == 2
     assert "write NAME=on or NAME=off" in capsys.readouterr().err
     assert main(["simulate", "--speed-rpm", "3000", "--set", "cho_n_s=1"]) == 2

@@ -50,10 +50,10 @@ def test_structured_jacobian_matches_plain_difference_quotients(level, axial_n, 
     n = len(pr.y0)
     floor = pr.atol / 1e-7
     jac = np.empty((n, n))
-    structure.evaluator(pr, pr.aux.copy(), floor)(0.01, pr.y0, jac)
+    structure.evaluator(pr, pr.log.copy(), floor)(0.01, pr.y0, jac)
     ref = dense_fd_jacobian(pr, 0.01, pr.y0, floor)
     assert np.all(ref[~structure.pattern] == 0.0)  # the claimed structure holds exactly
-    z = int(pr.params[P.P_Z])
+    z = pr.n_balls
     closed = np.count_nonzero(ref[P.PlanarLayout(z).slices()["r_dot"], z:2 * z])  # d r''/d theta: contacts
     assert closed > z  # ball-ball contacts are closed in this state, so the band is exercised
     scale = np.abs(ref).max(axis=1, keepdims=True) + 1e-300
@@ -72,7 +72,7 @@ def test_cvode_with_the_structured_jacobian_follows_its_own_difference_quotients
     DP5 rtol 1e-10 reference at these settings (7e-4 to 1.1e-3 pp, README work-precision table), doubled.
     """
     pr, cage = _settled_problem(3000.0, 500.0, 0.03)
-    z = int(pr.params[P.P_Z])
+    z = pr.n_balls
     t = np.linspace(0.0, 0.002, 21)
     own = step_cvode(pr, t, 1e-7, max_step=5e-6, jacobian="dense")
     for jacobian in ("structured", "sparse"):
@@ -97,7 +97,7 @@ def test_scipy_implicit_methods_use_it_and_follow_a_tight_reference(method):
     from simulation.solve import solve
 
     pr, cage = _settled_problem(3000.0, 500.0, 0.03)
-    z = int(pr.params[P.P_Z])
+    z = pr.n_balls
     t = np.linspace(0.0, 0.002, 21)
     ref = solve(pr, t, rtol=1e-10, max_step=2.5e-7)
     sol = solve(pr, t, method=method, rtol=1e-6, max_step=2e-6)

@@ -1,29 +1,50 @@
-"""numba's caches of the simulation package follow its sources (simulation._cache), on a stand-in tree."""
+"""numba's caches of the simulation package are keyed on the digest of all its sources (simulation._cache)."""
 
 from __future__ import annotations
+
+from pathlib import Path
+from types import SimpleNamespace
+
+import numba
 
 from simulation import _cache
 
 
-def test_stale_caches_are_dropped_when_a_source_changes(tmp_path, monkeypatch):
-    monkeypatch.setattr(_cache, "_ROOT", tmp_path)
+def test_the_key_follows_every_source_of_the_package(tmp_path):
+    """Editing any module (here a callee in models/) changes the digest every kernel's cache is stamped with."""
     (tmp_path / "models").mkdir()
     model = tmp_path / "models" / "planar.py"
     model.write_text("K = 1\n")
-    caches = [tmp_path / "__pycache__" / "kernels.model_rhs-20.py311.nbi", tmp_path / "models" / "__pycache__" / "x.nbc"]
+    (tmp_path / "kernels.py").write_text("import models\n")
+    before = _cache._digest.__wrapped__(tmp_path)
+    assert _cache._digest.__wrapped__(tmp_path) == before  # same sources, same key
+    model.write_text("K = 2\n")
+    assert _cache._digest.__wrapped__(tmp_path) != before
 
-    def fill() -> None:
-        for c in caches:
-            c.parent.mkdir(exist_ok=True)
-            c.write_text("")
 
-    fill()
-    _cache.check()  # no stamp yet: the caches cannot be trusted
-    assert not any(c.exists() for c in caches)
-    fill()
-    _cache.check()  # sources unchanged: kept
-    assert all(c.exists() for c in caches)
-    model.write_text("K = 2\n")  # a callee changes: every cache of the package goes, the stamp follows
-    _cache.check()
-    assert not any(c.exists() for c in caches)
-    assert (tmp_path / "__pycache__" / _cache._STAMP).read_text() == _cache._digest()
+def test_package_kernels_carry_the_digest_and_others_do_not():
+    from simulation.models import planar
+
+    locator = planar.planar_rhs._cache._impl.locator
+    assert isinstance(locator, _cache.PackageSourcesLocator)
+    assert locator.get_source_stamp()[1] == _cache.source_digest()
+
+    @numba.njit(cache=True)
+    def outside(x):  # pragma: no cover - compiled; this test file is not in the package
+        return x
+
+    assert not isinstance(outside._cache._impl.locator, _cache.PackageSourcesLocator)
+
+
+def test_clear_cache_removes_the_package_caches_only(tmp_path, monkeypatch):
+    monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path))
+    stub = SimpleNamespace(__code__=SimpleNamespace(co_firstlineno=0))
+    planar = Path(_cache.__file__).parent / "models" / "planar.py"
+    where = Path(_cache.PackageSourcesLocator.from_function(stub, str(planar)).get_cache_path())
+    assert where.is_relative_to(tmp_path)  # NUMBA_CACHE_DIR is honoured
+    ours = [where / "planar.planar_rhs-1.py311.nbi", where / "planar.planar_rhs-1.py311.1.nbc"]
+    other = where / "unrelated.f-1.py311.nbi"
+    for f in [*ours, other]:
+        f.write_text("")
+    assert _cache.clear_cache() >= 2
+    assert not any(f.exists() for f in ours) and other.exists()

@@ -89,15 +89,13 @@ def test_ensemble_on_a_local_cluster_matches_the_local_run(tmp_path):
     """One Dask task per seed gives the same traces as the local processes (the run is deterministic)."""
     distributed = pytest.importorskip("distributed", reason="dask[distributed] (the test extra) is not installed")
     from cageless.conditions import OperatingConditions
-    from simulation.effects import choose_model
     from simulation.ensemble import run_ensemble
     from simulation.scene import Scene
+    from simulation.simulation import Simulation
 
-    scene = Scene(conditions=OperatingConditions(6000.0, 500.0), duration_s=0.002)
-    choice = choose_model(scene)
-    local = run_ensemble(scene, choice, 2, tmp_path / "local.trace.h5", progress=False)
+    sim = Simulation(Scene(conditions=OperatingConditions(6000.0, 500.0), duration_s=0.002))
+    local = run_ensemble(sim, 2, tmp_path / "local.trace.h5", progress=False)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cl:
-        remote = run_ensemble(scene, choice, 2, tmp_path / "dask.trace.h5", progress=False,
-                              scheduler=cl.scheduler_address)
+        remote = run_ensemble(sim, 2, tmp_path / "dask.trace.h5", progress=False, scheduler=cl.scheduler_address)
     for a, b in zip(local, remote, strict=True):
         np.testing.assert_array_equal(read_trace(a["path"]).angle, read_trace(b["path"]).angle)

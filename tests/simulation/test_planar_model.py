@@ -18,11 +18,18 @@ from simulation.solve import solve
 B = default_bearing()
 G = B.geometry
 T = np.linspace(0, 5e-3, 501)
+#: The contacts, gravity and the race damping: the effects these tests build on (the low-level builder turns on
+#: only the effects it is given).
+CORE = {"race_contact": True, "ball_ball_contact": True, "gravity": True, "lubricant_damping": True}
+
+
+def _on(**effects: bool) -> dict[str, bool]:
+    return {**CORE, **effects}
 
 
 def _run(rtol: float, restitution: float = 1.0, **kw):
     th = packed_start(B, seed=1)
-    kw.setdefault("effects", {"lubricant_damping": False})
+    kw.setdefault("effects", _on(lubricant_damping=False))
     pr = planar_problem(B, th, np.full(G.n_balls, 0.5 * G.pitch_diameter_m), (0.0, -2e-6), 500.0,
                         restitution=restitution, atol_scale=1e-4, **kw)
     sol = solve(pr, T, rtol=rtol)
@@ -59,7 +66,7 @@ def test_no_interpenetration_beyond_the_hertz_scale():
 def test_energy_balance_closes_with_damping():
     """Lubricant damping at the races (C_ho = 5000 N s/m) and ball-ball damping (R = 0.5): mechanical
     energy falls, and mechanical energy plus the dissipated energy stays constant to the tolerance."""
-    pr, sol = _run(1e-10, restitution=0.5, effects={"lubricant_damping": True})
+    pr, sol = _run(1e-10, restitution=0.5, effects=_on(lubricant_damping=True))
     e = planar_energy(pr, sol.y)
     dissipated = sol.y[:, -1]
     assert dissipated[-1] > 0.2 * (e[0] - e.min())  # the damping takes a real share of the motion
@@ -78,10 +85,10 @@ def test_layout():
     assert np.all(np.diff(angles) >= phi) and angles.mean() == pytest.approx(1.5 * np.pi, abs=0.2)
 
 
-ALL_ON = {"race_traction": True, "ehl_film": True, "ball_ball_film": True, "drag": True}
+ALL_ON = _on(race_traction=True, ehl_film=True, ball_ball_film=True, drag=True)
 
 
-@pytest.mark.parametrize("effects", [{}, ALL_ON], ids=["core", "all-effects"])
+@pytest.mark.parametrize("effects", [CORE, ALL_ON], ids=["core", "all-effects"])
 def test_compiled_and_numpy_right_hand_sides_agree(effects):
     """The compiled RHS against the plain-numpy reference, on perturbed states with contacts and motion."""
     from simulation.models.planar_reference import reference_rhs
@@ -100,7 +107,7 @@ def test_compiled_and_numpy_right_hand_sides_agree(effects):
         y[3 * z:4 * z] = rng.normal(100.0, 5.0, z)
         y[4 * z:5 * z] = rng.normal(-500.0, 50.0, z)
         y[5 * z + 2:5 * z + 4] = rng.normal(0, 1e-3, 2)
-        aux_fast, aux_ref = pr.aux.copy(), pr.aux.copy()
+        aux_fast, aux_ref = pr.log.copy(), pr.log.copy()
         fast = pr.rhs(4e-4, y, aux_fast)
         ref = reference_rhs(4e-4, y, pr.params, aux_ref)
         # the compiled kernels reassociate sums (simulation.forces.FASTMATH): an acceleration that is the small
@@ -123,7 +130,8 @@ def test_dry_stribeck_right_hand_sides_agree():
     par = ModelParameters(dry_friction_coefficient=0.1, dry_static_coefficient=0.15)
     th = packed_start(dry, seed=2, spread=0.0)
     pr = planar_problem(dry, th, np.full(G.n_balls, 0.5 * G.pitch_diameter_m), (1e-6, -4e-6), 500.0,
-                        effects={"race_traction": True}, inner_speed_rad_s=300.0, parameters=par)
+                        effects=_on(lubricant_damping=False, race_traction=True, dry_friction=True), inner_speed_rad_s=300.0,
+                        parameters=par)
     z = G.n_balls
     for _ in range(5):
         y = pr.y0.copy()
@@ -131,7 +139,7 @@ def test_dry_stribeck_right_hand_sides_agree():
         y[3 * z:4 * z] = rng.normal(100.0, 5.0, z)
         # spins that put the ball surfaces within a few v_s of rolling and far from it
         y[4 * z:5 * z] = rng.normal(-0.5 * G.pitch_diameter_m * 100.0 / (0.5 * G.ball_diameter_m), 30.0, z)
-        aux_fast, aux_ref = pr.aux.copy(), pr.aux.copy()
+        aux_fast, aux_ref = pr.log.copy(), pr.log.copy()
         np.testing.assert_allclose(pr.rhs(4e-4, y, aux_fast), reference_rhs(4e-4, y, pr.params, aux_ref),
                                    rtol=1e-10, atol=1e-8)
 
@@ -154,14 +162,14 @@ def test_contact_episodes_are_logged_and_classified():
     from simulation.models.planar import contact_events
 
     v = 0.3
-    pr, t_end = _coasting_ball(v, restitution=0.9, effects={"lubricant_damping": False})
+    pr, t_end = _coasting_ball(v, restitution=0.9, effects=_on(lubricant_damping=False))
     sol = solve(pr, np.linspace(0, t_end, 11), rtol=1e-8)
-    events = contact_events(pr, sol.extra["aux"], t_end)
+    events = contact_events(pr, sol.extra["log"], t_end)
     assert len(events) >= 1
     first = events.iloc[0]
     assert first.pair == 3 and first.kind == "impact"
-    k_bb = pr.params[9]
-    dmax = (5 * (0.5 * pr.params[2]) * v**2 / (4 * k_bb)) ** 0.4
+    k_bb = pr.parameter("KB")
+    dmax = (5 * (0.5 * pr.parameter("M")) * v**2 / (4 * k_bb)) ** 0.4
     # Measured: 41 us and 48.6 N against the elastic 36.6 us and 53.6 N; a damped (R = 0.9) contact lasts a
     # little longer and peaks lower than the elastic Hertz values, hence 20 %.
     assert first.duration == pytest.approx(2.943 * dmax / v, rel=0.2)
@@ -175,9 +183,9 @@ def test_sustained_contact_is_rubbing():
 
     th = packed_start(B, seed=1, spread=0.0)
     pr = planar_problem(B, th, np.full(G.n_balls, 0.5 * G.pitch_diameter_m), (0.0, -2e-6), 500.0,
-                        restitution=0.6)
+                        restitution=0.6, effects=CORE)
     sol = solve(pr, np.linspace(0, 5e-3, 11), rtol=1e-7)
-    events = contact_events(pr, sol.extra["aux"], 5e-3)
+    events = contact_events(pr, sol.extra["log"], 5e-3)
     assert (events.kind == "rubbing").sum() >= 3
     assert events.duration.max() > 4e-3
 
@@ -191,19 +199,19 @@ def test_contact_onset_is_not_stepped_over():
     from simulation.models.planar import contact_events
 
     v = 0.3
-    pr, t_end = _coasting_ball(v, restitution=1.0, effects={"lubricant_damping": False, "race_contact": False})
+    pr, t_end = _coasting_ball(v, restitution=1.0, effects=_on(lubricant_damping=False, race_contact=False))
     peaks = {}
     for name, problem, max_step in (("controlled", pr, 5e-4), ("fine", pr, pr.onset_step / 4),
                                     ("uncontrolled", replace(pr, onset_step=0.0), 5e-4)):
         # force_jump=0 isolates the onset control (the force-jump control has its own test below)
         sol = solve(problem, np.linspace(0, t_end, 11), rtol=1e-6, max_step=max_step, force_jump=0.0)
-        ev = contact_events(problem, sol.extra["aux"], t_end)
+        ev = contact_events(problem, sol.extra["log"], t_end)
         peaks[name] = ev.peak_force.iloc[0] if len(ev) else 0.0
         if name == "controlled":
             assert sol.n_onset_retries >= 1 and sol.n_contact_changes >= 2
-    k_bb = pr.params[9]
+    k_bb = pr.parameter("KB")
     v_n = v * np.cos(np.arcsin(G.ball_diameter_m / G.pitch_diameter_m))  # along the line of centres (a chord)
-    elastic = k_bb * (5 * (0.5 * pr.params[2]) * v_n**2 / (4 * k_bb)) ** 0.6
+    elastic = k_bb * (5 * (0.5 * pr.parameter("M")) * v_n**2 / (4 * k_bb)) ** 0.6
     assert peaks["fine"] == pytest.approx(elastic, rel=0.01)
     assert peaks["controlled"] == pytest.approx(peaks["fine"], rel=0.005)
     # measured: 0.03 % off with the control, 1.8 % without it
@@ -217,7 +225,7 @@ def test_force_jumps_are_not_stepped_over(v):
     1.1e-3 at 1 m/s); the force-jump control retries the steps across which a contact force more than
     doubles, and the energy after the impact is kept (measured 5.5e-6 and 1.3e-5). An elastic Hertz impact
     conserves energy exactly (Johnson 1985, sect. 11.4)."""
-    pr, t_end = _coasting_ball(v, restitution=1.0, effects={"lubricant_damping": False, "race_contact": False})
+    pr, t_end = _coasting_ball(v, restitution=1.0, effects=_on(lubricant_damping=False, race_contact=False))
     e0 = planar_energy(pr, pr.y0[None, :])[0]
     errors = {}
     for fj in (0.0, 0.5):
@@ -232,6 +240,6 @@ def test_force_jumps_are_not_stepped_over(v):
 def test_force_jump_fraction_is_checked():
     from cageless.errors import ParameterError
 
-    pr, t_end = _coasting_ball(0.3)
+    pr, t_end = _coasting_ball(0.3, effects=CORE)
     with pytest.raises(ParameterError, match="force_jump"):
         solve(pr, np.array([t_end]), force_jump=float("nan"))

@@ -103,3 +103,26 @@ def test_ball_ball_friction_is_in_the_trace(axial):
     assert np.all(f >= 0) and np.all(f[q == 0] == 0)
     assert np.all(f <= ModelParameters().traction_peak_coefficient * q + 1e-12)
     assert np.sum(f > 0.01) > 10  # the packed balls rub at the start
+
+
+def test_one_run_object_sets_up_every_run():
+    """Simulation(scene, parameters, choices).run() gives the trace simulate() gives (the same run, set up once),
+    refuses bad settings when it is made, and an ensemble member differs only in its seed."""
+    from cageless.errors import ParameterError
+    from simulation.parameters import ModelParameters
+    from simulation.simulation import Choices, Simulation
+
+    scene = Scene(conditions=OperatingConditions(3000.0, 500.0), duration_s=5e-4)
+    sim = Simulation(scene, ModelParameters(restitution=0.6), Choices(method="dp5", sample_rate_hz=20_000.0))
+    trace = sim.run()
+    ref = simulate(scene, choose_model(scene), ModelParameters(restitution=0.6), method="dp5", sample_rate_hz=20_000.0,
+                   progress=False)
+    np.testing.assert_array_equal(trace.angle, ref.trace.angle)
+    np.testing.assert_array_equal(sim.solution.y, ref.solution.y)
+    assert trace.config["solver"]["method"] == "dp5" and trace.config["parameters"]["restitution"] == 0.6
+    with pytest.raises(ParameterError, match="Did you mean 'LSODA'"):
+        Simulation(scene, choices=Choices(method="LSDOA"))
+    with pytest.raises(UsageError, match="contradicts the scene"):
+        Simulation(scene, choices=Choices(effects={"gravity": False}))
+    member = sim.with_seed(3)
+    assert member.scene.seed == 3 and member.choices is sim.choices and member.model is sim.model

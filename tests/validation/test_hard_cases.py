@@ -98,10 +98,10 @@ def test_hard_case_is_stable(name, level):
     sol, tr, pr = r.solution, r.trace, r.problem
     assert sol.success and np.all(np.isfinite(sol.y)), sol.message
     # interpenetration
-    k = pr.params
+    k_b, k_i, k_o = (pr.parameter(name) for name in ("KB", "KI", "KO"))
     c = tr.groups["contacts"]
-    overlap = max(np.nanmax(c["ball_ball_normal"] / k[9]) ** (2 / 3), np.nanmax(c["inner_normal"] / k[7]) ** (2 / 3),
-                  np.nanmax(c["outer_normal"] / k[8]) ** (2 / 3))
+    overlap = max(np.nanmax(c["ball_ball_normal"] / k_b) ** (2 / 3), np.nanmax(c["inner_normal"] / k_i) ** (2 / 3),
+                  np.nanmax(c["outer_normal"] / k_o) ** (2 / 3))
     assert overlap < max(OVERLAP_FACTOR * static_deflection(scene), 2e-6), (overlap, static_deflection(scene))
     # energy balance
     energy = energy_balance(pr, sol.y)

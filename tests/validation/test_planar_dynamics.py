@@ -54,7 +54,8 @@ def test_energy_balance_closes_with_traction_damping_and_films():
     """Kinetic + potential + dissipated - drive input stays constant to the tolerance (DESIGN §7)."""
     scene = Scene(conditions=OperatingConditions(3000.0, 500.0))
     theta, radius, ring = initial_state(scene)
-    on = {"race_traction": True, "ehl_film": True, "ball_ball_film": True}
+    on = {"race_contact": True, "ball_ball_contact": True, "gravity": True, "lubricant_damping": True,
+          "race_traction": True, "ehl_film": True, "ball_ball_film": True}
     pr = planar_problem(scene.bearing, theta, radius, ring, 500.0, inner_speed_rad_s=scene.conditions.speed_rad_s,
                         effects=on, atol_scale=1e-3)
     sol = solve(pr, np.linspace(0, 3e-3, 31), rtol=1e-10, max_step=5e-7)

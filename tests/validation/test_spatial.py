@@ -223,9 +223,9 @@ def test_spatial_hard_cases_are_stable(name):
     assert sol.success and np.all(np.isfinite(sol.y))
     assert sol.n_rejected < 0.1 * sol.n_steps
     assert scene.duration_s / sol.n_steps > res.problem.onset_step / 20
-    k = res.problem.params
+    k_i, d = res.problem.parameter("KI"), res.problem.parameter("D")
     c = res.trace.groups["contacts"]
-    assert (np.nanmax(c["inner_normal"]) / k[P.P_KI]) ** (2 / 3) < 0.005 * k[P.P_D]  # overlap below 0.5 % of D
+    assert (np.nanmax(c["inner_normal"]) / k_i) ** (2 / 3) < 0.005 * d  # overlap below 0.5 % of D
     energy = energy_balance(res.problem, sol.y)
     assert energy.drift < 1e-5 * energy.input_work[-1]
 

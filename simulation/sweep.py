@@ -1,4 +1,4 @@
-"""``cageless sweep``: one scene over a parameter grid and seeds, locally or on Dask (DESIGN §10).
+"""One scene over a parameter grid and seeds, locally or on Dask (``cageless sweep``; DESIGN §10).
 
 This is the paper's lubrication sensitivity study (§4: viscosity, film thickness and damping varied
 at 1800 rpm). Each grid point runs ``seeds`` simulations; the result is the peak of the mean slip
@@ -24,7 +24,7 @@ from cageless.atomic import atomic_write_text
 from cageless.bearing import Bearing, default_bearing
 from cageless.errors import ParameterError, suggest
 
-__all__ = ["parse_vary", "sweep_grid", "run_sweep", "summarise", "plot_sweep", "SCENE_NAMES", "ALIASES"]
+__all__ = ["parse_vary", "sweep_grid", "run_sweep", "simulate_point", "sweep_base", "summarise", "plot_sweep", "SCENE_NAMES", "ALIASES"]
 
 SCENE_NAMES = ("speed_rpm", "radial_load_n", "axial_load_n")
 ALIASES = {"lubricant.viscosity": "lubricant.dynamic_viscosity_pa_s"}
@@ -76,19 +76,24 @@ def sweep_grid(vary: Mapping[str, Sequence[float]], seeds: int) -> list[dict[str
             for combo in itertools.product(*(vary[n] for n in names)) for s in range(seeds)]
 
 
-def _run_point(point: dict[str, Any], base: dict[str, Any]) -> dict[str, Any]:
+def simulate_point(point: Mapping[str, Any], base: Mapping[str, Any]) -> tuple[Any, Any, float, str]:
+    """Run one grid point: ``(trace, solution, settle_s, error)``.
+
+    ``point`` holds the varied values (scene quantities, model parameters, dotted bearing fields) and
+    ``seed``; ``base`` the fixed ones (see :func:`run_sweep`). On a refused scene or parameter set the
+    trace and solution are None and ``error`` says why. Used by the sweep and by the calibration.
+    """
     from cageless.conditions import OperatingConditions
     from cageless.errors import CagelessError
-    from simulation.effects import choose_model
-    from simulation.parameters import ModelParameters
-    from simulation.run import peak_unloaded_slip, simulate
-    from simulation.scene import Scene
-
     from cageless.kinematics import startup_duration
+    from simulation.parameters import ModelParameters
+    from simulation.scene import Scene
+    from simulation.simulation import Simulation
 
     scene_kw = {n: point.get(n, base[n]) for n in SCENE_NAMES}
     model = {k: v for k, v in point.items() if k not in SCENE_NAMES and "." not in k and k != "seed"}
     dotted = {k: v for k, v in point.items() if "." in k}
+    settle = float("nan")
     try:
         bearing = Bearing.from_dict(base["bearing"]).with_overrides(dotted)
         g = bearing.geometry
@@ -96,15 +101,32 @@ def _run_point(point: dict[str, Any], base: dict[str, Any]) -> dict[str, Any]:
             scene_kw["speed_rpm"], g.ball_diameter_m, g.pitch_diameter_m)
         scene = Scene(conditions=OperatingConditions(**scene_kw), bearing=bearing,
                       duration_s=settle + base["duration_s"], seed=int(point["seed"]))
-        res = simulate(scene, choose_model(scene),
-                       parameters=ModelParameters().with_overrides({**base["parameters"], **model}),
-                       progress=False, config={"command": "sweep"})
+        sim = Simulation(scene, ModelParameters().with_overrides({**base["parameters"], **model}))
+        trace = sim.run(config={"command": base.get("command", "sweep")})
     except CagelessError as exc:
-        return {**point, "peak_slip_pct": float("nan"), "status": "failed", "message": str(exc), "wall_s": 0.0}
-    ok = res.solution.success
-    peak = peak_unloaded_slip(res.trace, settle_s=settle) if ok else float("nan")
+        return None, None, settle, str(exc)
+    return trace, sim.solution, settle, ""
+
+
+def _run_point(point: dict[str, Any], base: dict[str, Any]) -> dict[str, Any]:
+    from simulation.run import peak_unloaded_slip
+
+    trace, sol, settle, error = simulate_point(point, base)
+    if trace is None:
+        return {**point, "peak_slip_pct": float("nan"), "status": "failed", "message": error, "wall_s": 0.0}
+    ok = sol.success
+    peak = peak_unloaded_slip(trace, settle_s=settle) if ok else float("nan")
     return {**point, "peak_slip_pct": 100 * peak, "status": "ok" if ok else "failed",
-            "message": "" if ok else res.trace.status, "wall_s": res.trace.simulation.wall_s}
+            "message": "" if ok else trace.status, "wall_s": trace.simulation.wall_s}
+
+
+def sweep_base(speed_rpm: float, radial_load_n: float = 0.0, axial_load_n: float = 0.0, duration_s: float = 0.1,
+               settle_s: float | None = None, parameters: Mapping[str, float] | None = None,
+               bearing: Bearing | None = None, command: str = "sweep") -> dict[str, Any]:
+    """The fixed part of every grid point (plain values, so it travels to worker processes and Dask)."""
+    return {"speed_rpm": speed_rpm, "radial_load_n": radial_load_n, "axial_load_n": axial_load_n,
+            "duration_s": duration_s, "settle_s": settle_s, "parameters": dict(parameters or {}),
+            "bearing": (bearing or default_bearing()).to_dict(), "command": command}
 
 
 def run_sweep(vary: Mapping[str, Sequence[float]], seeds: int, speed_rpm: float, radial_load_n: float = 0.0,
@@ -114,9 +136,7 @@ def run_sweep(vary: Mapping[str, Sequence[float]], seeds: int, speed_rpm: float,
     """Run the grid and return one row per run (the varied values, seed, peak slip in %, status)."""
     from cageless.parallel import gather, job_pool
 
-    base = {"speed_rpm": speed_rpm, "radial_load_n": radial_load_n, "axial_load_n": axial_load_n,
-            "duration_s": duration_s, "settle_s": settle_s, "parameters": dict(parameters or {}),
-            "bearing": (bearing or default_bearing()).to_dict()}
+    base = sweep_base(speed_rpm, radial_load_n, axial_load_n, duration_s, settle_s, parameters, bearing)
     points = sweep_grid(vary, seeds)
     with job_pool(workers, scheduler) as pool:
         rows = gather([pool.submit(_run_point, p, base) for p in points], "sweep runs", progress)

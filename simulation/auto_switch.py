@@ -1,4 +1,4 @@
-"""Long runs in chunks: progress, bounded memory, and the automatic switch to a stiff solver.
+"""The automatic stiff-solver switch, run over a long solve in chunks: progress, bounded memory, and the switch.
 
 :func:`solve_chunks` integrates a problem chunk by chunk (one progress-bar update per chunk, samples
 kept, internal steps not). With ``method="auto"`` it starts with the compiled DP5 and watches its
@@ -48,7 +48,6 @@ import numpy.typing as npt
 from tqdm.auto import tqdm
 
 from simulation.kernels import PLANAR, SPATIAL
-from simulation.models.planar import P_DRY
 from simulation.problem import Problem
 from simulation.solve import CvodeSession, Solution, solve, step_cvode
 
@@ -127,8 +126,7 @@ def _probe(part: Problem, t: npt.NDArray[np.float64], sol: Solution, time_s: flo
 
 def _may_switch(pr: Problem) -> bool:
     """Whether the automatic switch may take ``pr`` to the stiff backend (see :data:`SWITCH_WHEN_DRY`)."""
-    dry = pr.model_id in (PLANAR, SPATIAL) and pr.params[P_DRY] > 0.5
-    return SWITCH_WHEN_DRY or not dry
+    return SWITCH_WHEN_DRY or "dry_friction" not in pr.effects
 
 
 def default_max_step(method: str) -> float:
@@ -154,7 +152,7 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
     totals = dict.fromkeys(("n_steps", "n_rejected", "n_rhs", "n_onset_retries", "n_contact_changes",
                             "n_force_jump_retries", "n_stiff_steps"), 0)
     wall = 0.0
-    y0, aux, t0 = pr.y0.copy(), pr.aux.copy(), float(t[0])
+    y0, log, t0 = pr.y0.copy(), pr.log.copy(), float(t[0])
     current = "dp5" if method == "auto" else method
     probes: list[dict[str, Any]] = []
     dp5_rate, switched_back = np.inf, False
@@ -163,7 +161,7 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
     sol = None
     with tqdm(total=float(t[-1] - t[0]), desc="simulated s", unit="s", disable=not progress, leave=False) as bar:
         for i, (a, b) in enumerate(zip(edges[:-1], edges[1:], strict=True)):
-            part = replace(pr, aux=aux, y0=y0, t0=t0)
+            part = replace(pr, log=log, y0=y0, t0=t0)
             kw = {"rtol": rtol, "max_step": max_step, "force_jump": force_jump,
                   "max_steps": max(1, max_steps - totals["n_steps"] - totals["n_rejected"])}
             settings = _settings(current, kw)
@@ -200,7 +198,7 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
                 wall += probes[-1]["wall_s"]
                 if probes[-1]["switch"]:
                     current, dp5_rate = STIFF_METHOD, rate
-            y0, aux, t0 = sol.y[-1].copy(), sol.extra.get("aux", aux), float(t[b])
+            y0, log, t0 = sol.y[-1].copy(), sol.extra.get("log", log), float(t[b])
     y = np.concatenate(ys)
     if len(y) < len(t):
         y = np.vstack([y, np.full((len(t) - len(y), y.shape[1]), np.nan)])
@@ -208,4 +206,4 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
     used = method if method != "auto" else ("auto: dp5" + "".join(f" -> {p['to']} at {p['time_s']:.4g} s"
                                                                   for p in probes if p["switch"]))
     return Solution(t=t, y=y, status=sol.status, message=sol.message, method=used, wall_s=wall,
-                    extra={"aux": aux, "switches": probes}, **totals)
+                    extra={"log": log, "switches": probes}, **totals)

@@ -1,0 +1,33 @@
+"""The parameter layout the ball-bearing models share, generated from the effects table.
+
+The planar model's slots are its body (ball count and size, masses, race diameters, the load and the
+drive) followed by every effect's flag and parameter slots (:func:`simulation.effects.parameter_slots`);
+the spatial model extends them (:data:`simulation.models.spatial.LAYOUT`). The ``P_*`` constants are
+the slot positions, module-level integers that numba compiles in as literals; only the models and
+their physics modules (:mod:`simulation.models.contact_laws`) use them.
+"""
+
+from __future__ import annotations
+
+from simulation.effects import parameter_slots
+from simulation.layout import ParameterLayout
+
+__all__ = ["BODY_SLOTS", "LAYOUT"]
+
+#: The model body: ball count Z, ball diameter D, ball mass M and spin inertia I, the ring's translational
+#: mass MR, the race diameters DI and DO, the radial load FR, the ring speed WI and its ramp time RAMP.
+BODY_SLOTS = ("Z", "D", "M", "I", "MR", "DI", "DO", "FR", "WI", "RAMP")
+LAYOUT = ParameterLayout(parameter_slots(BODY_SLOTS))
+
+P_Z, P_D, P_M, P_I, P_MR, P_DI, P_DO, P_FR, P_WI, P_RAMP = LAYOUT.slots(*BODY_SLOTS)
+P_F_RACE, P_KI, P_KO = LAYOUT.slots("F_RACE", "KI", "KO")
+P_F_LUB, P_CHO = LAYOUT.slots("F_LUB", "CHO")
+P_F_TRAC, P_TA, P_TB, P_TC, P_TD, P_U_FLOOR = LAYOUT.slots("F_TRAC", "TA", "TB", "TC", "TD", "U_FLOOR")
+(P_F_FILM,) = LAYOUT.slots("F_FILM")
+P_F_BB, P_KB, P_CHI, P_V_IN_MIN = LAYOUT.slots("F_BB", "KB", "CHI", "V_IN_MIN")
+P_F_BBFILM, P_ETA0, P_H0 = LAYOUT.slots("F_BBFILM", "ETA0", "H0")
+P_F_GRAV, P_G = LAYOUT.slots("F_GRAV", "G")
+P_F_DRAG, P_CD, P_RHO_MIX = LAYOUT.slots("F_DRAG", "CD", "RHO_MIX")
+P_DRY, P_MU_DRY, P_V_REG, P_MU_STATIC, P_V_STRIBECK = LAYOUT.slots("DRY", "MU_DRY", "V_REG", "MU_STATIC",
+                                                                   "V_STRIBECK")
+N_PARAMS = len(LAYOUT)

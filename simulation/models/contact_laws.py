@@ -1,0 +1,32 @@
+"""Contact laws the bearing models share, reading their parameters from the named slots.
+
+:func:`tangential` is the friction law of every sliding contact (race and ball-ball, planar and
+spatial): the lubricated traction curve, or dry Coulomb-Stribeck friction when the ``dry_friction``
+effect is on (:mod:`simulation.traction` holds the formulas). :data:`race_extra` adds the registered extra
+race-contact laws (:mod:`simulation.models.race_laws`).
+"""
+
+from __future__ import annotations
+
+import numba
+
+from simulation.models import race_laws
+from simulation.models.base import (LAYOUT, P_DRY, P_MU_DRY, P_MU_STATIC, P_TA, P_TB, P_TC, P_TD, P_U_FLOOR, P_V_REG,
+                                    P_V_STRIBECK)
+from simulation.traction import dry_friction, regression_traction
+
+__all__ = ["tangential", "race_extra", "RACE_LAWS"]
+
+
+@numba.njit(cache=True, inline="always")
+def tangential(u_s, u_r, q, p):  # pragma: no cover - compiled
+    """Signed tangential force (N) at a contact sliding at u_s: lubricated traction, or dry friction."""
+    if p[P_DRY] > 0.5:
+        return dry_friction(u_s, q, p[P_MU_DRY], p[P_V_REG], p[P_MU_STATIC], p[P_V_STRIBECK])
+    return regression_traction(u_s, u_r, q, p[P_TA], p[P_TB], p[P_TC], p[P_TD], p[P_U_FLOOR])
+
+
+#: The registered extra race-contact laws (:mod:`simulation.models.race_laws`), summed under their flags, and
+#: whether there are any (a compile-time constant: with none, the race contacts compile without them).
+race_extra = race_laws.compose(LAYOUT)
+RACE_LAWS = race_laws.freeze()

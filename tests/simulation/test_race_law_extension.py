@@ -1,0 +1,81 @@
+"""A new race-contact force law is one physics module plus its parameters (simulation.models.race_laws).
+
+The example law is defined here, in a test-only module run in a fresh process (the laws compile into the
+models' race contacts, so they are registered before the models import): a linear spring f = k_x delta
+added along the normal of every race contact, switched by its own row of the effects table, with its
+stiffness in its own parameter slot. Nothing else of the package is edited. The check is the closed form
+(traction off, since it scales with the normal force): the law adds (-k_x delta_o + k_x delta_i n_r) / m to
+each ball's radial acceleration (the outer contact pushes the ball inward, the inner one out along its normal,
+of radial component n_r), and nothing where a contact is open; a short run with it differs from one without.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+_SCRIPT = r"""
+import json, numba, numpy as np
+from simulation.effects import EffectSpec
+from simulation.models import race_laws
+
+K_X = 2.0e6  # N/m: the example law's parameter
+SLOT = -1  # its slot in the parameter vector, known once the layout is generated (below); read at compile time
+
+@numba.njit(inline="always")
+def linear_spring(delta, delta_dot, q, p):
+    return p[SLOT] * delta
+
+spec = EffectSpec("race_spring", "a linear spring k_x delta at the race contacts (test-only example law)",
+                  lambda s: (True, "example law"), flag="F_SPRING", slots=("K_X",),
+                  fill=lambda par: {"K_X": K_X})
+race_laws.register_race_law(spec, linear_spring)
+from simulation.models.base import LAYOUT
+SLOT = LAYOUT.index("K_X")
+
+from cageless.conditions import OperatingConditions
+from simulation.scene import Scene
+from simulation.simulation import Choices, Simulation
+
+scene = Scene(conditions=OperatingConditions(3000.0, 500.0), duration_s=1e-3)
+on = Simulation(scene)
+off = Simulation(scene, choices=Choices(effects={"race_spring": False}, force=True))
+# the closed form is for the normal forces alone (traction scales with the normal force)
+normal_on = Simulation(scene, choices=Choices(effects={"race_traction": False}, force=True))
+normal_off = Simulation(scene, choices=Choices(effects={"race_traction": False, "race_spring": False}, force=True))
+pr_on, pr_off = normal_on.build(), normal_off.build()
+z = pr_on.n_balls
+y = pr_on.y0.copy()
+y[3 * z:4 * z] = 120.0
+a_on, a_off = pr_on.rhs(0.0, y), pr_off.rhs(0.0, y)
+d_o = y[:z] + 0.5 * pr_on.parameter("D") - 0.5 * pr_on.parameter("DO")
+th = y[z:2 * z]
+sx, sz = y[:z] * np.cos(th) - y[5 * z], y[:z] * np.sin(th) - y[5 * z + 1]
+ln = np.hypot(sx, sz)
+d_i = 0.5 * pr_on.parameter("DI") + 0.5 * pr_on.parameter("D") - ln
+n_r = (sx * np.cos(th) + sz * np.sin(th)) / ln  # radial component of the inner contact normal
+trace_on, trace_off = on.run(), off.run()
+print(json.dumps({"active": list(on.model.active), "k_x": pr_on.parameter("K_X"), "m": pr_on.parameter("M"),
+                  "d_o": d_o.tolist(), "d_i": d_i.tolist(), "n_r": n_r.tolist(), "dr_acc": (a_on[2 * z:3 * z] - a_off[2 * z:3 * z]).tolist(),
+                  "ring_z_on": float(on.solution.y[-1, 5 * z + 1]), "ring_z_off": float(off.solution.y[-1, 5 * z + 1]),
+                  "ok": bool(on.solution.success and off.solution.success)}))
+"""
+
+
+def test_an_example_race_law_enters_the_forces(tmp_path):
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba-cache")}
+    out = subprocess.run([sys.executable, "-c", _SCRIPT], capture_output=True, text=True, env=env, timeout=900)
+    assert out.returncode == 0, out.stderr[-2000:]
+    r = json.loads(out.stdout.strip().splitlines()[-1])
+    assert "race_spring" in r["active"] and r["k_x"] == 2.0e6 and r["ok"]
+    k, m = r["k_x"], r["m"]
+    loaded = 0
+    for d_o, d_i, n_r, dr in zip(r["d_o"], r["d_i"], r["n_r"], r["dr_acc"], strict=True):
+        # closed form: the outer spring pushes the ball inward (-k_x d_o), the inner one out along its normal
+        expected = (-k * max(d_o, 0.0) + k * max(d_i, 0.0) * n_r) / m
+        assert abs(dr - expected) <= 1e-6 * abs(expected) + 1e-9
+        loaded += d_o > 0
+    assert loaded >= 3 and max(abs(v) for v in r["dr_acc"]) > 1.0  # the law acts where balls are loaded
+    assert r["ring_z_on"] != r["ring_z_off"]  # the stiffer contacts carry the load: the run differs
