@@ -2,7 +2,14 @@
 
 Every output file records the software version, the git commit when the code
 runs from a checkout, the resolved configuration, the input files with their
-SHA-256 hashes, and UTC start and end times.
+hashes, and UTC start and end times.
+
+Each input's record names its hash algorithm by its key: ``{"name", "size_bytes",
+"sha256": hex}`` or ``{"name", "size_bytes", "blake3": hex}``. SHA-256 is the default;
+videos are hashed with BLAKE3 (the ``blake3`` package, 32-byte digests), which runs
+at about 3 GB/s on one core against SHA-256's 0.8 GB/s here, so that hashing a
+20 GB recording does not cap the tracking throughput. Records written before
+BLAKE3 was used say ``sha256`` and read as before.
 """
 
 from __future__ import annotations
@@ -24,9 +31,11 @@ from typing import Any
 from cageless._version import __version__
 from cageless.atomic import atomic_write_text
 
-__all__ = ["InputFile", "Provenance", "sha256_file", "git_commit", "cache_dir"]
+__all__ = ["InputFile", "Provenance", "sha256_file", "hash_file", "HASH_ALGORITHMS", "git_commit", "cache_dir"]
 
 _CHUNK = 1 << 20
+#: The hash algorithms an input can be recorded with.
+HASH_ALGORITHMS = ("sha256", "blake3")
 _POOL = ThreadPoolExecutor(max_workers=2, thread_name_prefix="cageless-hash")
 
 
@@ -51,19 +60,32 @@ _CACHE_LOCK = threading.Lock()
 
 
 def sha256_file(path: str | Path, cache: bool = True) -> str:
-    """Return the hex SHA-256 of a file, read in 1 MiB chunks.
+    """Return the hex SHA-256 of a file, read in 1 MiB chunks (see :func:`hash_file`)."""
+    return hash_file(path, "sha256", cache)
+
+
+def hash_file(path: str | Path, algorithm: str = "sha256", cache: bool = True) -> str:
+    """Return the hex digest of a file with ``algorithm`` (``"sha256"`` or ``"blake3"``).
 
     For a folder (an image sequence) the hash covers the sorted file names and contents.
-    With ``cache`` the result is remembered under :func:`cache_dir`, keyed by the path, size,
-    modification time and inode of every file, so an unchanged video is hashed once (hashing
-    costs about 0.6 s per GB here).
+    With ``cache`` the result is remembered under :func:`cache_dir` (one folder per algorithm),
+    keyed by the path, size, modification time and inode of every file, so an unchanged video
+    is hashed once. BLAKE3 reads a single file through a memory map on one thread (the
+    ``blake3`` package releases the GIL); SHA-256 costs about 1.3 s per GB here, BLAKE3 0.35 s.
+
+    Raises
+    ------
+    ValueError
+        For an algorithm not in :data:`HASH_ALGORITHMS`.
     """
+    if algorithm not in HASH_ALGORITHMS:
+        raise ValueError(f"hash algorithm {algorithm!r}: use one of {', '.join(HASH_ALGORITHMS)}")
     path = Path(path)
     key = _stat_key(path) if cache else ""
-    store = cache_dir() / "sha256"
+    store = cache_dir() / algorithm
     if cache and (store / key).is_file():
         return (store / key).read_text().strip()
-    value = _sha256_uncached(path)
+    value = _hash_uncached(path, algorithm)
     if cache:
         try:
             with _CACHE_LOCK:
@@ -73,8 +95,16 @@ def sha256_file(path: str | Path, cache: bool = True) -> str:
     return value
 
 
-def _sha256_uncached(path: Path) -> str:
-    digest = hashlib.sha256()
+def _hash_uncached(path: Path, algorithm: str) -> str:
+    if algorithm == "blake3":
+        from blake3 import blake3
+
+        digest: Any = blake3()
+        if path.is_file():
+            digest.update_mmap(path)  # one pass over the page cache, no copy into Python
+            return str(digest.hexdigest())
+    else:
+        digest = hashlib.sha256()
     files = sorted(p for p in path.rglob("*") if p.is_file()) if path.is_dir() else [path]
     for p in files:
         if path.is_dir():
@@ -82,7 +112,7 @@ def _sha256_uncached(path: Path) -> str:
         with open(p, "rb") as fh:
             while chunk := fh.read(_CHUNK):
                 digest.update(chunk)
-    return digest.hexdigest()
+    return str(digest.hexdigest())
 
 
 @lru_cache(maxsize=1)
@@ -111,21 +141,38 @@ def _utc_now() -> str:
 
 @dataclass(frozen=True)
 class InputFile:
-    """One input file: its name, size and SHA-256."""
+    """One input file: its name, size and hash (hex ``digest`` by ``algorithm``)."""
 
     name: str
     size_bytes: int
-    sha256: str
+    digest: str
+    algorithm: str = "sha256"
+
+    @property
+    def sha256(self) -> str | None:
+        """The SHA-256 digest, or ``None`` when the file was hashed with another algorithm."""
+        return self.digest if self.algorithm == "sha256" else None
 
     @classmethod
-    def from_path(cls, path: str | Path) -> InputFile:
+    def from_path(cls, path: str | Path, algorithm: str = "sha256") -> InputFile:
         """Hash a file (or image-sequence folder) and record it."""
         path = Path(path)
         size = (
             sum(p.stat().st_size for p in path.rglob("*") if p.is_file())
             if path.is_dir() else path.stat().st_size
         )
-        return cls(name=str(path), size_bytes=size, sha256=sha256_file(path))
+        return cls(name=str(path), size_bytes=size, digest=hash_file(path, algorithm), algorithm=algorithm)
+
+    @classmethod
+    def from_dict(cls, record: Mapping[str, Any]) -> InputFile:
+        """Read a record of :meth:`to_dict` (the key that names an algorithm holds the digest)."""
+        algorithm = next((a for a in HASH_ALGORITHMS if a in record), "sha256")
+        return cls(name=str(record["name"]), size_bytes=int(record["size_bytes"]),
+                   digest=str(record.get(algorithm, "")), algorithm=algorithm)
+
+    def to_dict(self) -> dict[str, Any]:
+        """``{"name", "size_bytes", <algorithm>: digest}``: the key names the hash algorithm."""
+        return {"name": self.name, "size_bytes": self.size_bytes, self.algorithm: self.digest}
 
 
 @dataclass
@@ -148,11 +195,12 @@ class Provenance:
     @classmethod
     def start(
         cls, config: Mapping[str, Any] | None = None, inputs: Iterable[str | Path] = (), background: bool = False,
+        hash_algorithm: str = "sha256",
     ) -> Provenance:
-        """Begin a record now, hashing the given input files.
+        """Begin a record now, hashing the given input files with ``hash_algorithm``.
 
-        With ``background=True`` the hashing runs in a thread (hashlib releases the GIL), overlapping
-        the caller's work; :meth:`finish` (or :attr:`inputs`) waits for it.
+        With ``background=True`` the hashing runs in a thread (hashlib and blake3 release the GIL),
+        overlapping the caller's work; :meth:`finish` (or :attr:`inputs`) waits for it.
         """
         paths = list(inputs)
         record = cls(
@@ -164,9 +212,9 @@ class Provenance:
             started_utc=_utc_now(),
         )
         if background and paths:
-            record._pending = _POOL.submit(lambda: [InputFile.from_path(p) for p in paths])
+            record._pending = _POOL.submit(lambda: [InputFile.from_path(p, hash_algorithm) for p in paths])
         else:
-            record.inputs = [InputFile.from_path(p) for p in paths]
+            record.inputs = [InputFile.from_path(p, hash_algorithm) for p in paths]
         return record
 
     def wait(self) -> Provenance:
@@ -186,4 +234,6 @@ class Provenance:
     def to_dict(self) -> dict[str, Any]:
         """Return the record as a JSON-ready dict."""
         self.wait()
-        return {k: v for k, v in asdict(self).items() if not k.startswith("_")}
+        out = {k: v for k, v in asdict(self).items() if not k.startswith("_")}
+        out["inputs"] = [f.to_dict() for f in self.inputs]
+        return out
