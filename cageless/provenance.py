@@ -23,7 +23,7 @@ import threading
 from collections.abc import Iterable, Mapping
 from dataclasses import asdict, dataclass, field
 from datetime import UTC, datetime
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
@@ -31,11 +31,14 @@ from typing import Any
 from cageless._version import __version__
 from cageless.atomic import atomic_write_text
 
-__all__ = ["InputFile", "Provenance", "sha256_file", "hash_file", "HASH_ALGORITHMS", "git_commit", "cache_dir"]
+__all__ = ["InputFile", "Provenance", "sha256_file", "hash_file", "prefetch_hash", "HASH_ALGORITHMS", "VIDEO_HASH", "git_commit",
+           "cache_dir"]
 
 _CHUNK = 1 << 20
 #: The hash algorithms an input can be recorded with.
 HASH_ALGORITHMS = ("sha256", "blake3")
+#: The algorithm videos are hashed with (a 20 GB recording: about 4 s of one core, against 26 s for SHA-256).
+VIDEO_HASH = "blake3"
 _POOL = ThreadPoolExecutor(max_workers=2, thread_name_prefix="cageless-hash")
 
 
@@ -70,8 +73,9 @@ def hash_file(path: str | Path, algorithm: str = "sha256", cache: bool = True) -
     For a folder (an image sequence) the hash covers the sorted file names and contents.
     With ``cache`` the result is remembered under :func:`cache_dir` (one folder per algorithm),
     keyed by the path, size, modification time and inode of every file, so an unchanged video
-    is hashed once. BLAKE3 reads a single file through a memory map on one thread (the
-    ``blake3`` package releases the GIL); SHA-256 costs about 1.3 s per GB here, BLAKE3 0.35 s.
+    is hashed once. The file is read in 1 MiB blocks into one reused buffer, so memory stays
+    flat; both hashers release the GIL, so hashing in a thread overlaps other work. Measured
+    here (CPU time, one core): SHA-256 about 1.3 s per GB, BLAKE3 about 0.2 s per GB.
 
     Raises
     ------
@@ -85,14 +89,50 @@ def hash_file(path: str | Path, algorithm: str = "sha256", cache: bool = True) -
     store = cache_dir() / algorithm
     if cache and (store / key).is_file():
         return (store / key).read_text().strip()
-    value = _hash_uncached(path, algorithm)
     if cache:
+        with _INFLIGHT_LOCK:
+            running = _INFLIGHT.get((key, algorithm))
+        if running is not None:  # prefetch_hash started it: wait instead of hashing twice
+            return str(running.result())
+    return _hash_and_store(path, algorithm, key if cache else None)
+
+
+def _hash_and_store(path: Path, algorithm: str, key: str | None) -> str:
+    value = _hash_uncached(path, algorithm)
+    if key is not None:
         try:
             with _CACHE_LOCK:
-                atomic_write_text(store / key, value)
+                atomic_write_text(cache_dir() / algorithm / key, value)
         except OSError:  # a read-only home is no reason to fail
             pass
     return value
+
+
+_INFLIGHT: dict[tuple[str, str], Future[str]] = {}
+_INFLIGHT_LOCK = threading.Lock()
+
+
+def prefetch_hash(path: str | Path, algorithm: str = "sha256") -> None:
+    """Start hashing ``path`` in a background thread now (e.g. while the modules that will use it load).
+
+    A later :func:`hash_file` of the same, unchanged file with the same algorithm waits for this
+    result instead of reading the file again. A hash already in the cache is not recomputed.
+    """
+    path = Path(path)
+    key = (_stat_key(path), algorithm)
+    if (cache_dir() / algorithm / key[0]).is_file():
+        return
+    with _INFLIGHT_LOCK:
+        if key in _INFLIGHT:
+            return
+        future = _POOL.submit(_hash_and_store, path, algorithm, key[0])
+        _INFLIGHT[key] = future
+    future.add_done_callback(lambda _: _forget(key))
+
+
+def _forget(key: tuple[str, str]) -> None:
+    with _INFLIGHT_LOCK:
+        _INFLIGHT.pop(key, None)
 
 
 def _hash_uncached(path: Path, algorithm: str) -> str:
@@ -100,18 +140,17 @@ def _hash_uncached(path: Path, algorithm: str) -> str:
         from blake3 import blake3
 
         digest: Any = blake3()
-        if path.is_file():
-            digest.update_mmap(path)  # one pass over the page cache, no copy into Python
-            return str(digest.hexdigest())
     else:
         digest = hashlib.sha256()
+    buf = bytearray(_CHUNK)  # one buffer, refilled: the memory used does not grow with the file
+    view = memoryview(buf)
     files = sorted(p for p in path.rglob("*") if p.is_file()) if path.is_dir() else [path]
     for p in files:
         if path.is_dir():
             digest.update(str(p.relative_to(path)).encode())
-        with open(p, "rb") as fh:
-            while chunk := fh.read(_CHUNK):
-                digest.update(chunk)
+        with open(p, "rb", buffering=0) as fh:
+            while n := fh.readinto(buf):
+                digest.update(view[:n])  # both hashers release the GIL on large buffers
     return str(digest.hexdigest())
 
 

@@ -27,7 +27,7 @@ from cageless.bearing import Bearing
 from cageless.conditions import OperatingConditions
 from cageless.errors import ParameterError, TrackingError
 from cageless.kinematics import slip_rate, theoretical_cage_speed
-from cageless.provenance import Provenance
+from cageless.provenance import VIDEO_HASH, Provenance
 from cageless.trace import Trace, VideoInfo, write_trace
 from tracking.detect import DetectorParams, detect_full, noise_sigma, spot_sigma, static_defects
 from tracking.geometry import fit_orbit, orbital_angles
@@ -41,15 +41,15 @@ __all__ = ["TrackOptions", "TrackResult", "track_video"]
 
 log = logging.getLogger(__name__)
 
-#: How the input video is hashed for its provenance: BLAKE3 reads a 20 GB recording in about 7 s on
-#: one core (SHA-256 needs about 25 s), in a background thread while the frames are tracked.
-INPUT_HASH = "blake3"
+#: How the input video is hashed for its provenance (BLAKE3), in a background thread while the frames
+#: are tracked.
+INPUT_HASH = VIDEO_HASH
 #: Shortest segment worth a thread, and the frames two segments share to match identities.
 _MIN_SEGMENT = 1024
 _OVERLAP = 8
 #: Frames served from a memory map between drops of their pages (fault-around maps whole frames:
-#: 32 full-size 16-bit frames are 66 MB).
-_DROP_EVERY = 32
+#: 8 full-size 16-bit frames are 16 MB).
+_DROP_EVERY = 8
 
 
 @dataclass(frozen=True)
@@ -111,6 +111,7 @@ class _CroppedFrames:
         self._cache: OrderedDict[int, np.ndarray] = OrderedDict()
         # Memory-mapped 8/16-bit cine: hand out views; the window kernel touches only the pages it needs.
         self.zero_copy = isinstance(video, CineReader) and not video._packed_bits
+        self._stack = video.frame_stack() if self.zero_copy else None  # type: ignore[attr-defined]
         self._span = (offset, offset)
 
     def __call__(self, i: int) -> np.ndarray:
@@ -120,6 +121,8 @@ class _CroppedFrames:
             if self._span[1] - self._span[0] >= _DROP_EVERY:
                 self.video.drop_pages(*self._span)  # type: ignore[attr-defined]
                 self._span = (j, j)
+            if self._stack is not None:  # one ndarray slice, no per-frame objects
+                return self._stack[j, self.rows, self.cols]
             return self.video.frame_view(j)[self.rows, self.cols]
         k = i // self.chunk
         block = self._cache.get(k)

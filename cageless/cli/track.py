@@ -101,15 +101,16 @@ def _track_one(job: tuple[Path, OperatingConditions, Bearing, Any, Path]) -> tup
 
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Track every input; print one summary line per video; return 1 if any failed."""
-    from tracking.detect import DetectorParams
-    from tracking.pipeline import TrackOptions
-
     if args.window < 3 or args.window % 2 == 0:
         raise UsageError(f"--window {args.window}: must be an odd number of frames >= 3.")
     bearing = bearing_from_config(config)
+    entries = collect_inputs(args.inputs, args.speed_rpm)
+    _prefetch_first_hash(entries, args.workers)
+    from tracking.detect import DetectorParams  # these imports take a second: the hash runs meanwhile
+    from tracking.pipeline import TrackOptions
+
     options = TrackOptions(detector=replace(DetectorParams(), method=args.detector), window=args.window,
                            strict=args.strict, fps=args.fps)
-    entries = collect_inputs(args.inputs, args.speed_rpm)
     out = Path(args.out)
     failed = 0
     for e in entries:
@@ -130,6 +131,18 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
                 tqdm.write(f"FAILED {video.name}: {info}")
                 failed += 1
     return 1 if failed else 0
+
+
+def _prefetch_first_hash(entries: list[LabEntry], workers: int) -> None:
+    """Start hashing the first video now, when it will be tracked in this process."""
+    from cageless.provenance import VIDEO_HASH, prefetch_hash
+
+    ok = [e for e in entries if e.ok]
+    if ok and (workers == 1 or len(ok) == 1):
+        try:
+            prefetch_hash(ok[0].video, VIDEO_HASH)
+        except OSError:  # unreadable: the tracker reports it
+            pass
 
 
 def _map(jobs: list[Any], workers: int, bar: Any) -> list[tuple[str, Any]]:

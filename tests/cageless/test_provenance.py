@@ -100,3 +100,18 @@ def test_provenance_names_the_hash_algorithm(tmp_path):
     assert (back.algorithm, back.digest, back.sha256) == ("blake3", BLAKE3_ABC, None)
     old = InputFile.from_dict({"name": "x", "size_bytes": 3, "sha256": SHA256_ABC})
     assert (old.algorithm, old.sha256) == ("sha256", SHA256_ABC)
+
+
+def test_prefetched_hash_is_computed_once(tmp_path, monkeypatch):
+    import cageless.provenance as pv
+
+    p = tmp_path / "abc.bin"
+    p.write_bytes(b"abc")
+    calls = []
+    real = pv._hash_uncached
+    monkeypatch.setattr(pv, "_hash_uncached", lambda path, alg: calls.append(alg) or real(path, alg))
+    pv.prefetch_hash(p, "blake3")
+    pv.prefetch_hash(p, "blake3")  # already running or cached: no second job
+    assert pv.hash_file(p, "blake3") == BLAKE3_ABC
+    assert pv.hash_file(p, "blake3") == BLAKE3_ABC
+    assert calls == ["blake3"]

@@ -80,6 +80,7 @@ class CineReader(FrameSource):
         if self._size < HEADER.size:
             raise VideoError(self.path, f"is too short ({self._size} bytes) to hold a cine header.", offset=0)
         self._mm = np.memmap(self.path, dtype=np.uint8, mode="r")
+        self._stack: np.ndarray | None | bool = False  # built on first use by frame_stack()
         self.header = self._unpack_named(HEADER, HEADER_FIELDS, 0, "CINEFILEHEADER")
         self._check_header()
         self.bitmap = self._unpack_named(BITMAPINFO, BITMAPINFO_FIELDS, self.header["off_image_header"], "BITMAPINFOHEADER")
@@ -205,6 +206,15 @@ class CineReader(FrameSource):
                                  hint="Re-copy the file; to read the complete frames pass allow_truncated=True.")
         self._data_start = data_start[:complete]
         self._n = complete
+        self._unmap(0, self._size)  # the checks above touched a page of every frame: do not keep them
+
+    def _unmap(self, lo: int, hi: int) -> None:
+        """Drop the mapped pages of bytes ``lo..hi`` from this process (they stay in the page cache)."""
+        mm = getattr(self._mm, "_mmap", None)
+        if mm is None or not hasattr(mm, "madvise") or hi <= lo:
+            return
+        lo -= lo % mmap.PAGESIZE
+        mm.madvise(mmap.MADV_DONTNEED, lo, min(hi, self._size) - lo)
 
     def _build_metadata(self, exposures: npt.NDArray[np.float64] | None) -> VideoMetadata:
         h, s = self.header, self.setup
@@ -252,20 +262,48 @@ class CineReader(FrameSource):
             raise IndexError(f"frame {index} out of range for {n} frames of {self.path}")
         if self._packed_bits:
             return self._read(index % n)
+        stack = self.frame_stack()
+        if stack is not None:
+            return stack[index % n]
         start = int(self._data_start[index % n])
         frame = self._mm[start:start + self._image_size].view(self._dtype).reshape(self.height, self.width)
         return frame[::-1] if self._bottom_up else frame
 
+    def frame_stack(self) -> np.ndarray | None:
+        """Every frame as one read-only (n, H, W) array viewing the memory map, upright; ``None`` for
+        packed frames or frames not laid out at one pitch.
+
+        Indexing it (``stack[i, rows, cols]``) costs a plain ndarray slice: no ``numpy.memmap``
+        objects are made per frame, and only the pages a caller touches are read.
+        """
+        if self._stack is False:
+            self._stack = self._build_stack()
+        return self._stack  # type: ignore[return-value]
+
+    def _build_stack(self) -> np.ndarray | None:
+        n, h, w, item = len(self), self.height, self.width, self._dtype.itemsize
+        if self._packed_bits or n == 0:
+            return None
+        starts = self._data_start
+        step = int(starts[1] - starts[0]) if n > 1 else self._image_size
+        if n > 1 and (not np.all(np.diff(starts) == step) or step < self._image_size):
+            return None
+        first, row = int(starts[0]), w * item
+        if self._bottom_up:  # start at the last row of the first frame and walk the rows backwards
+            first, row = first + (h - 1) * row, -row
+        raw = getattr(self._mm, "_mmap", None)
+        if raw is None:
+            return None
+        return np.ndarray((n, h, w), dtype=self._dtype, buffer=raw, offset=first, strides=(step, row, item))
+
     def drop_pages(self, first: int, last: int) -> None:
         """Unmap the file pages of frames ``first..last`` (they stay in the page cache), keeping the
         resident memory bounded while frame views stream through a long video."""
-        mm = getattr(self._mm, "_mmap", None)
-        if mm is None or not hasattr(mm, "madvise") or len(self) == 0:
+        if len(self) == 0:
             return
         lo = int(self._data_start[max(min(first, last), 0)])
         hi = int(self._data_start[min(max(first, last), len(self) - 1)]) + self._image_size
-        lo -= lo % mmap.PAGESIZE
-        mm.madvise(mmap.MADV_DONTNEED, lo, min(hi, self._size) - lo)
+        self._unmap(lo, hi)
 
     def _read_range(self, start: int, stop: int) -> np.ndarray:
         n = stop - start
@@ -299,6 +337,7 @@ class CineReader(FrameSource):
     def close(self) -> None:
         """Drop the memory map (the OS unmaps it once no frame view refers to it)."""
         self._mm = None  # type: ignore[assignment]
+        self._stack = None
 
 
 def _time64_to_iso(t: int) -> str:
