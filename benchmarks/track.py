@@ -15,7 +15,7 @@ lengths from its start, and for each length measures, each in a fresh process:
   and imports done (what the tracker itself sustains on both cores);
 * **end to end, cold**: ``cageless track clip.cine --speed-rpm 3000`` from a new interpreter
   with an empty hash cache (imports, hashing, tracking, writing the trace and its QC);
-* **peak RSS** of that end-to-end process (``wait4`` rusage);
+* **peak RSS** of that end-to-end process (``VmHWM``, read as it exits);
 
 and once: the wall time of ``cageless --version``, and trackpy (``locate`` + ``link``) on the
 first 100 frames of the same footage, giving the same-run ratio of our pipeline frames/s to
@@ -41,8 +41,12 @@ HERE = Path(__file__).resolve().parents[1]
 
 #: Runs first in every child: import cageless from the given source tree, not the installed one.
 _PRELUDE = (
-    "import sys; sys.meta_path[:] = [f for f in sys.meta_path if '__editable__' not in repr(f)]; "
+    "import sys, atexit; sys.meta_path[:] = [f for f in sys.meta_path if '__editable__' not in repr(f)]; "
     "sys.path.insert(0, {src!r}); "
+    # The peak RSS of this process since exec (VmHWM): wait4's ru_maxrss would carry the parent's peak over
+    # the fork (the parent maps the clips while cutting them).
+    "atexit.register(lambda: print('VMHWM_KB', open('/proc/self/status').read().split('VmHWM:')[1].split()[0], "
+    "file=sys.stderr)); "
 )
 _PIPELINE = _PRELUDE + (
     "import time, json; from cageless.bearing import default_bearing; "
@@ -63,7 +67,7 @@ def _child(code: str, env: dict[str, str] | None = None) -> tuple[float, float, 
     with tempfile.TemporaryFile("w+") as out:
         proc = subprocess.Popen([sys.executable, "-c", code], stdout=out, stderr=subprocess.PIPE, text=True,
                                 env={**os.environ, **(env or {})})
-        _, status, usage = os.wait4(proc.pid, 0)
+        _, status, _ = os.wait4(proc.pid, 0)
         wall = time.perf_counter() - t0
         proc.returncode = os.waitstatus_to_exitcode(status)
         err = proc.stderr.read() if proc.stderr else ""
@@ -71,15 +75,16 @@ def _child(code: str, env: dict[str, str] | None = None) -> tuple[float, float, 
         text = out.read()
     if proc.returncode not in (0,):
         raise RuntimeError(f"child failed ({proc.returncode}): {err[-2000:]}")
-    return wall, usage.ru_maxrss / 1024.0, text
+    peak = [int(line.split()[1]) for line in err.splitlines() if line.startswith("VMHWM_KB")]
+    return wall, (peak[-1] / 1024.0 if peak else float("nan")), text
 
 
-def _clips(folder: Path, lengths: list[int]) -> dict[int, Path]:
-    """The longest clip rendered once; the others are its first frames."""
+def _clips(folder: Path, lengths: list[int], footage: int | None = None) -> dict[int, Path]:
+    """A clip of ``footage`` frames (default the longest length) rendered once; the others are its first frames."""
     from tracking.bench import prepare_footage
     from tracking.io import open_video, write_cine
 
-    longest = max(lengths)
+    longest = footage or max(lengths)
     video, _ = prepare_footage(folder, longest)
     clips = {longest: video}
     with open_video(video) as src:
@@ -123,9 +128,10 @@ def _trackpy_fps(clip: Path, n: int = 100) -> float | None:
         return None
 
 
-def speed_table(folder: Path, lengths: list[int], repeats: int, baseline: Path | None) -> dict[str, Any]:
+def speed_table(folder: Path, lengths: list[int], repeats: int, baseline: Path | None,
+                footage: int | None = None) -> dict[str, Any]:
     """Measure every tree on every clip length, interleaved, best of ``repeats``."""
-    clips = _clips(folder, lengths)
+    clips = _clips(folder, lengths, footage)
     trees = {"this": HERE} | ({"baseline": baseline.resolve()} if baseline else {})
     for src in trees.values():  # warm-up: numba caches, page cache
         _measure(src, clips[min(lengths)])
@@ -134,6 +140,7 @@ def speed_table(folder: Path, lengths: list[int], repeats: int, baseline: Path |
         for n in sorted(lengths):
             for name, src in trees.items():
                 m = _measure(src, clips[n])
+                print(f"  {n} frames, {name}: {json.dumps(m)}", file=sys.stderr, flush=True)  # partial results
                 best = rows[name].get(n)
                 rows[name][n] = m if best is None else {
                     "pipeline_fps": max(best["pipeline_fps"], m["pipeline_fps"]),
@@ -141,7 +148,7 @@ def speed_table(folder: Path, lengths: list[int], repeats: int, baseline: Path |
                     "peak_rss_mib": max(best["peak_rss_mib"], m["peak_rss_mib"])}
     version = {name: _version_s(src, 5) for name, src in trees.items()}
     longest = max(lengths)
-    tpy = _trackpy_fps(clips[longest])
+    tpy = _trackpy_fps(clips[footage or longest])
     return {"lengths": sorted(lengths), "rows": {k: {str(n): v for n, v in r.items()} for k, r in rows.items()},
             "version_s": version, "trackpy_fps": tpy, "trackpy_frames": 100}
 
@@ -182,10 +189,12 @@ def main() -> None:
     ap.add_argument("--speed", action="store_true", help="the speed table over clip lengths")
     ap.add_argument("--lengths", type=int, nargs="+", default=[1000, 5000, 10000])
     ap.add_argument("--baseline", type=Path, help="another cageless source tree to compare against")
+    ap.add_argument("--footage", type=int, help="frames of the rendered clip the lengths are cut from "
+                    "(default the longest length)")
     args = ap.parse_args()
     args.dir.mkdir(parents=True, exist_ok=True)
     if args.speed:
-        result = speed_table(args.dir, args.lengths, args.repeats, args.baseline)
+        result = speed_table(args.dir, args.lengths, args.repeats, args.baseline, args.footage)
         print(format_speed(result))
     else:
         from tracking.bench import format_tables, run_benchmark
