@@ -23,6 +23,7 @@ second copy), packed runs are unpacked by a compiled loop.
 from __future__ import annotations
 
 import mmap
+import os
 import struct
 from datetime import UTC, datetime
 from pathlib import Path
@@ -183,22 +184,15 @@ class CineReader(FrameSource):
         starts = np.frombuffer(self._mm, dtype="<i8", count=n, offset=off).astype(np.int64)
         data_start = np.full(n, -1, dtype=np.int64)
         complete = 0
-        for i, start in enumerate(starts):
-            if start < off + 8 * n or start + 8 > self._size:
-                break
-            (ann,) = struct.unpack_from("<I", self._mm, int(start))
-            if ann < 8 or start + ann > self._size:
-                break
-            (img,) = struct.unpack_from("<I", self._mm, int(start + ann - 4))
-            if img != self._image_size:
-                raise VideoError(self.path, f"frame {i} declares {img} bytes of pixels but a {self.width} x {self.height} "
-                                 f"{self._storage} frame needs {self._image_size}: the file is corrupt.",
-                                 offset=int(start + ann - 4))
-            if start + ann + img > self._size:
-                break
-            data_start[i] = start + ann
-            complete += 1
+        # The frame headers are read with pread, not through the map: touching one page of every frame
+        # would map (and count in the resident memory) a large part of every frame.
+        fd = os.open(self.path, os.O_RDONLY)
+        try:
+            complete = self._check_frames(fd, starts, off, data_start)
+        finally:
+            os.close(fd)
         if complete < n:
+
             bad = int(starts[complete])
             if not allow_truncated or complete == 0:
                 raise VideoError(self.path, f"is truncated: frame {complete} of {n} starts at or runs past the end of "
@@ -206,7 +200,25 @@ class CineReader(FrameSource):
                                  hint="Re-copy the file; to read the complete frames pass allow_truncated=True.")
         self._data_start = data_start[:complete]
         self._n = complete
-        self._unmap(0, self._size)  # the checks above touched a page of every frame: do not keep them
+
+    def _check_frames(self, fd: int, starts: np.ndarray, off: int, data_start: np.ndarray) -> int:
+        """Fill ``data_start`` from each frame's annotation header; return how many frames are complete."""
+        n = len(starts)
+        for i, start in enumerate(starts):
+            if start < off + 8 * n or start + 8 > self._size:
+                return i
+            (ann,) = struct.unpack("<I", os.pread(fd, 4, int(start)))
+            if ann < 8 or start + ann > self._size:
+                return i
+            (img,) = struct.unpack("<I", os.pread(fd, 4, int(start + ann - 4)))
+            if img != self._image_size:
+                raise VideoError(self.path, f"frame {i} declares {img} bytes of pixels but a {self.width} x {self.height} "
+                                 f"{self._storage} frame needs {self._image_size}: the file is corrupt.",
+                                 offset=int(start + ann - 4))
+            if start + ann + img > self._size:
+                return i
+            data_start[i] = start + ann
+        return n
 
     def _unmap(self, lo: int, hi: int) -> None:
         """Drop the mapped pages of bytes ``lo..hi`` from this process (they stay in the page cache)."""
