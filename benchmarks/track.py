@@ -1,18 +1,183 @@
-"""Tracking speed and accuracy-versus-time (see tracking/bench.py for what is measured).
+"""Tracking speed: the study behind `cageless bench tracking`, and the speed table of long clips.
 
     python benchmarks/track.py [--dir bench_footage] [--frames 2400] [--repeats 3] [--json out.json]
+    python benchmarks/track.py --speed [--dir bench_footage] [--lengths 1000 5000 10000]
+                               [--baseline OLD_SOURCE_TREE] [--repeats 2] [--json out.json]
 
-The same study runs as `cageless bench tracking`. It renders full-size footage once
-(about 2 minutes for 2400 frames on 2 cores, 4.9 GB) and reuses it.
+Without ``--speed`` it runs the accuracy-versus-time study of :mod:`tracking.bench`
+(detectors, smoothing windows, trackpy on the same frames, peak memory).
+
+With ``--speed`` it renders one full-size clip (1280 x 800 px, 16-bit cine words, 12.5 px/mm,
+3000 rpm at 10,000 frames/s; 2 MB a frame) of the longest length once, cuts the shorter
+lengths from its start, and for each length measures, each in a fresh process:
+
+* **pipeline frames/s**: :func:`tracking.pipeline.track_video` in process, input hash cached
+  and imports done (what the tracker itself sustains on both cores);
+* **end to end, cold**: ``cageless track clip.cine --speed-rpm 3000`` from a new interpreter
+  with an empty hash cache (imports, hashing, tracking, writing the trace and its QC);
+* **peak RSS** of that end-to-end process (``VmHWM``, read as it exits);
+
+and once: the wall time of ``cageless --version``, and trackpy (``locate`` + ``link``) on the
+first 100 frames of the same footage, giving the same-run ratio of our pipeline frames/s to
+trackpy's. ``--baseline`` names another cageless source tree (e.g. ``git archive`` of an older
+commit); every measurement is then made for both trees, interleaved, best of ``--repeats``, and
+the table shows both with their ratio. The page cache holds the clip in every run (one warm-up
+run is not counted); numba's on-disk cache is warm.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
 from pathlib import Path
+from typing import Any
 
-from tracking.bench import format_tables, run_benchmark
+HERE = Path(__file__).resolve().parents[1]
+
+#: Runs first in every child: import cageless from the given source tree, not the installed one.
+_PRELUDE = (
+    "import sys, atexit; sys.meta_path[:] = [f for f in sys.meta_path if '__editable__' not in repr(f)]; "
+    "sys.path.insert(0, {src!r}); "
+    # The peak RSS of this process since exec (VmHWM): wait4's ru_maxrss would carry the parent's peak over
+    # the fork (the parent maps the clips while cutting them).
+    "atexit.register(lambda: print('VMHWM_KB', open('/proc/self/status').read().split('VmHWM:')[1].split()[0], "
+    "file=sys.stderr)); "
+)
+_PIPELINE = _PRELUDE + (
+    "import time, json; from cageless.bearing import default_bearing; "
+    "from cageless.conditions import OperatingConditions; import tracking.pipeline as p; "
+    "import cageless.provenance as pv; "
+    "h = pv.hash_file({clip!r}, getattr(p, 'INPUT_HASH', 'sha256')) if hasattr(pv, 'hash_file') "
+    "else pv.sha256_file({clip!r}); "
+    "t = time.perf_counter(); r = p.track_video({clip!r}, OperatingConditions(3000.0, 500.0), "
+    "default_bearing(), progress=False); "
+    "print(json.dumps({{'s': time.perf_counter() - t, 'n': int(r.trace.n_samples)}}))"
+)
+_CLI = _PRELUDE + "from cageless.cli import main; sys.exit(main({argv!r}))"
+
+
+def _child(code: str, env: dict[str, str] | None = None) -> tuple[float, float, str]:
+    """Run ``python -c code``; return its wall time (s), peak RSS (MiB) and stdout."""
+    t0 = time.perf_counter()
+    with tempfile.TemporaryFile("w+") as out:
+        proc = subprocess.Popen([sys.executable, "-c", code], stdout=out, stderr=subprocess.PIPE, text=True,
+                                env={**os.environ, **(env or {})})
+        _, status, _ = os.wait4(proc.pid, 0)
+        wall = time.perf_counter() - t0
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        err = proc.stderr.read() if proc.stderr else ""
+        out.seek(0)
+        text = out.read()
+    if proc.returncode not in (0,):
+        raise RuntimeError(f"child failed ({proc.returncode}): {err[-2000:]}")
+    peak = [int(line.split()[1]) for line in err.splitlines() if line.startswith("VMHWM_KB")]
+    return wall, (peak[-1] / 1024.0 if peak else float("nan")), text
+
+
+def _clips(folder: Path, lengths: list[int], footage: int | None = None) -> dict[int, Path]:
+    """A clip of ``footage`` frames (default the longest length) rendered once; the others are its first frames."""
+    from tracking.bench import prepare_footage
+    from tracking.io import open_video, write_cine
+
+    longest = footage or max(lengths)
+    video, _ = prepare_footage(folder, longest)
+    clips = {longest: video}
+    with open_video(video) as src:
+        for n in sorted(set(lengths) - {longest}):
+            dst = folder / f"{video.stem}_first{n}.cine"
+            if not dst.is_file():
+                write_cine(dst, (src[i] for i in range(n)), fps=10_000.0, fmt="16",
+                           real_bpp=src.metadata.bit_depth, n_frames=n, timestamps_s=src.times[:n])
+            clips[n] = dst
+    return clips
+
+
+def _measure(src: Path, clip: Path) -> dict[str, float]:
+    """Pipeline frames/s (hash cached), and cold end-to-end frames/s and peak RSS."""
+    with tempfile.TemporaryDirectory(prefix="cageless-speed-") as tmp:
+        _, _, out = _child(_PIPELINE.format(src=str(src), clip=str(clip)), {"CAGELESS_CACHE_DIR": tmp + "/c1"})
+        r = json.loads(out.strip().splitlines()[-1])
+        wall, rss, _ = _child(_CLI.format(src=str(src), argv=["track", str(clip), "-o", tmp + "/out",
+                                                                "--speed-rpm", "3000", "-q"]),
+                              {"CAGELESS_CACHE_DIR": tmp + "/c2"})
+    return {"pipeline_fps": r["n"] / r["s"], "cold_fps": r["n"] / wall, "cold_s": wall, "peak_rss_mib": rss}
+
+
+def _version_s(src: Path, repeats: int) -> float:
+    return min(_child(_CLI.format(src=str(src), argv=["--version"]))[0] for _ in range(repeats))
+
+
+def _trackpy_fps(clip: Path, n: int = 100) -> float | None:
+    try:
+        from tracking.bench import _trackpy
+    except ImportError:
+        return None
+    import pandas as pd
+
+    truth = pd.read_csv(clip.with_suffix(".truth.csv")) if clip.with_suffix(".truth.csv").is_file() else None
+    if truth is None:
+        return None
+    try:
+        return float(_trackpy(clip, truth, n)["fps"])
+    except ImportError:
+        return None
+
+
+def speed_table(folder: Path, lengths: list[int], repeats: int, baseline: Path | None,
+                footage: int | None = None) -> dict[str, Any]:
+    """Measure every tree on every clip length, interleaved, best of ``repeats``."""
+    clips = _clips(folder, lengths, footage)
+    trees = {"this": HERE} | ({"baseline": baseline.resolve()} if baseline else {})
+    for src in trees.values():  # warm-up: numba caches, page cache
+        _measure(src, clips[min(lengths)])
+    rows: dict[str, dict[int, dict[str, float]]] = {k: {} for k in trees}
+    for _ in range(repeats):
+        for n in sorted(lengths):
+            for name, src in trees.items():
+                m = _measure(src, clips[n])
+                print(f"  {n} frames, {name}: {json.dumps(m)}", file=sys.stderr, flush=True)  # partial results
+                best = rows[name].get(n)
+                rows[name][n] = m if best is None else {
+                    "pipeline_fps": max(best["pipeline_fps"], m["pipeline_fps"]),
+                    "cold_fps": max(best["cold_fps"], m["cold_fps"]), "cold_s": min(best["cold_s"], m["cold_s"]),
+                    "peak_rss_mib": max(best["peak_rss_mib"], m["peak_rss_mib"])}
+    version = {name: _version_s(src, 5) for name, src in trees.items()}
+    longest = max(lengths)
+    tpy = _trackpy_fps(clips[footage or longest])
+    return {"lengths": sorted(lengths), "rows": {k: {str(n): v for n, v in r.items()} for k, r in rows.items()},
+            "version_s": version, "trackpy_fps": tpy, "trackpy_frames": 100}
+
+
+def format_speed(r: dict[str, Any]) -> str:
+    """The speed table as text."""
+    trees = list(r["rows"])
+    lines = ["Tracking speed, 1280x800 16-bit cine from the page cache, 3000 rpm, both cores"
+             + (" (this tree vs baseline, same run)" if len(trees) > 1 else ""),
+             f"{'frames':>7} {'tree':<9}{'pipeline f/s':>13}{'cold e2e f/s':>14}{'cold e2e s':>11}{'peak RSS MiB':>14}"]
+    for n in r["lengths"]:
+        for t in trees:
+            m = r["rows"][t][str(n)]
+            lines.append(f"{n:>7} {t:<9}{m['pipeline_fps']:>13.0f}{m['cold_fps']:>14.0f}{m['cold_s']:>11.2f}"
+                         f"{m['peak_rss_mib']:>14.0f}")
+        if len(trees) > 1:
+            a, b = r["rows"]["this"][str(n)], r["rows"]["baseline"][str(n)]
+            lines.append(f"{'':>7} {'ratio':<9}{a['pipeline_fps'] / b['pipeline_fps']:>12.2f}x"
+                         f"{a['cold_fps'] / b['cold_fps']:>13.2f}x")
+    lines.append("cageless --version: " + ", ".join(f"{t} {s:.3f} s" for t, s in r["version_s"].items()))
+    if r["trackpy_fps"]:
+        longest = str(r["lengths"][-1])
+        ratios = ", ".join(f"{t} {r['rows'][t][longest]['pipeline_fps'] / r['trackpy_fps']:.0f}x"
+                           for t in trees)
+        lines.append(f"trackpy locate+link on {r['trackpy_frames']} frames of the same clip: "
+                     f"{r['trackpy_fps']:.1f} frames/s; pipeline / trackpy: {ratios}")
+    else:
+        lines.append("trackpy: not installed (pip install 'cageless[bench]')")
+    return "\n".join(lines)
 
 
 def main() -> None:
@@ -21,10 +186,21 @@ def main() -> None:
     ap.add_argument("--frames", type=int, default=2400)
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--json", type=Path)
+    ap.add_argument("--speed", action="store_true", help="the speed table over clip lengths")
+    ap.add_argument("--lengths", type=int, nargs="+", default=[1000, 5000, 10000])
+    ap.add_argument("--baseline", type=Path, help="another cageless source tree to compare against")
+    ap.add_argument("--footage", type=int, help="frames of the rendered clip the lengths are cut from "
+                    "(default the longest length)")
     args = ap.parse_args()
     args.dir.mkdir(parents=True, exist_ok=True)
-    result = run_benchmark(args.dir, args.frames, args.repeats)
-    print(format_tables(result))
+    if args.speed:
+        result = speed_table(args.dir, args.lengths, args.repeats, args.baseline, args.footage)
+        print(format_speed(result))
+    else:
+        from tracking.bench import format_tables, run_benchmark
+
+        result = run_benchmark(args.dir, args.frames, args.repeats)
+        print(format_tables(result))
     if args.json:
         args.json.write_text(json.dumps(result, indent=1))
 

@@ -12,10 +12,17 @@ The app layer (:mod:`cageless.cli`) is the only place that imports
 ``tracking``, ``simulation`` and ``comparison``.
 """
 
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
 from cageless._version import __version__
-from cageless.bearing import Bearing, Geometry, Lubricant, Masses, Material, default_bearing
-from cageless.conditions import OperatingConditions
-from cageless.trace import Trace, read_trace, write_trace
+
+if TYPE_CHECKING:  # pragma: no cover - for type checkers only
+    from cageless.bearing import Bearing, Geometry, Lubricant, Masses, Material, default_bearing
+    from cageless.conditions import OperatingConditions
+    from cageless.trace import Trace, read_trace, write_trace
 
 __all__ = [
     "__version__",
@@ -30,3 +37,25 @@ __all__ = [
     "read_trace",
     "write_trace",
 ]
+
+#: Public names and the module that defines each. They are imported on first use (PEP 562), so that
+#: ``import cageless`` (and ``cageless --version``) does not pull in pandas, h5py or numpy.
+_LAZY = {
+    "Bearing": "cageless.bearing", "Geometry": "cageless.bearing", "Lubricant": "cageless.bearing",
+    "Masses": "cageless.bearing", "Material": "cageless.bearing", "default_bearing": "cageless.bearing",
+    "OperatingConditions": "cageless.conditions",
+    "Trace": "cageless.trace", "read_trace": "cageless.trace", "write_trace": "cageless.trace",
+}
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'cageless' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

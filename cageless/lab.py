@@ -42,7 +42,7 @@ from cageless.errors import CagelessError
 from cageless.kinematics import startup_duration, theoretical_cage_speed
 from cageless.outputs import clean_stale_parts, output_lock
 from cageless.parallel import job_pool
-from cageless.provenance import sha256_file
+from cageless.provenance import hash_file
 from cageless.trace import read_trace
 from cageless.validate import plausible_entry
 
@@ -321,7 +321,7 @@ def _track_all(pool: Any, entries: list[LabEntry], bearing: Bearing, out: Path, 
     traces: dict[Path, Any] = {}
     jobs, keys, pending = [], [], []
     for e in entries:
-        key = cache.key("track", {"input": sha256_file(e.video), "conditions": e.resolved.conditions.to_dict(),
+        key = cache.key("track", {"input": hash_file(e.video, "blake3"), "conditions": e.resolved.conditions.to_dict(),
                                   "bearing": bearing.to_dict()})
         hit = cache.hit(key)
         if hit:

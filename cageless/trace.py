@@ -70,14 +70,34 @@ FloatArray = npt.NDArray[np.float64]
 
 @dataclass(frozen=True)
 class VideoInfo:
-    """Root attributes that only video traces carry (DESIGN §4)."""
+    """Root attributes that only video traces carry (DESIGN §4).
+
+    The input video's identity is ``input_hash`` (hex) by ``input_hash_algorithm`` (``"sha256"`` or
+    ``"blake3"``). ``input_sha256`` is kept for traces that name SHA-256: it equals ``input_hash``
+    when the algorithm is SHA-256 and is empty otherwise (and then not written). A trace written
+    before ``input_hash`` existed carries only ``input_sha256``; it reads as a SHA-256 hash.
+    """
 
     fps: float
     px_per_mm: float
     centre_px: tuple[float, float]
     camera_roll_rad: float
     input_file: str
-    input_sha256: str
+    input_sha256: str = ""
+    input_hash: str = ""
+    input_hash_algorithm: str = ""
+
+    def __post_init__(self) -> None:
+        algorithm = self.input_hash_algorithm or "sha256"
+        digest = self.input_hash or (self.input_sha256 if algorithm == "sha256" else "")
+        object.__setattr__(self, "input_hash_algorithm", algorithm)
+        object.__setattr__(self, "input_hash", digest)
+        if algorithm == "sha256":
+            if self.input_sha256 and self.input_sha256 != digest:
+                raise ValueError(f"input_sha256 {self.input_sha256!r} differs from input_hash {digest!r}")
+            object.__setattr__(self, "input_sha256", digest)
+        elif self.input_sha256:
+            raise ValueError(f"input_sha256 is given but the input hash algorithm is {algorithm!r}")
 
 
 @dataclass(frozen=True)
@@ -273,6 +293,8 @@ def _write_root_attrs(f: h5py.File, trace: Trace) -> None:
     a["direction"] = np.int64(trace.direction)
     extra = trace.video if trace.source == "video" else trace.simulation
     for key, value in asdict(extra).items():  # type: ignore[arg-type]
+        if key == "input_sha256" and not value:
+            continue  # the input was hashed with another algorithm: input_hash names it
         a[key] = np.asarray(value, dtype=np.float64) if key == "centre_px" else value
 
 
@@ -358,9 +380,11 @@ def _read_body(path: Path, f: h5py.File) -> Trace:
     source = _attr(a, "source")
     kwargs: dict[str, Any] = {}
     if source == "video":
+        if "input_sha256" not in a and "input_hash" not in a:
+            raise KeyError("attribute input_hash (or input_sha256)")
         kwargs["video"] = VideoInfo(**{
             k: (tuple(float(x) for x in _attr(a, k)) if k == "centre_px" else _scalar(_attr(a, k)))
-            for k in VideoInfo.__dataclass_fields__
+            for k in VideoInfo.__dataclass_fields__ if k not in _VIDEO_HASH_FIELDS or k in a
         })
     elif source == "simulation":
         kwargs["simulation"] = SimulationInfo(**{
@@ -393,6 +417,11 @@ def _read_body(path: Path, f: h5py.File) -> Trace:
         created_utc=str(_attr(a, "created_utc")), software_version=str(_attr(a, "software_version")),
         **kwargs,
     )
+
+
+#: Video attributes of which a trace carries some: ``input_sha256`` alone (older traces),
+#: ``input_hash`` with ``input_hash_algorithm``, or all three.
+_VIDEO_HASH_FIELDS = ("input_sha256", "input_hash", "input_hash_algorithm")
 
 
 def _scalar(value: Any) -> Any:

@@ -68,8 +68,18 @@ def background_frame(video: FrameSource, n_sample: int = 25) -> npt.NDArray[np.f
     """Per-pixel median of up to ``n_sample`` frames spread over the video (removes the moving highlights)."""
     n = len(video)
     idx = np.unique(np.linspace(0, n - 1, min(n, n_sample)).round().astype(int))
-    stack = np.stack([video[int(i)] for i in idx])
-    return np.median(stack, axis=0).astype(np.float32)
+    frames = [video.frame_view(int(i)) for i in idx]
+    out = np.empty(video.frame_shape, dtype=np.float32)
+    # In bands of rows: the same medians as over the whole stack, but the working set stays in cache
+    # and the memory used is a few MB instead of 25 frames and their sorted copy.
+    for r0 in range(0, out.shape[0], _MEDIAN_ROWS):
+        band = np.stack([f[r0:r0 + _MEDIAN_ROWS] for f in frames])
+        out[r0:r0 + _MEDIAN_ROWS] = np.median(band, axis=0)
+    return out
+
+
+#: Rows per band of the background median (25 frames x 32 rows x 1280 px x 2 B = 2 MB).
+_MEDIAN_ROWS = 32
 
 
 def fit_circle(u: npt.ArrayLike, v: npt.ArrayLike) -> tuple[float, float, float, float]:

@@ -27,7 +27,7 @@ from cageless.bearing import Bearing
 from cageless.conditions import OperatingConditions
 from cageless.errors import ParameterError, TrackingError
 from cageless.kinematics import slip_rate, theoretical_cage_speed
-from cageless.provenance import Provenance
+from cageless.provenance import VIDEO_HASH, Provenance
 from cageless.trace import Trace, VideoInfo, write_trace
 from tracking.detect import DetectorParams, detect_full, noise_sigma, spot_sigma, static_defects
 from tracking.geometry import fit_orbit, orbital_angles
@@ -41,12 +41,15 @@ __all__ = ["TrackOptions", "TrackResult", "track_video"]
 
 log = logging.getLogger(__name__)
 
+#: How the input video is hashed for its provenance (BLAKE3), in a background thread while the frames
+#: are tracked.
+INPUT_HASH = VIDEO_HASH
 #: Shortest segment worth a thread, and the frames two segments share to match identities.
 _MIN_SEGMENT = 1024
 _OVERLAP = 8
 #: Frames served from a memory map between drops of their pages (fault-around maps whole frames:
-#: 32 full-size 16-bit frames are 66 MB).
-_DROP_EVERY = 32
+#: 8 full-size 16-bit frames are 16 MB).
+_DROP_EVERY = 8
 
 
 @dataclass(frozen=True)
@@ -111,6 +114,7 @@ class _CroppedFrames:
         self._cache: OrderedDict[int, np.ndarray] = OrderedDict()
         # Memory-mapped 8/16-bit cine: hand out views; the window kernel touches only the pages it needs.
         self.zero_copy = isinstance(video, CineReader) and not video._packed_bits
+        self._stack = video.frame_stack() if self.zero_copy else None  # type: ignore[attr-defined]
         self._span = (offset, offset)
 
     def __call__(self, i: int) -> np.ndarray:
@@ -120,6 +124,8 @@ class _CroppedFrames:
             if self._span[1] - self._span[0] >= _DROP_EVERY:
                 self.video.drop_pages(*self._span)  # type: ignore[attr-defined]
                 self._span = (j, j)
+            if self._stack is not None:  # one ndarray slice, no per-frame objects
+                return self._stack[j, self.rows, self.cols]
             return self.video.frame_view(j)[self.rows, self.cols]
         k = i // self.chunk
         block = self._cache.get(k)
@@ -171,8 +177,10 @@ def track_video(
     path = Path(path)
     fps = options.fps or conditions.fps
     prov = Provenance.start(config={"tracking": options.to_dict(), "conditions": conditions.to_dict(),
-                                    **(config or {})}, inputs=[path], background=True)
-    with warnings.catch_warnings(record=True) as caught, open_video(path, fps=fps, allow_truncated=options.allow_truncated) as video:
+                                    **(config or {})}, inputs=[path], background=True,
+                             hash_algorithm=INPUT_HASH)
+    with warnings.catch_warnings(record=True) as caught, \
+            open_video(path, fps=fps, allow_truncated=options.allow_truncated) as video:
         warnings.simplefilter("always", BallCountWarning)
         times = video.times
         if len(video) < options.window:
@@ -282,7 +290,8 @@ def _finish(path: Path, video: FrameSource, table: pd.DataFrame, loc: BearingLoc
                 "slip_contact_angle_rad": 0.0,
                 "video": meta.to_dict() | {"extra": {}}},
         video=VideoInfo(fps=float(fps), px_per_mm=float(px_per_mm), centre_px=orbit.centre,
-                        camera_roll_rad=roll, input_file=path.name, input_sha256=prov.finish().inputs[0].sha256),
+                        camera_roll_rad=roll, input_file=path.name, input_hash=prov.finish().inputs[0].digest,
+                        input_hash_algorithm=prov.inputs[0].algorithm),
         provenance=prov.to_dict(),
         qc=qc.to_dict(),
     )

@@ -1,9 +1,12 @@
 """The ``cageless`` command line: one console script with subcommands (DESIGN §2).
 
 Each subcommand lives in its own module exposing ``register(subparsers, parent)``
-and ``run(args, config) -> int``; :data:`SUBCOMMANDS` lists them in help order.
-Later issues add ``track``, ``simulate``, ``compare``, ``report``, ``bench``
-and ``sample`` by adding a module name here.
+and ``run(args, config) -> int``; :data:`SUBCOMMANDS` lists them in help order and
+:data:`SUMMARIES` gives each one's help line.
+
+Start-up is lazy: a subcommand's module (and with it numpy, pandas, numba, ...) is
+imported only when that subcommand is named, so ``cageless --version`` and
+``cageless --help`` import none of them.
 
 Exit codes: 0 success, 1 some inputs failed (the rest done), 2 usage error.
 """
@@ -24,6 +27,20 @@ __all__ = ["main", "entry_point", "build_parser", "SUBCOMMANDS"]
 
 SUBCOMMANDS: tuple[str, ...] = ("info", "track", "simulate", "compare", "report", "sweep", "calibrate", "sample", "bench")
 
+#: The one-line help of each subcommand, listed by ``cageless --help`` without importing its module
+#: (each module's ``register`` uses the same line; a test checks that they agree).
+SUMMARIES: dict[str, str] = {
+    "info": "show the bearing, its kinematics and characteristic frequencies",
+    "track": "track the balls in videos and write trace files",
+    "simulate": "decide (and explain) the bearing model a scene calls for",
+    "compare": "compare a measured and a simulated trace (one Table-2 row)",
+    "report": "lab folder -> traces, simulations, slip table and report.html",
+    "sweep": "a scene over a parameter grid and seeds: peak slip table and plot",
+    "calibrate": "fit open model parameters to a measured slip profile or peak slip",
+    "sample": "render synthetic bearing videos with known ground truth",
+    "bench": "accuracy-versus-time studies (tables)",
+}
+
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 
 log = logging.getLogger("cageless")
@@ -40,8 +57,15 @@ exit codes: 0 success, 1 some inputs failed (the rest done), 2 usage error
 """
 
 
-def build_parser() -> ArgumentParser:
-    """Build the top-level parser with every registered subcommand."""
+def build_parser(command: str | None = None) -> ArgumentParser:
+    """Build the top-level parser.
+
+    Parameters
+    ----------
+    command
+        Register only this subcommand in full (importing its module); the others are listed by
+        name and help line. ``None`` (the default) registers every subcommand in full.
+    """
     parser = ArgumentParser(
         prog="cageless",
         description="Track, simulate and compare the balls of cageless ball bearings.",
@@ -52,8 +76,19 @@ def build_parser() -> ArgumentParser:
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=ArgumentParser)
     parent = common_options()
     for name in SUBCOMMANDS:
-        importlib.import_module(f"cageless.cli.{name}").register(subparsers, parent)
+        if command is None or name == command:
+            importlib.import_module(f"cageless.cli.{name}").register(subparsers, parent)
+        else:
+            subparsers.add_parser(name, help=SUMMARIES[name], add_help=False)
     return parser
+
+
+def _command_of(argv: Sequence[str]) -> str | None:
+    """The subcommand named in ``argv`` (the first word that is not an option), if it is a known one."""
+    for word in argv:
+        if not word.startswith("-"):
+            return word if word in SUMMARIES else None
+    return None
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -70,7 +105,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         0 on success, 1 if some inputs failed, 2 on a usage error.
     """
     argv = list(sys.argv[1:] if argv is None else argv)
-    parser = build_parser()
+    parser = build_parser(_command_of(argv) or "")  # "" registers no subcommand in full
     try:
         args = parser.parse_args(argv)
         if args.command is None:

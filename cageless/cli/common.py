@@ -9,7 +9,6 @@ import re
 from collections.abc import Sequence
 from typing import Any, NoReturn
 
-from cageless.config import load_config
 from cageless.errors import UsageError, suggest
 
 __all__ = [
@@ -65,6 +64,8 @@ def apply_config_defaults(
     """
     if not getattr(args, "config", None):
         return args, {}
+    from cageless.config import load_config  # imported here: ``--version``/``--help`` do not need it
+
     config = load_config(args.config)
     table = config.get(command, {})
     sub = parser._subparsers._group_actions[0].choices[command]  # type: ignore[union-attr]

@@ -109,16 +109,17 @@ def _track_one(job: tuple[Path, OperatingConditions, Bearing, Any, Path]) -> tup
 
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Track every input; print one summary line per video; return 1 if any failed."""
-    from tracking.detect import DetectorParams
-    from tracking.pipeline import TrackOptions
-
     if args.window < 3 or args.window % 2 == 0:
         raise UsageError(f"--window {args.window}: must be an odd number of frames >= 3.")
     _validate(args)
     bearing = bearing_from_config(config)
+    entries = [plausible_entry(e, args.force) for e in collect_inputs(args.inputs, args.speed_rpm)]
+    _prefetch_first_hash(entries, args.workers)
+    from tracking.detect import DetectorParams  # these imports take a second: the hash runs meanwhile
+    from tracking.pipeline import TrackOptions
+
     options = TrackOptions(detector=replace(DetectorParams(), method=args.detector), window=args.window,
                            strict=args.strict, fps=args.fps, allow_truncated=args.allow_truncated)
-    entries = [plausible_entry(e, args.force) for e in collect_inputs(args.inputs, args.speed_rpm)]
     out = Path(args.out)
     with output_lock(out):
         clean_stale_parts(out)
@@ -151,6 +152,18 @@ def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bear
                 tqdm.write(f"FAILED {video.name}: {info}")
                 failed += 1
     return 1 if failed else 0
+
+
+def _prefetch_first_hash(entries: list[LabEntry], workers: int) -> None:
+    """Start hashing the first video now, when it will be tracked in this process."""
+    from cageless.provenance import VIDEO_HASH, prefetch_hash
+
+    ok = [e for e in entries if e.ok]
+    if ok and (workers == 1 or len(ok) == 1):
+        try:
+            prefetch_hash(ok[0].video, VIDEO_HASH)
+        except OSError:  # unreadable: the tracker reports it
+            pass
 
 
 def _map(jobs: list[Any], workers: int, bar: Any) -> list[tuple[str, Any]]:

@@ -96,7 +96,8 @@ def build_report(descriptions: Sequence[ConditionDescription], failed_rows: Sequ
                                                  f"{info['wall_s']:.1f} s"))
             repro.append((f"{d.label}: effects", "; ".join(_effects(info))))
         for item in d.video_provenance.get("inputs", []):
-            repro.append((f"input {item.get('name')}", f"sha256 {item.get('sha256')}"))
+            algorithm = next((a for a in ("blake3", "sha256") if a in item), "sha256")
+            repro.append((f"input {item.get('name')}", f"{algorithm} {item.get(algorithm)}"))
     return {
         "title": title,
         "generated_utc": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC"),

@@ -67,3 +67,51 @@ def test_hash_cache_follows_the_file(tmp_path):
     p.write_bytes(b"abcd")  # new size and mtime: a new key, a fresh hash
     assert sha256_file(p) == "88d4266fd4e6338d13b845fcf289579d209c897823b9217da3e161936f031589"
     assert sha256_file(p, cache=False) == sha256_file(p)
+
+
+#: BLAKE3 digests of b"" and b"abc" from the official test vectors of the BLAKE3 reference
+#: implementation (github.com/BLAKE3-team/BLAKE3, test_vectors.json and the spec's examples).
+BLAKE3_EMPTY = "af1349b9f5f9a1a6a0404dea36dcc9499bcb25c9adc112b7cc9a93cae41f3262"
+BLAKE3_ABC = "6437b3ac38465133ffb63b75273a8db548c558465d79db03fd359c6cd5bd9d85"
+
+
+def test_blake3_matches_the_reference_vectors(tmp_path):
+    from cageless.provenance import hash_file
+
+    p = tmp_path / "abc.bin"
+    p.write_bytes(b"abc")
+    assert hash_file(p, "blake3", cache=False) == BLAKE3_ABC
+    assert hash_file(p, "blake3") == BLAKE3_ABC and hash_file(p, "blake3") == BLAKE3_ABC  # cached
+    assert hash_file(p, "sha256") == SHA256_ABC  # a separate cache per algorithm
+    (tmp_path / "empty.bin").write_bytes(b"")
+    assert hash_file(tmp_path / "empty.bin", "blake3", cache=False) == BLAKE3_EMPTY
+    with pytest.raises(ValueError, match="md5"):
+        hash_file(p, "md5")
+
+
+def test_provenance_names_the_hash_algorithm(tmp_path):
+    from cageless.provenance import InputFile
+
+    p = tmp_path / "in.cine"
+    p.write_bytes(b"abc")
+    d = Provenance.start(inputs=[p], background=True, hash_algorithm="blake3").finish().to_dict()
+    assert d["inputs"] == [{"name": str(p), "size_bytes": 3, "blake3": BLAKE3_ABC}]
+    back = InputFile.from_dict(d["inputs"][0])
+    assert (back.algorithm, back.digest, back.sha256) == ("blake3", BLAKE3_ABC, None)
+    old = InputFile.from_dict({"name": "x", "size_bytes": 3, "sha256": SHA256_ABC})
+    assert (old.algorithm, old.sha256) == ("sha256", SHA256_ABC)
+
+
+def test_prefetched_hash_is_computed_once(tmp_path, monkeypatch):
+    import cageless.provenance as pv
+
+    p = tmp_path / "abc.bin"
+    p.write_bytes(b"abc")
+    calls = []
+    real = pv._hash_uncached
+    monkeypatch.setattr(pv, "_hash_uncached", lambda path, alg: calls.append(alg) or real(path, alg))
+    pv.prefetch_hash(p, "blake3")
+    pv.prefetch_hash(p, "blake3")  # already running or cached: no second job
+    assert pv.hash_file(p, "blake3") == BLAKE3_ABC
+    assert pv.hash_file(p, "blake3") == BLAKE3_ABC
+    assert calls == ["blake3"]

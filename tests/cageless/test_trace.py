@@ -213,3 +213,26 @@ def test_reader_rejects_non_hdf5_and_missing(tmp_path):
 def test_trace_refuses_inconsistent_data(changes, match):
     with pytest.raises(ValueError, match=match):
         make_trace(**changes)
+
+
+def test_input_hash_names_its_algorithm(tmp_path):
+    """BLAKE3 traces carry input_hash + input_hash_algorithm and no input_sha256; SHA-256 traces keep
+    input_sha256, and a trace written before input_hash existed reads as SHA-256."""
+    b3 = VideoInfo(fps=1e4, px_per_mm=12.5, centre_px=(1.0, 2.0), camera_roll_rad=0.0, input_file="x.cine",
+                   input_hash="cd" * 32, input_hash_algorithm="blake3")
+    path = write_trace(tmp_path / "b3.trace.h5", make_trace(video=b3))
+    with h5py.File(path, "r") as f:
+        assert "input_sha256" not in f.attrs and f.attrs["input_hash_algorithm"] == "blake3"
+    assert read_trace(path).video == b3
+    old = write_trace(tmp_path / "old.trace.h5", make_trace())  # VIDEO names only input_sha256
+    with h5py.File(old, "r+") as f:
+        del f.attrs["input_hash"], f.attrs["input_hash_algorithm"]
+    back = read_trace(old).video
+    assert (back.input_sha256, back.input_hash, back.input_hash_algorithm) == ("ab" * 32, "ab" * 32, "sha256")
+    with h5py.File(old, "r+") as f:
+        del f.attrs["input_sha256"]
+    with pytest.raises(TraceFormatError, match="input_hash"):
+        read_trace(old)
+    with pytest.raises(ValueError, match="algorithm is 'blake3'"):
+        VideoInfo(fps=1e4, px_per_mm=1.0, centre_px=(0.0, 0.0), camera_roll_rad=0.0, input_file="x",
+                  input_sha256="ab" * 32, input_hash_algorithm="blake3")

@@ -125,3 +125,10 @@ def test_chunked_reads_equal_frame_by_frame_reads(tmp_path, fmt, width):
         np.testing.assert_array_equal(video[2:7], data[2:7])
         np.testing.assert_array_equal(video[1:8:3], data[1:8:3])
         assert all(np.array_equal(video[i], data[i]) for i in range(9))
+        assert all(np.array_equal(video.frame_view(i), data[i]) for i in range(-9, 9))
+        stack = video.frame_stack()
+        if bits in (10, 12):
+            assert stack is None  # packed frames have no view: they are unpacked
+        else:
+            np.testing.assert_array_equal(stack, data)  # the written cine is bottom-up: rows come back upright
+            assert not stack.flags.writeable

@@ -23,6 +23,7 @@ second copy), packed runs are unpacked by a compiled loop.
 from __future__ import annotations
 
 import mmap
+import os
 import struct
 from datetime import UTC, datetime
 from pathlib import Path
@@ -80,6 +81,7 @@ class CineReader(FrameSource):
         if self._size < HEADER.size:
             raise VideoError(self.path, f"is too short ({self._size} bytes) to hold a cine header.", offset=0)
         self._mm = np.memmap(self.path, dtype=np.uint8, mode="r")
+        self._stack: np.ndarray | None | bool = False  # built on first use by frame_stack()
         self.header = self._unpack_named(HEADER, HEADER_FIELDS, 0, "CINEFILEHEADER")
         self._check_header()
         self.bitmap = self._unpack_named(BITMAPINFO, BITMAPINFO_FIELDS, self.header["off_image_header"], "BITMAPINFOHEADER")
@@ -189,22 +191,15 @@ class CineReader(FrameSource):
         starts = np.frombuffer(self._mm, dtype="<i8", count=n, offset=off).astype(np.int64)
         data_start = np.full(n, -1, dtype=np.int64)
         complete = 0
-        for i, start in enumerate(starts):
-            if start < off + 8 * n or start + 8 > self._size:
-                break
-            (ann,) = struct.unpack_from("<I", self._mm, int(start))
-            if ann < 8 or start + ann > self._size:
-                break
-            (img,) = struct.unpack_from("<I", self._mm, int(start + ann - 4))
-            if img != self._image_size:
-                raise VideoError(self.path, f"frame {i} declares {img} bytes of pixels but a {self.width} x {self.height} "
-                                 f"{self._storage} frame needs {self._image_size}: the file is corrupt.",
-                                 offset=int(start + ann - 4))
-            if start + ann + img > self._size:
-                break
-            data_start[i] = start + ann
-            complete += 1
+        # The frame headers are read with pread, not through the map: touching one page of every frame
+        # would map (and count in the resident memory) a large part of every frame.
+        fd = os.open(self.path, os.O_RDONLY)
+        try:
+            complete = self._check_frames(fd, starts, off, data_start)
+        finally:
+            os.close(fd)
         if complete < n:
+
             bad = int(starts[complete])
             if not allow_truncated or complete == 0:
                 raise VideoError(self.path, f"is truncated: frame {complete} of {n} starts at or runs past the end of "
@@ -212,6 +207,33 @@ class CineReader(FrameSource):
                                  hint="Re-copy the file, or re-run with --allow-truncated to use the complete frames.")
         self._data_start = data_start[:complete]
         self._n = complete
+
+    def _check_frames(self, fd: int, starts: np.ndarray, off: int, data_start: np.ndarray) -> int:
+        """Fill ``data_start`` from each frame's annotation header; return how many frames are complete."""
+        n = len(starts)
+        for i, start in enumerate(starts):
+            if start < off + 8 * n or start + 8 > self._size:
+                return i
+            (ann,) = struct.unpack("<I", os.pread(fd, 4, int(start)))
+            if ann < 8 or start + ann > self._size:
+                return i
+            (img,) = struct.unpack("<I", os.pread(fd, 4, int(start + ann - 4)))
+            if img != self._image_size:
+                raise VideoError(self.path, f"frame {i} declares {img} bytes of pixels but a {self.width} x {self.height} "
+                                 f"{self._storage} frame needs {self._image_size}: the file is corrupt.",
+                                 offset=int(start + ann - 4))
+            if start + ann + img > self._size:
+                return i
+            data_start[i] = start + ann
+        return n
+
+    def _unmap(self, lo: int, hi: int) -> None:
+        """Drop the mapped pages of bytes ``lo..hi`` from this process (they stay in the page cache)."""
+        mm = getattr(self._mm, "_mmap", None)
+        if mm is None or not hasattr(mm, "madvise") or hi <= lo:
+            return
+        lo -= lo % mmap.PAGESIZE
+        mm.madvise(mmap.MADV_DONTNEED, lo, min(hi, self._size) - lo)
 
     def _build_metadata(self, exposures: npt.NDArray[np.float64] | None) -> VideoMetadata:
         h, s = self.header, self.setup
@@ -259,20 +281,48 @@ class CineReader(FrameSource):
             raise IndexError(f"frame {index} out of range for {n} frames of {self.path}")
         if self._packed_bits:
             return self._read(index % n)
+        stack = self.frame_stack()
+        if stack is not None:
+            return stack[index % n]
         start = int(self._data_start[index % n])
         frame = self._mm[start:start + self._image_size].view(self._dtype).reshape(self.height, self.width)
         return frame[::-1] if self._bottom_up else frame
 
+    def frame_stack(self) -> np.ndarray | None:
+        """Every frame as one read-only (n, H, W) array viewing the memory map, upright; ``None`` for
+        packed frames or frames not laid out at one pitch.
+
+        Indexing it (``stack[i, rows, cols]``) costs a plain ndarray slice: no ``numpy.memmap``
+        objects are made per frame, and only the pages a caller touches are read.
+        """
+        if self._stack is False:
+            self._stack = self._build_stack()
+        return self._stack  # type: ignore[return-value]
+
+    def _build_stack(self) -> np.ndarray | None:
+        n, h, w, item = len(self), self.height, self.width, self._dtype.itemsize
+        if self._packed_bits or n == 0:
+            return None
+        starts = self._data_start
+        step = int(starts[1] - starts[0]) if n > 1 else self._image_size
+        if n > 1 and (not np.all(np.diff(starts) == step) or step < self._image_size):
+            return None
+        first, row = int(starts[0]), w * item
+        if self._bottom_up:  # start at the last row of the first frame and walk the rows backwards
+            first, row = first + (h - 1) * row, -row
+        raw = getattr(self._mm, "_mmap", None)
+        if raw is None:
+            return None
+        return np.ndarray((n, h, w), dtype=self._dtype, buffer=raw, offset=first, strides=(step, row, item))
+
     def drop_pages(self, first: int, last: int) -> None:
         """Unmap the file pages of frames ``first..last`` (they stay in the page cache), keeping the
         resident memory bounded while frame views stream through a long video."""
-        mm = getattr(self._mm, "_mmap", None)
-        if mm is None or not hasattr(mm, "madvise") or len(self) == 0:
+        if len(self) == 0:
             return
         lo = int(self._data_start[max(min(first, last), 0)])
         hi = int(self._data_start[min(max(first, last), len(self) - 1)]) + self._image_size
-        lo -= lo % mmap.PAGESIZE
-        mm.madvise(mmap.MADV_DONTNEED, lo, min(hi, self._size) - lo)
+        self._unmap(lo, hi)
 
     def _read_range(self, start: int, stop: int) -> np.ndarray:
         n = stop - start
@@ -306,6 +356,7 @@ class CineReader(FrameSource):
     def close(self) -> None:
         """Drop the memory map (the OS unmaps it once no frame view refers to it)."""
         self._mm = None  # type: ignore[assignment]
+        self._stack = None
 
 
 def _time64_to_iso(t: int) -> str:

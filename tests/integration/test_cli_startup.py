@@ -1,0 +1,56 @@
+"""The command line starts lazily: ``--version`` and ``--help`` import no heavy library.
+
+Start-up time is benchmarked (``benchmarks/track.py``), not asserted; what is asserted here is
+the cause of a slow start: which modules a fresh interpreter has imported after the call.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from cageless.cli import SUBCOMMANDS, SUMMARIES, build_parser
+
+#: Libraries that cost 0.1-1 s each to import; none is needed to print the version or the help.
+HEAVY = ("numpy", "numba", "scipy", "pandas", "matplotlib", "cv2", "h5py", "dask", "tqdm",
+         "tracking", "simulation", "comparison")
+
+
+def _modules_after(code: str) -> set[str]:
+    probe = (
+        "import sys, json, contextlib, io\n"
+        f"with contextlib.redirect_stdout(io.StringIO()):\n    {code}\n"
+        "print(json.dumps(sorted(sys.modules)))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
+    return set(json.loads(out.stdout.strip().splitlines()[-1]))
+
+
+@pytest.mark.parametrize("code", [
+    "import cageless.cli",
+    "import cageless",
+    "from cageless.cli import main; main(['--version'])",
+    "from cageless.cli import main; main(['--help'])",
+    "from cageless.cli import main; main([])",
+])
+def test_startup_imports_no_heavy_module(code):
+    loaded = {m.split(".")[0] for m in _modules_after(code)}
+    assert not loaded & set(HEAVY), f"{code!r} imported {sorted(loaded & set(HEAVY))}"
+
+
+def test_a_subcommand_imports_its_own_module_only():
+    loaded = _modules_after("from cageless.cli import main; main(['compare', '--help'])")
+    assert "cageless.cli.compare" in loaded
+    assert not {f"cageless.cli.{name}" for name in SUBCOMMANDS if name != "compare"} & loaded
+
+
+def test_summaries_match_the_registered_help():
+    """The help lines listed without importing a subcommand are the ones its module registers."""
+    parser = build_parser()
+    sub = parser._subparsers._group_actions[0]  # type: ignore[union-attr]
+    registered = {a.dest: a.help for a in sub._choices_actions}
+    assert registered == SUMMARIES
+    assert tuple(SUMMARIES) == SUBCOMMANDS
