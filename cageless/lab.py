@@ -42,7 +42,7 @@ from cageless.errors import CagelessError
 from cageless.kinematics import startup_duration, theoretical_cage_speed
 from cageless.outputs import clean_stale_parts, output_lock
 from cageless.parallel import job_pool
-from cageless.provenance import hash_file
+from cageless.provenance import hash_file, sha256_file
 from cageless.trace import read_trace
 from cageless.validate import plausible_entry
 
