@@ -40,18 +40,23 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--workers", type=int, default=2, help="local processes (default 2)")
     p.add_argument("--scheduler", help="address of a Dask scheduler to run the jobs on")
     p.add_argument("--force", action="store_true", help="compare even when a trace's conditions differ")
+    p.add_argument("--n-balls", type=int, metavar="N",
+                   help="ball count the videos show, when it differs from the bearing's (default: the bearing's)")
 
 
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Run the workflow and print where the report is."""
     from cageless.config import bearing_from_config
+    from cageless.errors import UsageError
     from cageless.lab import LabOptions, run_lab
     from simulation.parameters import ModelParameters, parse_set_overrides
 
+    if args.n_balls is not None and args.n_balls < 3:
+        raise UsageError(f"--n-balls {args.n_balls}: must be a whole number >= 3.")
     values = parse_set_overrides(args.set_values)
     ModelParameters().with_overrides(values)  # validated before any work starts
     options = LabOptions(duration_s=args.duration, settle_s=args.settle, rtol=args.rtol, workers=args.workers,
-                         scheduler=args.scheduler, force=args.force, parameters=values)
+                         scheduler=args.scheduler, force=args.force, parameters=values, n_balls=args.n_balls)
     res = run_lab(args.lab, args.out, options, bearing_from_config(config), progress=not args.quiet)
     for row in res.rows:
         if row.status == "failed":

@@ -49,7 +49,10 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
                    help=f"Savitzky-Golay speed window in frames, odd (default {DEFAULT_WINDOW})")
     p.add_argument("--detector", choices=DETECTORS, default="window",
                    help="centroid method: window refinement (default), weighted, or binary mask")
-    p.add_argument("--strict", action="store_true", help="a wrong ball count is an error, not a warning")
+    p.add_argument("--n-balls", type=int, metavar="N",
+                   help="ball count the video shows, when it differs from the bearing's; otherwise a video that "
+                   "does not show the bearing's count is an error (no trace; the QC image shows what was found)")
+    p.add_argument("--strict", action="store_true", help=argparse.SUPPRESS)  # a wrong count is always an error now
     p.add_argument("--workers", type=int, default=2, help="videos tracked in parallel (default 2)")
 
 
@@ -106,9 +109,11 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
 
     if args.window < 3 or args.window % 2 == 0:
         raise UsageError(f"--window {args.window}: must be an odd number of frames >= 3.")
+    if args.n_balls is not None and args.n_balls < 3:
+        raise UsageError(f"--n-balls {args.n_balls}: must be a whole number >= 3.")
     bearing = bearing_from_config(config)
     options = TrackOptions(detector=replace(DetectorParams(), method=args.detector), window=args.window,
-                           strict=args.strict, fps=args.fps)
+                           strict=args.strict, fps=args.fps, n_balls=args.n_balls)
     entries = collect_inputs(args.inputs, args.speed_rpm)
     out = Path(args.out)
     failed = 0
