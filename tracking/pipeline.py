@@ -35,6 +35,7 @@ from tracking.io import CineReader, FrameSource, open_video
 from tracking.kinematics import DEFAULT_WINDOW, revolution_speed
 from tracking.link import BallCountWarning, TrackSetup, track_frames
 from tracking.locate import BearingLocation, background_frame, locate_bearing
+from tracking.locate_motion import locate_by_motion, motion_map, plausible_band
 from tracking.qc import QCReport, build_qc, write_qc, write_selection_qc
 from tracking.select import SPEED_BAND, Selection, SelectionError, select_balls
 
@@ -134,6 +135,29 @@ class _CroppedFrames:
         return block[i - k * self.chunk]
 
 
+def _locate(video: FrameSource, background: np.ndarray, bearing: Bearing, path: Path) -> BearingLocation:
+    """The bearing and its ball band from brightness; from motion when that fails or gives a band that
+    does not fit a ball (dark ring faces, balls over bright faces)."""
+    g = bearing.geometry
+    ratio = g.ball_diameter_m / (0.5 * g.pitch_diameter_m)
+    err: TrackingError | None = None
+    try:
+        loc = locate_bearing(background, path)
+        if plausible_band(loc, ratio):
+            return loc
+    except TrackingError as exc:
+        if "no contrast" in exc.message:
+            raise
+        err = exc
+    alt = locate_by_motion(motion_map(video), path, ratio)
+    if alt is not None:
+        log.info("%s: ball band found from motion (%.0f..%.0f px)", path, alt.band_inner, alt.band_outer)
+        return alt
+    if err is not None:
+        raise err
+    return loc
+
+
 def _setup(video: FrameSource, loc: BearingLocation, background: np.ndarray, bearing: Bearing,
            options: TrackOptions, frames: _CroppedFrames, conditions: OperatingConditions,
            path: Path) -> tuple[TrackSetup, Selection]:
@@ -149,12 +173,17 @@ def _setup(video: FrameSource, loc: BearingLocation, background: np.ndarray, bea
     g = bearing.geometry
     z = options.n_balls or g.n_balls
     centre0 = (loc.centre[0] - cols.start, loc.centre[1] - rows.start)
+    known = bool(conditions.px_per_mm) or loc.source == "brightness"
     r_prior = (0.5 * g.pitch_diameter_m * 1e3 * conditions.px_per_mm if conditions.px_per_mm
                else 0.5 * (loc.band_inner + loc.band_outer))
     sel = select_balls(frames, video.times, bg, mask, z=z, ball_diameter_m=g.ball_diameter_m,
                        pitch_diameter_m=g.pitch_diameter_m, omega_i=conditions.speed_rad_s, centre0=centre0,
-                       r_prior=r_prior, path=path)
-    ball_px = sel.ring.ball_px
+                       r_prior=r_prior, path=path, prior_known=known)
+    ring = sel.ring
+    ball_px = 2 * g.ball_diameter_m / g.pitch_diameter_m * ring.radius  # now from the measured ball circle
+    h, w = mask.shape
+    vv, uu = np.ogrid[0:h, 0:w]
+    mask = mask & (np.abs(np.hypot(uu - ring.centre[0], vv - ring.centre[1]) - ring.radius) <= 0.5 * ball_px)
     a = sel.anchors[0]
     spots = spot_sigma(frames(a.frame), bg, mask, a.u, a.v, 0.12 * ball_px, options.detector.weight_sigma * sigma)
     hs = float(np.nanmedian(spots)) if np.isfinite(spots).any() else sel.ring.sigma_px
@@ -187,7 +216,7 @@ def track_video(
             raise TrackingError(path, f"has {len(video)} frames, fewer than the speed window of {options.window}: "
                                 "too short to give a speed.", "Record longer, or lower --window.")
         background = background_frame(video)
-        loc = locate_bearing(background, path)
+        loc = _locate(video, background, bearing, path)
         rows, cols = loc.crop(video.frame_shape)
         frames = _CroppedFrames(video, rows, cols, options.chunk)
         try:

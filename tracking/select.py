@@ -126,6 +126,7 @@ class _Context:
     centre0: tuple[float, float]
     sigma_px: float
     k_sigma: float
+    prior_known: bool = True  # False: r_prior is only a scale guess; the circle is chosen by support
 
 
 def _burst_plan(n: int, times: np.ndarray, omega_c: float, n_bursts: int) -> list[tuple[int, int]]:
@@ -249,10 +250,11 @@ def _burst_tracklets(frames: Callable[[int], np.ndarray], span: tuple[int, int],
     return tracks, float(noise)
 
 
-def _ransac_circle(pts: np.ndarray, burst: np.ndarray, ctx: _Context, tol: float, seed: int = 0
-                   ) -> tuple[float, float, float] | None:
+def _ransac_circle(pts: np.ndarray, burst: np.ndarray, weight: np.ndarray, ctx: _Context, tol: float,
+                   seed: int = 0) -> tuple[float, float, float] | None:
     """Circle hypotheses through random triples; among those holding (nearly) a full ring of balls in
-    the most bursts, the one closest to the expected radius."""
+    the most bursts, the one closest to the expected radius (or, when the radius is not known, the one
+    whose members are the strongest blobs)."""
     n = len(pts)
     if n < 3:
         return None
@@ -272,7 +274,7 @@ def _ransac_circle(pts: np.ndarray, burst: np.ndarray, ctx: _Context, tol: float
         res = np.abs(np.hypot(pts[:, 0] - cx, pts[:, 1] - cy) - r)
         inl = res <= tol
         score = sum(min(int(np.sum(inl & (burst == b))), ctx.z) for b in range(n_b))
-        hyps.append((score, abs(r - ctx.r_prior), cx, cy, r))
+        hyps.append((score, abs(r - ctx.r_prior) if ctx.prior_known else -float(np.sum(weight[inl])), cx, cy, r))
     if not hyps:
         return None
     top = max(h[0] for h in hyps)
@@ -412,18 +414,18 @@ def _table(feats: list[dict[str, float]], reasons: list[str], burst: np.ndarray,
 
 def _context(z: int, ball_diameter_m: float, pitch_diameter_m: float, omega_i: float,
              centre0: tuple[float, float], r_prior: float, k_sigma: float,
-             sigma_px: float | None = None) -> _Context:
+             sigma_px: float | None = None, prior_known: bool = True) -> _Context:
     ratio = ball_diameter_m / pitch_diameter_m
     ball_px = 2.0 * ratio * r_prior
     return _Context(z=z, gap=MIN_SPACING * 2 * math.asin(min(ratio, 1.0)), omega_c=0.5 * omega_i * (1 - ratio),
                     omega_i=omega_i, ball_px=ball_px, r_prior=r_prior, centre0=centre0,
-                    sigma_px=sigma_px or max(1.0, 0.05 * ball_px), k_sigma=k_sigma)
+                    sigma_px=sigma_px or max(1.0, 0.05 * ball_px), k_sigma=k_sigma, prior_known=prior_known)
 
 
 def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, background: np.ndarray,
                  mask: np.ndarray, *, z: int, ball_diameter_m: float, pitch_diameter_m: float, omega_i: float,
                  centre0: tuple[float, float], r_prior: float, path: object = "video", n_bursts: int = 6,
-                 k_sigma: float = 5.0) -> Selection:
+                 k_sigma: float = 5.0, prior_known: bool = True) -> Selection:
     """Choose exactly ``z`` ball tracks from bursts spread over the clip (see the module docstring).
 
     Parameters
@@ -438,13 +440,16 @@ def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, backgro
         Inner-ring speed (rad/s).
     centre0, r_prior
         Bearing centre and the expected radius of the highlight circle (px, cropped image).
+    prior_known
+        False when ``r_prior`` is only a rough scale (then the circle is chosen by its support).
 
     Raises
     ------
     SelectionError
         When the clip shows a count other than ``z``, or the chosen tracks fail the checks.
     """
-    ctx = _context(z, ball_diameter_m, pitch_diameter_m, omega_i, centre0, r_prior, k_sigma)
+    ctx = _context(z, ball_diameter_m, pitch_diameter_m, omega_i, centre0, r_prior, k_sigma,
+                   prior_known=prior_known)
     spans = _burst_plan(len(times), times, ctx.omega_c, n_bursts)
     tracks: list[Tracklet] = []
     burst: list[int] = []
@@ -461,7 +466,8 @@ def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, backgro
     circle = None
     if movers.size >= 3:
         pts = np.array([[feats[k]["u"], feats[k]["v"]] for k in movers])
-        circle = _ransac_circle(pts, burst_arr[movers], ctx, tol)
+        wts = np.array([math.log1p(feats[k]["response"]) for k in movers])
+        circle = _ransac_circle(pts, burst_arr[movers], wts, ctx, tol)
     ring_args = dict(ball_px=ctx.ball_px, sigma_px=ctx.sigma_px, radial_tol_px=tol, response_sigma=float(noise or 1),
                      k_sigma=k_sigma, z=z, gap=ctx.gap, omega_c=ctx.omega_c, omega_i=omega_i)
     if circle is None:

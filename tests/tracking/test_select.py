@@ -152,3 +152,18 @@ def test_a_clip_without_balls_is_refused(tmp_path):
         track_video(still, OperatingConditions(3000, 500), B, out_dir=tmp_path / "out", progress=False)
     assert not list(tmp_path.rglob("*.trace.h5"))
     assert (tmp_path / "out" / "qc" / "still2.selection.png").is_file()
+
+
+def test_dark_ring_faces_are_located_by_motion(tmp_path):
+    """Dark ring faces frame no dark band: the ball band is found from what moves, and the ball
+    circle is chosen by its support (the annulus middle is not the pitch circle)."""
+    from tracking.synthetic.render import Renderer
+
+    look = Appearance(highlight_peak=0.85, ring_level=0.05, cavity_level=0.12, n_static_glints=8, glint_peak=1.2)
+    clip = render_clip(tmp_path / "dark.cine", Renderer(G, CAM, look, seed=21),
+                       frames_for_revolutions(G, 3000, CAM.fps, 0.3), law=KinematicLaw(G, 3000, seed=21),
+                       fmt="cine-16")
+    res = track_video(clip["video"], OperatingConditions(3000, 500), B, progress=False)
+    s = _score(res, clip["truth"], 3000)
+    assert res.trace.n_balls == 14 and s["max_err_deg"] < 5
+    assert s["angle_rms"] <= 0.5e-3 and s["speed_rms"] <= 0.005 and s["slip_mae_pp"] <= 0.3
