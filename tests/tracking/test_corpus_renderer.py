@@ -220,10 +220,13 @@ def test_a_perfect_detector_meets_the_bars_on_every_clip():
 def test_written_clip_reads_back(tmp_path):
     """A rendered clip reads back through the tracker's reader: frame count, time stamps (dropped frames),
     sidecar conditions and truth rows agree."""
-    seed = next(s for s in TUNING if draw_params(s).dropped_frame_rate > 0 and draw_params(s).width == 640)
+    seed = next(s for s in TUNING if draw_params(s).dropped_frame_rate >= 0.02 and draw_params(s).width <= 800)
     spec = render_clip(seed, tmp_path)
+    assert spec.conditions.fps is None  # a cine's time stamps are not overridden
+    times = truth_arrays(spec.truth)["time"]
+    assert np.max(np.diff(times)) > 1.5 / spec.params.fps  # frames were dropped
     with open_video(spec.video, fps=spec.conditions.fps) as video:
-        assert len(video) == spec.n_frames == len(truth_arrays(spec.truth)["time"])
-        assert np.allclose(video.times - video.times[0], truth_arrays(spec.truth)["time"], atol=1e-7)
+        assert len(video) == spec.n_frames == len(times)
+        assert np.allclose(video.times - video.times[0], times, atol=1e-7)
     again = render_clip(seed, tmp_path)  # reused, not re-rendered
     assert again.render_s == 0.0 and again.video == spec.video

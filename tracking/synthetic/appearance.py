@@ -233,11 +233,19 @@ def draw_params(seed: int) -> ClipParams:
     if container == "cine-16" and factor_u(s, "bit_depth_16") < 0.5:
         bit_depth = 12  # 12-bit data in 16-bit words, as Phantom software saves by default
     ball_px = px_mm * d_m * sin_half
-    # Visible half-width of the ball band (hidden mode) limits how far the highlight may sit off-centre.
-    half_band = 0.5 * (0.55 + 0.35 * land_frac) if land_mode == "hidden" else 0.5
+    # Hidden mode: the lands leave a band of half-width w = (0.8 + 0.2 land_frac) R visible (R the ball
+    # radius). The specular lobe (half-widths 2 sigma R across, 2 sigma elongation R along, in px) must stay
+    # 2.5 half-widths and a chamfer (1.5 px) clear of the lands at every orbital angle, or the lands would clip
+    # it unevenly round the orbit and bias its centroid: elongation and light tilt are limited for that.
     sigma = _cont(s, "highlight_sigma", 0.05, 0.12)
-    tilt_max = math.degrees(2 * math.asin(min(0.5, 2 * half_band - 2.5 * sigma)))
-    tilt = _cont(s, "light_tilt", 8.0, max(10.0, tilt_max))
+    elongation = _cont(s, "elongation", 1.0, 3.0)
+    w_r = 0.8 + 0.2 * land_frac if land_mode == "hidden" else 1.0
+    if land_mode == "hidden":
+        sigma = min(sigma, 0.09)
+        elongation = min(elongation, max(1.0, 0.07 / sigma))
+    room = w_r - 5.0 * sigma * elongation - 1.5 / (0.5 * ball_px)
+    tilt_max = math.degrees(2 * math.asin(min(0.5, max(room, math.sin(math.radians(2.5))))))
+    tilt = _cont(s, "light_tilt", 4.0, tilt_max) if land_mode == "hidden" else _cont(s, "light_tilt", 8.0, 60.0)
     exp_max = min(0.9 / fps, 120e-6)
     exposure = _cont(s, "exposure", 2e-6, exp_max)
     omega_c = 0.5 * speed * math.pi / 30 * (1 - sin_half)
@@ -271,7 +279,7 @@ def draw_params(seed: int) -> ClipParams:
         roll_deg=_cont(s, "roll", -15.0, 15.0), distortion_k1=k1,
         light_tilt_deg=tilt, light_azimuth_deg=360.0 * factor_u(s, "light_azimuth"),
         highlight_peak=_cont(s, "highlight_peak", 0.25, 4.0), highlight_sigma=sigma,
-        elongation=_cont(s, "elongation", 1.0, 3.0), elongation_angle_deg=180.0 * factor_u(s, "elong_angle"),
+        elongation=elongation, elongation_angle_deg=180.0 * factor_u(s, "elong_angle"),
         second_light_rel=_maybe(s, "second_light", 0.4, 0.3, 0.9),
         second_light_azimuth_deg=360.0 * factor_u(s, "second_azimuth"),
         vignetting=_cont(s, "vignetting", 0.0, 0.6), gradient=_cont(s, "gradient", 0.0, 0.5),

@@ -61,6 +61,8 @@ TRUTH_COLUMNS = ("frame", "time_s", "ball", "angle_rad", "speed_rad_s", "slip", 
                  "highlight_u_px", "highlight_v_px", "highlight_visible")
 _AVI_MAX_FPS = 1000.0
 _SPEED_DT = 1e-6
+#: Bumped when what render_clip writes changes, so cached clips are rendered again.
+_FORMAT = 3
 
 
 @dataclass
@@ -110,7 +112,8 @@ def clip_stem(params: ClipParams, long: bool = False) -> str:
 
 
 def _key(params: ClipParams, long: bool) -> str:
-    text = json.dumps({"params": params.to_dict(), "long": long, "version": __version__}, sort_keys=True)
+    text = json.dumps({"params": params.to_dict(), "long": long, "version": __version__, "format": _FORMAT},
+                      sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
@@ -140,9 +143,14 @@ def _spec(params: ClipParams, folder: Path, stem: str, video: Path, truth: pd.Da
 
 
 def conditions_of(params: ClipParams) -> OperatingConditions:
-    """The conditions a lab would write down for this clip."""
+    """The conditions a lab would write down for this clip.
+
+    ``fps`` only for AVI, whose container cannot hold the rate: for a cine it would override the per-frame
+    time stamps, and with them the gaps that dropped frames leave.
+    """
+    fps = params.fps if params.container == "avi-mjpg" else None
     return OperatingConditions(speed_rpm=round(params.speed_rpm, 3), radial_load_n=round(params.radial_load_n, 1),
-                               axial_load_n=0.0, fps=params.fps, px_per_mm=round(params.px_per_mm, 6),
+                               axial_load_n=0.0, fps=fps, px_per_mm=round(params.px_per_mm, 6),
                                camera_roll_deg=round(params.roll_deg, 6))
 
 

@@ -93,7 +93,7 @@ class SceneRenderer:
     def _radii(self) -> None:
         p, rp, d = self.p, self.rp, self.d
         if p.land_mode == "hidden":
-            w = 0.5 * (0.55 + 0.35 * p.land_frac) * d
+            w = 0.5 * (0.8 + 0.2 * p.land_frac) * d  # see appearance.draw_params
             self.r_il, self.r_ol = rp - w, rp + w
         else:  # the ring faces reach under the balls; the balls are drawn over them
             w = 0.5 * (0.45 + 0.4 * p.land_frac) * d
