@@ -5,7 +5,8 @@
 
 Renders each clip once into ``--cache`` (default ``/tmp/cageless-corpus``; reused while the
 software version and the seed's parameters are unchanged), tracks it with the current tracker,
-scores it (tracking/synthetic/score.py) and prints, per set, one row per clip (its factors,
+scores it (tracking/synthetic/score.py) beside an oracle (a plain centroid detector told where
+each highlight is: it shows the pixels support the bars) and prints, per set, one row per clip (its factors,
 balls found, identity swaps, angle / speed / slip-profile errors, pass or fail and why), the
 pass count and the worst clip. ``--long`` runs the long variants (one cage revolution each).
 """
@@ -29,20 +30,28 @@ def _num(v: float | None, fmt: str = "{:.3g}") -> str:
     return "-" if v is None else fmt.format(v)
 
 
+def _oracle(r: ClipResult) -> str:
+    o = r.oracle
+    if o is None:
+        return "-"
+    return f"{'ok' if o['passed'] else 'FAIL'} {o['angle_rms_mrad']:.2f}"
+
+
 def _row(r: ClipResult) -> str:
     f = r.factors
     s = r.score or {}
     found = s.get("n_found")
     cells = [str(r.seed)] + [str(f[c]) for c in _COLS] + [
         "-" if found is None else str(found), _num(s.get("swaps"), "{}"), _num(s.get("angle_rms_mrad")),
-        _num(s.get("speed_rms_pct")), _num(s.get("slip_mae_pp")), r.status.upper(),
+        _num(s.get("speed_rms_pct")), _num(s.get("slip_mae_pp")), _oracle(r), r.status.upper(),
         (r.message or "")[:110].replace("|", "/"), f"{r.render_s:.1f}", f"{r.track_s:.1f}"]
     return "| " + " | ".join(cells) + " |"
 
 
 def format_set(name: str, results: list[ClipResult]) -> str:
     """Markdown table of one seed set, with its pass count and worst clip."""
-    head = ["seed", *_COLS, "found", "swaps", "angle mrad", "speed %", "slip MAE pp", "result", "why", "render s",
+    head = ["seed", *_COLS, "found", "swaps", "angle mrad", "speed %", "slip MAE pp", "oracle (mrad)",
+            "result", "why", "render s",
             "track s"]
     lines = [f"### {name}", "", "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     lines += [_row(r) for r in results]
@@ -50,8 +59,11 @@ def format_set(name: str, results: list[ClipResult]) -> str:
     n_err = sum(r.status == "error" for r in results)
     wrong = sum(r.status != "error" and r.score and r.score["n_found"] != r.score["n_balls"] for r in results)
     worst = max(results, key=badness)
+    n_oracle = sum(bool(r.oracle and r.oracle["passed"]) for r in results)
     lines += ["", f"{name}: {n_pass} of {len(results)} clips pass; {n_err} end in a tracker error (no trace); "
               f"{wrong} give a trace with the wrong ball count.",
+              f"The oracle (a plain centroid detector told where each highlight is) passes {n_oracle} of "
+              f"{len(results)}.",
               f"Worst clip: seed {worst.seed} ({worst.status}: {worst.message[:160]})", ""]
     return "\n".join(lines)
 

@@ -233,16 +233,19 @@ def draw_params(seed: int) -> ClipParams:
     if container == "cine-16" and factor_u(s, "bit_depth_16") < 0.5:
         bit_depth = 12  # 12-bit data in 16-bit words, as Phantom software saves by default
     ball_px = px_mm * d_m * sin_half
-    # Hidden mode: the lands leave a band of half-width w = (0.8 + 0.2 land_frac) R visible (R the ball
-    # radius). The specular lobe (half-widths 2 sigma R across, 2 sigma elongation R along, in px) must stay
-    # 2.5 half-widths and a chamfer (1.5 px) clear of the lands at every orbital angle, or the lands would clip
-    # it unevenly round the orbit and bias its centroid: elongation and light tilt are limited for that.
-    sigma = _cont(s, "highlight_sigma", 0.05, 0.12)
+    # The specular lobe has half-widths sigma D across and sigma elongation D along (px, D the ball diameter):
+    # at least 0.8 px across, and at most 0.12 D along (a highlight, not a glow over the whole ball).
+    # Hidden mode: the lands leave a band of half-width w = (0.8 + 0.2 land_frac) R visible (R = D / 2); the
+    # lobe must stay 2.5 half-widths and a chamfer (1.5 px) clear of the lands at every orbital angle, or the
+    # lands would clip it unevenly round the orbit and bias its centroid: the lobe is at most 0.07 D long
+    # there, and the light tilt is limited.
+    sigma = max(_cont(s, "highlight_sigma", 0.04, 0.10), 0.8 / ball_px)
     elongation = _cont(s, "elongation", 1.0, 3.0)
     w_r = 0.8 + 0.2 * land_frac if land_mode == "hidden" else 1.0
-    if land_mode == "hidden":
-        sigma = min(sigma, 0.09)
-        elongation = min(elongation, max(1.0, 0.07 / sigma))
+    cap = 0.07 if land_mode == "hidden" else 0.12
+    if sigma * elongation > cap:
+        sigma = max(0.8 / ball_px, cap / elongation)
+        elongation = min(elongation, max(1.0, cap / sigma))
     room = w_r - 5.0 * sigma * elongation - 1.5 / (0.5 * ball_px)
     tilt_max = math.degrees(2 * math.asin(min(0.5, max(room, math.sin(math.radians(2.5))))))
     tilt = _cont(s, "light_tilt", 4.0, tilt_max) if land_mode == "hidden" else _cont(s, "light_tilt", 8.0, 60.0)
@@ -265,6 +268,9 @@ def draw_params(seed: int) -> ClipParams:
     jpeg = int(round(_cont(s, "jpeg", 30, 90))) if bit_depth == 8 else 0
     if container == "cine-8" and rng.random() < 0.35:
         jpeg = 0  # some 8-bit cines are clean
+    # The highlight is the brightest thing on a ball: the rim (the ring faces mirrored in the ball's edge)
+    # stays under 0.6 of it.
+    highlight_peak = _cont(s, "highlight_peak", 0.25, 4.0)
     n_frames, n_long = _frames_for(z, speed, gap, fps)
     dark = _maybe(s, "dark_frames", 0.4, 0.003, 0.02)
     dropped = _maybe(s, "dropped_frames", 0.4, 0.003, 0.03) if container != "avi-mjpg" else 0.0
@@ -278,7 +284,7 @@ def draw_params(seed: int) -> ClipParams:
         centre_offset_px=(off_r * math.cos(off_a), off_r * math.sin(off_a)),
         roll_deg=_cont(s, "roll", -15.0, 15.0), distortion_k1=k1,
         light_tilt_deg=tilt, light_azimuth_deg=360.0 * factor_u(s, "light_azimuth"),
-        highlight_peak=_cont(s, "highlight_peak", 0.25, 4.0), highlight_sigma=sigma,
+        highlight_peak=highlight_peak, highlight_sigma=sigma,
         elongation=elongation, elongation_angle_deg=180.0 * factor_u(s, "elong_angle"),
         second_light_rel=_maybe(s, "second_light", 0.4, 0.3, 0.9),
         second_light_azimuth_deg=360.0 * factor_u(s, "second_azimuth"),
@@ -287,7 +293,7 @@ def draw_params(seed: int) -> ClipParams:
         flicker_amplitude=_maybe(s, "flicker", 0.6, 0.02, 0.25), flicker_hz=_pick(s, "flicker_hz", (100.0, 120.0)),
         ring_face=_pick(s, "ring_face", ("bright", "dark")), ring_level=_cont(s, "ring_level", 0.0, 1.0),
         ring_texture=_pick(s, "texture", ("brushed", "machined", "scratched")), land_mode=land_mode,
-        land_frac=land_frac, ball_albedo=_cont(s, "ball_albedo", 0.01, 0.12), rim=_cont(s, "rim", 0.0, 0.6),
+        land_frac=land_frac, ball_albedo=_cont(s, "ball_albedo", 0.01, 0.12), rim=min(_cont(s, "rim", 0.0, 0.6), 0.6 * highlight_peak),
         cavity_level=_cont(s, "cavity", 0.0, 0.35), background_level=float(rng.uniform(0.01, 0.15)),
         n_static_glints=int(round(_cont(s, "static_glints", 0, 12))),
         n_turning_glints=int(round(_cont(s, "turning_glints", 0, 8))),

@@ -171,7 +171,7 @@ class SceneRenderer:
         t = np.ones((p.height, p.width), F32)
         for _ in range(p.n_dust):
             u0, v0 = self.rng.uniform(0, p.width), self.rng.uniform(0, p.height)
-            rad, depth = self.rng.uniform(2, 9), self.rng.uniform(0.1, 0.5)
+            rad, depth = self.rng.uniform(3, 12), self.rng.uniform(0.05, 0.25)  # defocused sensor dust
             sl, du, dv = _window(u0, v0, rad + 3, t.shape)
             t[sl] *= 1 - depth * np.clip(rad - np.hypot(du, dv) + 0.5, 0, 1) * np.exp(-0.5 * (du**2 + dv**2) / rad**2)
         return t
