@@ -13,7 +13,14 @@ from tqdm.auto import tqdm
 
 from cageless.bearing import Bearing
 from cageless.cli.common import finite_float
-from cageless.conditions import IMAGE_SUFFIXES, LabEntry, OperatingConditions, discover_lab, resolve_conditions
+from cageless.conditions import (
+    IMAGE_SUFFIXES,
+    LabEntry,
+    OperatingConditions,
+    bearing_with_keys,
+    discover_lab,
+    resolve_conditions,
+)
 from cageless.config import bearing_from_config
 from cageless.errors import CagelessError, UsageError
 
@@ -121,7 +128,14 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
         if not e.ok:
             print(f"FAILED {e.video}: {e.error}")
             failed += 1
-    jobs = [(e.video, e.resolved.conditions, bearing, options, out) for e in entries if e.ok]
+    jobs = []
+    for e in entries:
+        if e.ok:
+            try:  # a sidecar may describe another bearing (n_balls, ball_diameter_mm, pitch_diameter_mm)
+                jobs.append((e.video, e.resolved.conditions, bearing_with_keys(bearing, e.resolved), options, out))
+            except CagelessError as exc:
+                print(f"FAILED {e.video}: {exc}")
+                failed += 1
     workers = max(1, min(args.workers, len(jobs)))
     with tqdm(total=len(jobs), desc="videos", unit="video", disable=args.quiet) as bar:
         results = _map(jobs, workers, bar)
