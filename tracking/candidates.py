@@ -74,10 +74,18 @@ def _hessian_min(img: np.ndarray, sigma: float) -> np.ndarray:
     return (sigma * sigma) * (0.5 * (a + c) - np.sqrt(half * half + dxy * dxy))
 
 
+#: Scales searched, in expected highlight widths: small and saturated highlights, and highlights
+#: drawn out along the orbit (motion blur, elongated lobes), which look like blobs at a coarser scale.
+_SCALES = (1.0, 2.0, 4.0)
+
+
 def blob_response(diff: np.ndarray, sigma_px: float) -> np.ndarray:
-    """Largest scale-normalised blob response over the scales ``sigma_px`` and ``2 sigma_px``."""
+    """Largest scale-normalised blob response over the scales :data:`_SCALES` times ``sigma_px``."""
     d = diff.astype(np.float32, copy=False)
-    return np.maximum(_hessian_min(d, sigma_px), _hessian_min(d, 2.0 * sigma_px))
+    out = _hessian_min(d, sigma_px)
+    for k in _SCALES[1:]:
+        np.maximum(out, _hessian_min(d, k * sigma_px), out=out)
+    return out
 
 
 #: The response is computed on an image binned so that the highlight width is at least this (px):

@@ -223,8 +223,9 @@ def track_video(
             setup, sel = _setup(video, loc, background, bearing, options, frames, conditions, path)
         except SelectionError as exc:
             if out_dir is not None and exc.table is not None:
-                qc_png = write_selection_qc(Path(out_dir) / "qc", _stem(path), video[0], exc.table, exc.ring,
-                                            (cols.start, rows.start), str(exc))
+                shown = exc.table.assign(u_px=exc.table.u_px + cols.start, v_px=exc.table.v_px + rows.start)
+                qc_png = write_selection_qc(Path(out_dir) / "qc", _stem(path), video[0], shown, exc.ring,
+                                            (cols.start, rows.start), exc.message)
                 raise SelectionError(path, f"{exc.message} No trace written; QC: {qc_png}.", exc.hint,
                                      exc.table, exc.found, exc.ring) from None
             raise

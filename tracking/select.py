@@ -240,7 +240,7 @@ def _burst_tracklets(frames: Callable[[int], np.ndarray], span: tuple[int, int],
         if noise is None:
             resp, f = response_map(frame, background, ctx.sigma_px)
             noise = response_noise(resp, bin_mask(mask, f))
-        cands.append(find_candidates(frame, background, mask, ctx.sigma_px, ctx.k_sigma, 8 * ctx.z + 16, noise))
+        cands.append(find_candidates(frame, background, mask, ctx.sigma_px, ctx.k_sigma, 12 * ctx.z + 32, noise))
     dt = float(np.median(np.diff(times[a:b]))) if b - a > 1 else 1e-4
     r_max = ctx.r_prior + ctx.ball_px
     gate = max(3.0, 1.3 * ctx.omega_i * r_max * dt + 2.0)
@@ -425,7 +425,7 @@ def _context(z: int, ball_diameter_m: float, pitch_diameter_m: float, omega_i: f
 def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, background: np.ndarray,
                  mask: np.ndarray, *, z: int, ball_diameter_m: float, pitch_diameter_m: float, omega_i: float,
                  centre0: tuple[float, float], r_prior: float, path: object = "video", n_bursts: int = 6,
-                 k_sigma: float = 5.0, prior_known: bool = True) -> Selection:
+                 k_sigma: float = 4.0, prior_known: bool = True) -> Selection:
     """Choose exactly ``z`` ball tracks from bursts spread over the clip (see the module docstring).
 
     Parameters
