@@ -326,7 +326,8 @@ def _selection_summary(sel: Selection, du: int, dv: int) -> dict[str, Any]:
     """What the ball selection found, for the QC record (full-image pixels)."""
     t = sel.table
     reasons = t.loc[t.status == "rejected", "reason"].value_counts()
-    return {"counts": [int(c) for c in sel.counts], "circle_centre_px": (sel.ring.centre[0] + du, sel.ring.centre[1] + dv),
+    return {"counts": [int(c) for c in sel.counts],
+            "circle_centre_px": (sel.ring.centre[0] + du, sel.ring.centre[1] + dv),
             "circle_radius_px": sel.ring.radius, "direction": sel.ring.direction,
             "speed_over_cage_speed": sel.ring.omega / sel.ring.omega_c,
             "selected": int((t.status == "selected").sum()),
