@@ -7,7 +7,8 @@ test_corpus_renderer.py).
 
 CI runs the first block of 8 seeds of each set (each block covers every factor's range ends); the other
 clips and the long variants are ``slow`` (``--runslow``). Clips render once per session into
-``$CAGELESS_CORPUS_CACHE`` (default: a pytest temporary folder) on two processes.
+``$CAGELESS_CORPUS_CACHE`` (default: a pytest temporary folder, each video deleted once scored) on two
+processes.
 
 Today's tracker fails most clips, so each known failure is a strict xfail: when a change makes a clip pass,
 pytest reports XPASS(strict) as a failure and the seed must leave :data:`KNOWN_FAILURES`.
@@ -91,8 +92,11 @@ KNOWN_FAILURES: dict[int, str] = {
     7031: "no trace: no bright ring-shaped region found: no bearing in view",
 }
 
-#: The same for the long variants (one cage revolution each).
-KNOWN_FAILURES_LONG: dict[int, str] = dict(KNOWN_FAILURES)
+#: The same for the long variants (one cage revolution each; baseline the same day: TUNING 4 of 32 pass,
+#: HOLDOUT 1 of 32). Seeds 1005, 1019, 1021, 1025, 7001 pass long (1018 passes only short, 1019 only long).
+_LONG_PASS = {1005, 1019, 1021, 1025, 7001}
+KNOWN_FAILURES_LONG: dict[int, str] = {
+    s: KNOWN_FAILURES.get(s, "found the wrong ball count on the long clip") for _, s in ALL if s not in _LONG_PASS}
 
 _REASON = "tracker not yet robust to this footage (issue 14)"
 
@@ -122,13 +126,14 @@ def corpus_results(request, corpus_dir):
     seeds = list(CI_SEEDS)
     if request.config.getoption("--runslow"):
         seeds += [s for _, s in ALL if s not in CI_SEEDS]
-    return {r.seed: r for r in run_seeds(seeds, corpus_dir / "ci", workers=2, progress=False)}
+    keep = bool(os.environ.get("CAGELESS_CORPUS_CACHE"))  # else delete each video once scored (disk)
+    return {r.seed: r for r in run_seeds(seeds, corpus_dir / "ci", workers=2, progress=False, keep=keep)}
 
 
 @pytest.fixture(scope="session")
 def corpus_results_long(corpus_dir):
     return {r.seed: r for r in run_seeds([s for _, s in ALL], corpus_dir / "long", workers=2, long=True,
-                                         progress=False)}
+                                         progress=False, keep=False)}
 
 
 def _assert_bars(result) -> None:
