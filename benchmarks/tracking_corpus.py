@@ -8,7 +8,8 @@ software version and the seed's parameters are unchanged), tracks it with the cu
 scores it (tracking/synthetic/score.py) beside an oracle (a plain centroid detector told where
 each highlight is: it shows the pixels support the bars) and prints, per set, one row per clip (its factors,
 balls found, identity swaps, angle / speed / slip-profile errors, pass or fail and why), the
-pass count and the worst clip. ``--long`` runs the long variants (one cage revolution each).
+pass count and the worst clip. ``--long`` runs the long variants (one cage revolution each; their videos
+are deleted after scoring unless ``--keep``). The short clips take about 9 GB for both sets.
 """
 
 from __future__ import annotations
@@ -75,6 +76,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seeds", help="comma-separated seeds instead of whole sets")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--long", action="store_true")
+    ap.add_argument("--keep", action="store_true",
+                    help="keep the long videos (up to 3.5 GB each; short ones are always kept for reuse)")
     ap.add_argument("--json", type=Path)
     args = ap.parse_args(argv)
     if args.seeds:
@@ -91,7 +94,7 @@ def main(argv: list[str] | None = None) -> int:
     out: dict[str, list[dict]] = {}
     start = time.perf_counter()
     for name, seeds in chosen.items():
-        results = run_seeds(seeds, folder, workers=args.workers, long=args.long)
+        results = run_seeds(seeds, folder, workers=args.workers, long=args.long, keep=args.keep or not args.long)
         print(format_set(name, results))
         out[name] = [asdict(r) for r in results]
         render = sum(r.render_s for r in results)

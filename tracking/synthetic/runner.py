@@ -53,11 +53,23 @@ class ClipResult:
     warnings: list[str] = field(default_factory=list)
 
 
-def run_seed(seed: int, folder: str | Path, long: bool = False) -> ClipResult:
-    """Render (or reuse) the clip of ``seed`` in ``folder``, track it and score the trace."""
+def run_seed(seed: int, folder: str | Path, long: bool = False, keep: bool = True) -> ClipResult:
+    """Render (or reuse) the clip of ``seed`` in ``folder``, track it and score the trace.
+
+    With ``keep=False`` the video is deleted afterwards (a long 16-bit clip is up to 3.5 GB); the truth stays.
+    """
+    spec = render_clip(seed, folder, long=long)
+    try:
+        return _track_and_score(spec)
+    finally:
+        if not keep:
+            spec.video.unlink(missing_ok=True)
+
+
+def _track_and_score(spec: ClipSpec) -> ClipResult:
     from tracking.pipeline import TrackOptions, track_video
 
-    spec = render_clip(seed, folder, long=long)
+    seed = spec.seed
     factors = describe(spec.params)
     oracle = score_trace(oracle_trace(spec), spec.truth, spec.bearing).to_dict()
     start = time.perf_counter()
@@ -87,15 +99,15 @@ def _messages(caught: list[Any]) -> list[str]:
     return out
 
 
-def _run(args: tuple[int, str, bool]) -> ClipResult:
+def _run(args: tuple[int, str, bool, bool]) -> ClipResult:
     logging.disable(logging.WARNING)
-    return run_seed(args[0], args[1], args[2])
+    return run_seed(*args)
 
 
 def run_seeds(seeds: Sequence[int], folder: str | Path, workers: int = 2, long: bool = False,
-              progress: bool = True) -> list[ClipResult]:
+              progress: bool = True, keep: bool = True) -> list[ClipResult]:
     """:func:`run_seed` over ``seeds`` in ``workers`` spawned processes; results in the order of ``seeds``."""
-    jobs = [(int(s), str(folder), long) for s in seeds]
+    jobs = [(int(s), str(folder), long, keep) for s in seeds]
     if workers <= 1:
         return [_run(j) for j in tqdm(jobs, desc="clips", disable=not progress)]
     with ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn")) as pool:
