@@ -12,10 +12,17 @@ precedence first:
 Only ``speed_rpm`` is required; the loads default to 0 and the camera keys to
 what the video file says (``None`` here). A malformed source is an error, never
 silently skipped, and every error names the file it is about.
+
+A sidecar or ``conditions.csv`` may also describe the bearing a video shows,
+when it is not the configured one: ``n_balls``, ``ball_diameter_mm`` and
+``pitch_diameter_mm`` (:data:`BEARING_KEYS`). They are kept apart from the
+operating conditions (:attr:`ResolvedConditions.bearing_keys`) and applied with
+:func:`bearing_with_keys`.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
 import math
@@ -29,11 +36,13 @@ from typing import Any
 
 import pandas as pd
 
+from cageless.bearing import Bearing, Geometry
 from cageless.errors import CagelessError, ConditionsError, ParameterError, suggest
 from cageless.units import rpm_to_rad_s
 
 __all__ = [
     "CONDITION_KEYS",
+    "BEARING_KEYS",
     "VIDEO_SUFFIXES",
     "IMAGE_SUFFIXES",
     "OperatingConditions",
@@ -45,11 +54,15 @@ __all__ = [
     "resolve_conditions",
     "find_videos",
     "discover_lab",
+    "bearing_with_keys",
 ]
 
 log = logging.getLogger(__name__)
 
 CONDITION_KEYS = ("speed_rpm", "radial_load_n", "axial_load_n", "fps", "px_per_mm", "camera_roll_deg")
+#: Optional keys describing the bearing a video shows (a sidecar or a conditions.csv column).
+BEARING_KEYS = ("n_balls", "ball_diameter_mm", "pitch_diameter_mm")
+_SOURCE_KEYS = CONDITION_KEYS + BEARING_KEYS
 VIDEO_SUFFIXES = (".cine", ".avi", ".mp4", ".mkv")
 IMAGE_SUFFIXES = (".tif", ".tiff", ".png")
 CONDITIONS_CSV = "conditions.csv"
@@ -132,11 +145,14 @@ class ResolvedConditions:
         The merged conditions.
     origin
         For each key that a source gave, a description of that source.
+    bearing_keys
+        The :data:`BEARING_KEYS` the sources gave (empty: the configured bearing).
     """
 
     video: Path
     conditions: OperatingConditions
     origin: dict[str, str] = field(default_factory=dict)
+    bearing_keys: dict[str, float] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -177,8 +193,8 @@ def read_sidecar(path: str | Path) -> dict[str, float]:
         raise ConditionsError(path, "the sidecar must hold a table of condition keys.")
     out: dict[str, float] = {}
     for key, value in data.items():
-        if key not in CONDITION_KEYS:
-            hint = suggest(key, CONDITION_KEYS).strip() or f"Valid keys: {', '.join(CONDITION_KEYS)}."
+        if key not in _SOURCE_KEYS:
+            hint = suggest(key, _SOURCE_KEYS).strip() or f"Valid keys: {', '.join(_SOURCE_KEYS)}."
             raise ConditionsError(path, f"unknown key '{key}'.", hint)
         out[key] = _check_number(path, key, value)
     return out
@@ -212,11 +228,11 @@ def read_conditions_csv(path: str | Path) -> dict[str, dict[str, float]]:
                 "separated by commas.",
             )
     for col in list(table.columns):
-        if col != "file" and col not in CONDITION_KEYS:
-            hint = suggest(col, CONDITION_KEYS)
+        if col != "file" and col not in _SOURCE_KEYS:
+            hint = suggest(col, _SOURCE_KEYS)
             if hint:  # a misspelled key would silently lose its value
                 raise ConditionsError(path, f"unknown column '{col}'." + hint)
-            log.warning("%s: ignoring column '%s'; the columns read are file, %s", path, col, ", ".join(CONDITION_KEYS))
+            log.warning("%s: ignoring column '%s'; the columns read are file, %s", path, col, ", ".join(_SOURCE_KEYS))
             table = table.drop(columns=col)
     rows: dict[str, dict[str, float]] = {}
     for i, row in table.iterrows():
@@ -227,7 +243,7 @@ def read_conditions_csv(path: str | Path) -> dict[str, dict[str, float]]:
         if name in rows:
             raise ConditionsError(path, f"line {line}: '{name}' is listed twice.", "Keep one row per video.")
         values: dict[str, float] = {}
-        for key in CONDITION_KEYS:
+        for key in _SOURCE_KEYS:
             if key not in table.columns or pd.isna(row[key]):
                 continue
             try:
@@ -363,11 +379,46 @@ def resolve_conditions(
             f"Give them in a sidecar ({video.stem}.toml with speed_rpm = ...), a row of "
             f"{CONDITIONS_CSV}, or the file name (e.g. n3000_Fr500_Fa0{video.suffix}).",
         )
+    bearing_keys = {k: merged.pop(k) for k in BEARING_KEYS if k in merged}
+    for key, value in bearing_keys.items():
+        if not (math.isfinite(value) and value > 0) or (key == "n_balls" and (value != int(value) or value < 3)):
+            need = "a whole number >= 3" if key == "n_balls" else "a finite number > 0"
+            raise ConditionsError(video, f"invalid bearing key from {origin[key]}: {key} = {value:g} must be {need}.")
     try:
         conditions = OperatingConditions.from_mapping(merged)
     except ParameterError as exc:
         raise ConditionsError(video, f"invalid condition from {origin.get(exc.parameter, 'a source')}: {exc}") from exc
-    return ResolvedConditions(video=video, conditions=conditions, origin=origin)
+    return ResolvedConditions(video=video, conditions=conditions, origin=origin, bearing_keys=bearing_keys)
+
+
+def bearing_with_keys(bearing: Bearing, resolved: ResolvedConditions) -> Bearing:
+    """``bearing`` with the ball count and diameters a video's sources give (:data:`BEARING_KEYS`).
+
+    The diametral clearance and the groove curvature factors are kept: the races sit at
+    ``d_m -/+ (D + P_d / 2)`` (Harris & Kotzalas, *Rolling Bearing Analysis*, 5th ed., vol. 1, ch. 2).
+
+    Raises
+    ------
+    ConditionsError
+        When the keys describe a bearing that cannot exist (e.g. Z balls do not fit), naming the video.
+    """
+    keys = resolved.bearing_keys
+    if not keys:
+        return bearing
+    g = bearing.geometry
+    d = keys.get("ball_diameter_mm", g.ball_diameter_m * 1e3) * 1e-3
+    d_m = keys.get("pitch_diameter_mm", g.pitch_diameter_m * 1e3) * 1e-3
+    half = d + 0.5 * g.diametral_clearance_m
+    try:
+        geometry = Geometry(inner_race_diameter_m=d_m - half, outer_race_diameter_m=d_m + half, ball_diameter_m=d,
+                            inner_curvature_factor=g.inner_curvature_factor,
+                            outer_curvature_factor=g.outer_curvature_factor,
+                            n_balls=int(keys.get("n_balls", g.n_balls)))
+    except CagelessError as exc:
+        raise ConditionsError(resolved.video, f"the bearing keys ({', '.join(sorted(keys))}) give an impossible "
+                              f"bearing: {exc}") from exc
+    label = ", ".join(f"{k} = {v:g}" for k, v in sorted(keys.items()))
+    return dataclasses.replace(bearing, geometry=geometry, name=f"{bearing.name} ({label})")
 
 
 def _is_image_sequence(folder: Path) -> bool:

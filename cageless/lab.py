@@ -67,11 +67,12 @@ class LabOptions:
     parameters: dict[str, float] = field(default_factory=dict)
     #: Where the parameters came from when a calibration file gave them (one line), or None.
     calibration: str | None = None
+    n_balls: int | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready, without the scheduler address (it does not change results)."""
         return {"duration_s": self.duration_s, "settle_s": self.settle_s, "bin_deg": self.bin_deg, "rtol": self.rtol,
-                "force": self.force, "parameters": dict(self.parameters),
+                "force": self.force, "parameters": dict(self.parameters), "n_balls": self.n_balls,
                 **({"calibration": self.calibration} if self.calibration else {})}
 
 
@@ -89,11 +90,13 @@ class LabResult:
 
 # -- jobs (top-level so processes and Dask workers can run them) --------------------------------------
 
-def _track_job(video: str, conditions: OperatingConditions, bearing: Bearing, out_dir: str) -> tuple[str, str]:
-    from tracking.pipeline import track_video
+def _track_job(video: str, conditions: OperatingConditions, bearing: Bearing, out_dir: str,
+               n_balls: int | None = None) -> tuple[str, str]:
+    from tracking.pipeline import TrackOptions, track_video
 
     try:
-        res = track_video(video, conditions, bearing, out_dir=out_dir, progress=False, config={"command": "report"})
+        res = track_video(video, conditions, bearing, TrackOptions(n_balls=n_balls), out_dir=out_dir, progress=False,
+                          config={"command": "report"})
     except CagelessError as exc:
         return "failed", str(exc)
     return "ok", str(res.path)
@@ -259,7 +262,7 @@ def _run_lab(folder: str | Path, out: Path, options: LabOptions | None, bearing:
     good = [e for e in entries if e.ok]
     with job_pool(options.workers, options.scheduler) as pool:
         t0 = time.perf_counter()
-        traces, n_skip = _track_all(pool, good, bearing, out, cache, progress)
+        traces, n_skip = _track_all(pool, good, bearing, out, cache, progress, options.n_balls)
         skipped += n_skip
         timings["tracking"] = time.perf_counter() - t0
         for e in good:
@@ -317,17 +320,17 @@ def _collect(results: dict[Any, Any], pending: list[Any], keys: list[str], outco
 
 
 def _track_all(pool: Any, entries: list[LabEntry], bearing: Bearing, out: Path, cache: _Cache,
-               progress: bool) -> tuple[dict[Path, Any], int]:
+               progress: bool, n_balls: int | None = None) -> tuple[dict[Path, Any], int]:
     traces: dict[Path, Any] = {}
     jobs, keys, pending = [], [], []
     for e in entries:
         key = cache.key("track", {"input": hash_file(e.video, "blake3"), "conditions": e.resolved.conditions.to_dict(),
-                                  "bearing": bearing.to_dict()})
+                                  "bearing": bearing.to_dict(), "n_balls": n_balls})
         hit = cache.hit(key)
         if hit:
             traces[e.video] = hit
             continue
-        jobs.append((_track_job, (str(e.video), e.resolved.conditions, bearing, str(out / "traces"))))
+        jobs.append((_track_job, (str(e.video), e.resolved.conditions, bearing, str(out / "traces"), n_balls)))
         keys.append(key)
         pending.append(e.video)
     _collect(traces, pending, keys, _run_jobs(pool, jobs, "tracking", progress), cache)

@@ -27,8 +27,10 @@ import numpy.typing as npt
 import pandas as pd
 
 from cageless.errors import TrackingError
+from tracking.candidates import find_candidates
 from tracking.detect import Detections, DetectorParams, centroid_windows, detect_full
 from tracking.locate import fit_circle
+from tracking.select import Anchor, BallRing, anchor_at
 
 __all__ = ["TRACK_COLUMNS", "TrackSetup", "BallCountWarning", "track_frames", "find_start"]
 
@@ -40,6 +42,9 @@ TRACK_COLUMNS = ("frame", "time_s", "ball", "u_px", "v_px", "mass", "detected")
 #: whole frame is searched (a highlight dropout lasts a few frames; the prediction stays good).
 _WIDEN_AFTER = 3
 _REDETECT_AFTER = 12
+#: A window whose mass exceeds this multiple of the ball's usual mass has caught something brighter
+#: than a highlight (the ring face between two balls) and counts as a miss.
+_MAX_MASS_RATIO = 4.0
 #: Frames scanned for a start frame with all balls in view.
 _START_SCAN = 64
 
@@ -59,6 +64,8 @@ class TrackSetup:
     max_area_px: float
     n_balls: int
     params: DetectorParams
+    ring: BallRing | None = None  # the chosen ball circle (tracking.select); None: the count-based start
+    anchors: tuple[Anchor, ...] = ()  # chosen highlights in sampled frames (absolute frame numbers)
 
 
 @dataclass
@@ -76,8 +83,73 @@ def _angles(u: np.ndarray, v: np.ndarray, c: tuple[float, float]) -> np.ndarray:
 
 
 def _full(frame: np.ndarray, s: TrackSetup) -> Detections:
+    if s.ring is not None:
+        return _ring_detections(frame, s)
     return detect_full(frame, s.background, s.mask, s.sigma_noise, s.params, s.highlight_sigma or None,
                        s.max_area_px, s.n_balls)
+
+
+def _ring_detections(frame: np.ndarray, s: TrackSetup,
+                     near: tuple[np.ndarray, np.ndarray] | None = None) -> Detections:
+    """Blob candidates on the chosen ball circle, measured by weighted centroids.
+
+    With ``near`` (predicted positions), only patches around them are searched: a third of the ball
+    spacing along the circle each way, the per-frame cost of a miss.
+    """
+    ring = s.ring
+    assert ring is not None
+    if near is None:
+        boxes = [(0, frame.shape[0], 0, frame.shape[1])]
+    else:
+        h = int(math.ceil(ring.radius * 2 * math.pi / s.n_balls / 3 + 4 * ring.sigma_px))
+        boxes = [(max(int(v) - h, 0), min(int(v) + h + 1, frame.shape[0]),
+                  max(int(u) - h, 0), min(int(u) + h + 1, frame.shape[1])) for u, v in zip(*near, strict=True)]
+    us, vs = [], []
+    for y0, y1, x0, x1 in boxes:
+        if y1 - y0 < 3 or x1 - x0 < 3:
+            continue
+        c = find_candidates(frame[y0:y1, x0:x1], s.background[y0:y1, x0:x1], s.mask[y0:y1, x0:x1], ring.sigma_px,
+                            ring.k_sigma, 4 * s.n_balls + 8, ring.response_sigma)
+        cu, cv = c.u + x0, c.v + y0
+        on = np.abs(np.hypot(cu - ring.centre[0], cv - ring.centre[1]) - ring.radius) <= ring.radial_tol_px
+        us.append(cu[on])
+        vs.append(cv[on])
+    if not us:
+        return Detections(*(np.zeros(0),) * 4)
+    return _measure(frame, s, np.concatenate(us), np.concatenate(vs))
+
+
+def _measure(frame: np.ndarray, s: TrackSetup, u0: np.ndarray, v0: np.ndarray) -> Detections:
+    half = s.params.window_sigma * max(s.highlight_sigma, 1.0)
+    u, v, m = centroid_windows(frame, s.background, s.mask, u0, v0, half, s.params.weight_sigma * s.sigma_noise,
+                               s.params.iterations)
+    ok = m > 0
+    return Detections(u[ok], v[ok], m[ok], np.full(int(ok.sum()), s.highlight_sigma))
+
+
+def _anchor_start(frames: Callable[[int], np.ndarray], times: npt.NDArray[np.float64], s: TrackSetup,
+                  offset: int, path: str) -> tuple[int, Detections, np.ndarray]:
+    """Start frame, detections (cyclic order) and image angular speeds from the selection's anchors."""
+    n = len(times)
+    inside = [a for a in s.anchors if offset <= a.frame < offset + n]
+    anchor = inside[0] if inside else None
+    if anchor is not None:
+        anchor = Anchor(anchor.frame - offset, anchor.u, anchor.v, anchor.omega)
+    else:
+        assert s.ring is not None
+        anchor = anchor_at(frames, times, s.background, s.mask, s.ring)
+    if anchor is None:
+        raise TrackingError(path, f"could not find the {s.n_balls} balls again at frame {offset}.",
+                            "Track with one thread, or check the clip for a change of view.")
+    frame = frames(anchor.frame)
+    half = s.params.window_sigma * max(s.highlight_sigma, 1.0)
+    u, v, m = centroid_windows(frame, s.background, s.mask, anchor.u, anchor.v, half,
+                               s.params.weight_sigma * s.sigma_noise, s.params.iterations)
+    bad = ~(m > 0) | (np.hypot(u - anchor.u, v - anchor.v) > half)
+    u, v = np.where(bad, anchor.u, u), np.where(bad, anchor.v, v)
+    m = np.where(bad, np.nanmedian(np.where(bad, np.nan, m)) if (~bad).any() else 1.0, m)
+    det = Detections(u, v, m, np.full(u.size, s.highlight_sigma))
+    return anchor.frame, det, anchor.omega
 
 
 def find_start(frames: Callable[[int], np.ndarray], n_frames: int, s: TrackSetup, path: str,
@@ -110,24 +182,34 @@ def find_start(frames: Callable[[int], np.ndarray], n_frames: int, s: TrackSetup
 
 def track_frames(frames: Callable[[int], np.ndarray], times: npt.NDArray[np.float64], s: TrackSetup,
                  path: str = "video", strict: bool = False,
-                 progress: Callable[[int], None] | None = None) -> tuple[pd.DataFrame, tuple[float, float]]:
+                 progress: Callable[[int], None] | None = None,
+                 offset: int = 0) -> tuple[pd.DataFrame, tuple[float, float]]:
     """Track all frames; return the track table and the highlight-circle centre used for prediction.
 
     ``frames(i)`` returns frame ``i`` (cropped like ``s.background``); ``progress(k)`` is called
-    with the number of frames done since the last call.
+    with the number of frames done since the last call. ``offset`` is the absolute number of frame 0
+    (for a segment of a longer video). With a chosen ball circle (``s.ring``) tracking starts from
+    the selection's anchors; without, from the first frame showing the expected count.
     """
     n = len(times)
-    start, det, z = find_start(frames, n, s, path, strict)
+    omega0 = None
+    if s.ring is not None:
+        start, det, omega0 = _anchor_start(frames, times, s, offset, path)
+        z = s.n_balls
+        centre = s.ring.centre
+    else:
+        start, det, z = find_start(frames, n, s, path, strict)
+        cx, cy, _, _ = fit_circle(det.u, det.v)
+        centre = (cx, cy)
     s = TrackSetup(**{**s.__dict__, "n_balls": z})
-    cx, cy, _, _ = fit_circle(det.u, det.v)
-    centre = (cx, cy)
     th0 = _angles(det.u, det.v, centre)
     order = np.argsort(th0)
     u = np.full((n, z), np.nan)
     v = np.full((n, z), np.nan)
     mass = np.zeros((n, z))
     u[start], v[start], mass[start] = det.u[order], det.v[order], det.mass[order]
-    init = _State(theta=th0[order], radius=np.hypot(det.u - cx, det.v - cy)[order], omega=np.zeros(z),
+    omega = np.zeros(z) if omega0 is None else np.asarray(omega0, dtype=np.float64)[order]
+    init = _State(theta=th0[order], radius=np.hypot(det.u - centre[0], det.v - centre[1])[order], omega=omega,
                   misses=np.zeros(z, dtype=int), ref_mass=det.mass[order].copy(), t=float(times[start]))
     if progress:
         progress(1)
@@ -157,14 +239,24 @@ def _step(frame: np.ndarray, t: float, st: _State, s: TrackSetup, centre: tuple[
         # Until the speed is known, widen the window by the largest plausible motion.
         # Until the speed is known, or after a few misses, find the highlight in a wider window first,
         # then measure it in the normal one.
-        grow = np.where((st.omega == 0.0) | (st.misses >= _WIDEN_AFTER), 2.0, 1.0)
+        # With a chosen ball circle, a ball missing for a few frames is looked for among the blob
+        # candidates on that circle near its prediction (a wider centroid window could slide onto the
+        # bright ring face seen between two balls).
+        widen = st.misses >= _WIDEN_AFTER
+        grow = np.where((st.omega == 0.0) | (widen & (s.ring is None)), 2.0, 1.0)
         thr = s.params.weight_sigma * s.sigma_noise
         if np.any(grow > 1.0):
             fu, fv, _ = centroid_windows(frame, s.background, s.mask, pu, pv, half * grow, thr, 1)
             pu, pv = np.where(np.isfinite(fu), fu, pu), np.where(np.isfinite(fv), fv, pv)
         mu, mv, mm = centroid_windows(frame, s.background, s.mask, pu, pv, half, thr, s.params.iterations)
         ok = (mm >= s.params.lost_fraction * st.ref_mass) & (np.hypot(mu - pu, mv - pv) <= half)
-        if np.any(st.misses[~ok] + 1 >= _REDETECT_AFTER):
+        if s.ring is not None:
+            ok &= mm <= _MAX_MASS_RATIO * st.ref_mass
+            look = ~ok & (st.misses + 1 >= _WIDEN_AFTER)
+            if np.any(look):
+                det = _ring_detections(frame, s, (pu[look], pv[look]))
+                mu, mv, mm, ok = _assign(det, pred, centre, st, s, mu, mv, mm, ok)
+        elif np.any(st.misses[~ok] + 1 >= _REDETECT_AFTER):
             mu, mv, mm, ok = _assign(_full(frame, s), pred, centre, st, s, mu, mv, mm, ok)
     else:
         mu, mv, mm, ok = _assign(_full(frame, s), pred, centre, st, s, None, None, None, None)

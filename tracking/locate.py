@@ -42,6 +42,9 @@ class BearingLocation:
         Radii of the dark band between the ring lands, where the balls are seen.
     contour_residual
         RMS distance of the contour points from the fitted circle.
+    source
+        ``"brightness"`` (the dark band between bright ring faces) or ``"motion"`` (where things move:
+        a search annulus whose middle is not the pitch circle).
     """
 
     centre: tuple[float, float]
@@ -49,6 +52,7 @@ class BearingLocation:
     band_inner: float
     band_outer: float
     contour_residual: float
+    source: str = "brightness"
 
     def annulus_mask(self, shape: tuple[int, int], margin: float = 0.0) -> npt.NDArray[np.bool_]:
         """Boolean mask of the band, shrunk by ``margin`` px on both sides."""

@@ -35,7 +35,9 @@ from tracking.io import CineReader, FrameSource, open_video
 from tracking.kinematics import DEFAULT_WINDOW, revolution_speed
 from tracking.link import BallCountWarning, TrackSetup, track_frames
 from tracking.locate import BearingLocation, background_frame, locate_bearing
-from tracking.qc import QCReport, build_qc, slip_warnings, write_qc
+from tracking.locate_motion import locate_by_motion, motion_map, plausible_band
+from tracking.qc import QCReport, build_qc, slip_warnings, write_qc, write_selection_qc
+from tracking.select import SPEED_BAND, Selection, SelectionError, select_balls
 
 __all__ = ["TrackOptions", "TrackResult", "track_video"]
 
@@ -65,7 +67,7 @@ class TrackOptions:
     polyorder
         Savitzky-Golay polynomial order.
     strict
-        Make a ball-count mismatch an error instead of a warning.
+        Kept for old configurations: a ball count other than the bearing's (or ``n_balls``) is always an error.
     chunk
         Frames read per chunk (two chunks are cached: 64 full-size 16-bit frames are 131 MB).
     fps
@@ -76,6 +78,8 @@ class TrackOptions:
         Segments tracked in parallel threads for long videos (each at least 1024 frames).
     allow_truncated
         Track the complete frames of a truncated ``.cine`` instead of refusing it.
+    n_balls
+        The ball count the video shows, when it differs from the bearing's (default: the bearing's).
     """
 
     detector: DetectorParams = field(default_factory=DetectorParams)
@@ -87,6 +91,7 @@ class TrackOptions:
     qc_frames: int = 3
     threads: int = 2
     allow_truncated: bool = False
+    n_balls: int | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready settings."""
@@ -139,27 +144,62 @@ class _CroppedFrames:
         return block[i - k * self.chunk]
 
 
+def _locate(video: FrameSource, background: np.ndarray, bearing: Bearing, path: Path) -> BearingLocation:
+    """The bearing and its ball band from brightness; from motion when that fails or gives a band that
+    does not fit a ball (dark ring faces, balls over bright faces)."""
+    g = bearing.geometry
+    ratio = g.ball_diameter_m / (0.5 * g.pitch_diameter_m)
+    err: TrackingError | None = None
+    try:
+        loc = locate_bearing(background, path)
+        if plausible_band(loc, ratio):
+            return loc
+    except TrackingError as exc:
+        if "no contrast" in exc.message:
+            raise
+        err = exc
+    alt = locate_by_motion(motion_map(video), path, ratio)
+    if alt is not None:
+        log.info("%s: ball band found from motion (%.0f..%.0f px)", path, alt.band_inner, alt.band_outer)
+        return alt
+    if err is not None:
+        raise err
+    return loc
+
+
 def _setup(video: FrameSource, loc: BearingLocation, background: np.ndarray, bearing: Bearing,
-           options: TrackOptions, frames: _CroppedFrames) -> TrackSetup:
+           options: TrackOptions, frames: _CroppedFrames, conditions: OperatingConditions,
+           path: Path) -> tuple[TrackSetup, Selection]:
+    """Masks and noise level, then the ball selection (:mod:`tracking.select`) and the highlight width."""
     rows, cols = frames.rows, frames.cols
     margin = max(1.5, 0.04 * (loc.band_outer - loc.band_inner))
     mask = loc.annulus_mask(video.frame_shape, margin)[rows, cols]
     bg = np.ascontiguousarray(background[rows, cols])
     picks = np.linspace(0, len(video) - 1, min(4, len(video))).astype(int)
-    sample = np.stack([video[int(i)][rows, cols] for i in picks])
+    sample = np.stack([frames(int(i)) for i in picks])
     sigma = noise_sigma(sample, bg, mask)
     mask = mask & ~static_defects(bg, sigma)
     g = bearing.geometry
-    r_mid = 0.5 * (loc.band_inner + loc.band_outer)
-    ball_px = g.ball_diameter_m / (0.5 * g.pitch_diameter_m) * r_mid
-    base = TrackSetup(background=bg, mask=mask, sigma_noise=sigma, highlight_sigma=0.0,
-                      max_area_px=math.pi * (0.25 * ball_px) ** 2, n_balls=g.n_balls, params=options.detector)
-    det = detect_full(sample[0], bg, mask, sigma, options.detector, None, base.max_area_px, g.n_balls)
-    if len(det) == 0:
-        raise TrackingError(video.path, "no ball highlight was found in the ball band.",
-                            "Check the lighting and the exposure: the highlights must stand out of the black balls.")
-    spots = spot_sigma(sample[0], bg, mask, det.u, det.v, 0.12 * ball_px, options.detector.weight_sigma * sigma)
-    return TrackSetup(**{**base.__dict__, "highlight_sigma": float(np.nanmedian(spots))})
+    z = options.n_balls or g.n_balls
+    centre0 = (loc.centre[0] - cols.start, loc.centre[1] - rows.start)
+    known = bool(conditions.px_per_mm) or loc.source == "brightness"
+    r_prior = (0.5 * g.pitch_diameter_m * 1e3 * conditions.px_per_mm if conditions.px_per_mm
+               else 0.5 * (loc.band_inner + loc.band_outer))
+    sel = select_balls(frames, video.times, bg, mask, z=z, ball_diameter_m=g.ball_diameter_m,
+                       pitch_diameter_m=g.pitch_diameter_m, omega_i=conditions.speed_rad_s, centre0=centre0,
+                       r_prior=r_prior, path=path, prior_known=known)
+    ring = sel.ring
+    ball_px = 2 * g.ball_diameter_m / g.pitch_diameter_m * ring.radius  # now from the measured ball circle
+    h, w = mask.shape
+    vv, uu = np.ogrid[0:h, 0:w]
+    mask = mask & (np.abs(np.hypot(uu - ring.centre[0], vv - ring.centre[1]) - ring.radius) <= 0.5 * ball_px)
+    a = sel.anchors[0]
+    spots = spot_sigma(frames(a.frame), bg, mask, a.u, a.v, 0.12 * ball_px, options.detector.weight_sigma * sigma)
+    hs = float(np.nanmedian(spots)) if np.isfinite(spots).any() else sel.ring.sigma_px
+    setup = TrackSetup(background=bg, mask=mask, sigma_noise=sigma, highlight_sigma=hs,
+                       max_area_px=math.pi * (0.25 * ball_px) ** 2, n_balls=z, params=options.detector,
+                       ring=sel.ring, anchors=tuple(sel.anchors))
+    return setup, sel
 
 
 def track_video(
@@ -187,16 +227,27 @@ def track_video(
             raise TrackingError(path, f"has {len(video)} frames, fewer than the speed window of {options.window}: "
                                 "too short to give a speed.", "Record longer, or lower --window.")
         background = background_frame(video)
-        loc = locate_bearing(background, path)
+        loc = _locate(video, background, bearing, path)
         rows, cols = loc.crop(video.frame_shape)
         frames = _CroppedFrames(video, rows, cols, options.chunk)
-        setup = _setup(video, loc, background, bearing, options, frames)
+        try:
+            setup, sel = _setup(video, loc, background, bearing, options, frames, conditions, path)
+        except SelectionError as exc:
+            if out_dir is not None and exc.table is not None:
+                shown = exc.table.assign(u_px=exc.table.u_px + cols.start, v_px=exc.table.v_px + rows.start)
+                qc_png = write_selection_qc(Path(out_dir) / "qc", _stem(path), video[0], shown, exc.ring,
+                                            (cols.start, rows.start), exc.message)
+                raise SelectionError(path, f"{exc.message} No trace written; QC: {qc_png}.", exc.hint,
+                                     exc.table, exc.found, exc.ring) from None
+            raise
         with tqdm(total=len(video), desc=path.name, unit="frame", disable=not progress, leave=False) as bar:
             table = _track_all(path, fps, video, frames, times, setup, options, bar.update)
         table["u_px"] += cols.start
         table["v_px"] += rows.start
         trace, qc = _finish(path, video, table, loc, conditions, bearing, options, prov,
-                            [str(w.message) for w in caught])
+                            [str(w.message) for w in caught], _selection_summary(sel, cols.start, rows.start))
+        selection_table = sel.table.assign(u_px=sel.table.u_px + cols.start, v_px=sel.table.v_px + rows.start)
+        first_frame = video[0] if out_dir is not None else None
     for w in caught:  # recorded for QC; still shown to the caller
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     written = None
@@ -206,6 +257,8 @@ def track_video(
         try:
             write_qc(out_dir / "qc", _stem(path), path, qc, table, trace, options.qc_frames, fps,
                      allow_truncated=options.allow_truncated)
+            write_selection_qc(out_dir / "qc", _stem(path), first_frame, selection_table, sel.ring,
+                               (cols.start, rows.start), f"{qc.n_balls_found} balls selected")
         except BaseException:  # no trace without its QC: a re-run redoes both
             written.unlink(missing_ok=True)
             raise
@@ -226,7 +279,7 @@ def _track_all(path: Path, fps: float | None, video: FrameSource, frames: _Cropp
         a, b = span
         with open_video(path, fps=fps, allow_truncated=options.allow_truncated) as own:
             seg = _CroppedFrames(own, frames.rows, frames.cols, options.chunk, offset=a, stop=b)
-            return track_frames(seg, times[a:b], setup, str(path), options.strict, update)[0]
+            return track_frames(seg, times[a:b], setup, str(path), options.strict, update, offset=a)[0]
 
     with ThreadPoolExecutor(max_workers=k) as pool:
         parts = list(pool.map(one, spans))
@@ -259,13 +312,47 @@ def _stitch(parts: list[pd.DataFrame], spans: list[tuple[int, int]], times: np.n
     })
 
 
+#: Largest share of interpolated (missed) samples a trace may have.
+MAX_LOST_SHARE = 0.3
+
+
+def _check_tracks(path: Path, times: np.ndarray, angle: np.ndarray, valid: np.ndarray, omega_c: float) -> None:
+    """Refuse tracks that are not balls: mean speeds outside the plausible band, or too many misses."""
+    lost = 1.0 - float(valid.mean())
+    if lost > MAX_LOST_SHARE:
+        raise TrackingError(path, f"{lost:.0%} of the ball positions were lost (limit {MAX_LOST_SHARE:.0%}); "
+                            "no trace written.", "Check the lighting and focus over the whole clip.")
+    span = float(times[-1] - times[0])
+    if span <= 0:
+        return
+    ratio = (angle[-1] - angle[0]) / span / omega_c
+    lo, hi = SPEED_BAND
+    bad = np.flatnonzero((ratio < lo) | (ratio > hi))
+    if bad.size:
+        k = int(bad[0])
+        raise TrackingError(path, f"ball {k} moves at {ratio[k]:.2f} x the cage speed, outside the plausible "
+                            f"{lo}-{hi}; no trace written.", "Check speed_rpm and the bearing description.")
+
+
 def _stem(path: Path) -> str:
     return path.name if path.is_dir() else path.stem
 
 
+def _selection_summary(sel: Selection, du: int, dv: int) -> dict[str, Any]:
+    """What the ball selection found, for the QC record (full-image pixels)."""
+    t = sel.table
+    reasons = t.loc[t.status == "rejected", "reason"].value_counts()
+    return {"counts": [int(c) for c in sel.counts],
+            "circle_centre_px": (sel.ring.centre[0] + du, sel.ring.centre[1] + dv),
+            "circle_radius_px": sel.ring.radius, "direction": sel.ring.direction,
+            "speed_over_cage_speed": sel.ring.omega / sel.ring.omega_c,
+            "selected": int((t.status == "selected").sum()),
+            "rejected": {str(k): int(v) for k, v in reasons.items()}}
+
+
 def _finish(path: Path, video: FrameSource, table: pd.DataFrame, loc: BearingLocation,
             conditions: OperatingConditions, bearing: Bearing, options: TrackOptions, prov: Provenance,
-            warned: list[str]) -> tuple[Trace, QCReport]:
+            warned: list[str], selection: dict[str, Any] | None = None) -> tuple[Trace, QCReport]:
     g = bearing.geometry
     orbit = fit_orbit(table)
     roll = math.radians(conditions.camera_roll_deg or 0.0)
@@ -276,10 +363,12 @@ def _finish(path: Path, video: FrameSource, table: pd.DataFrame, loc: BearingLoc
     except ParameterError as exc:
         raise TrackingError(path, str(exc)) from exc
     omega_c = theoretical_cage_speed(g, conditions.speed_rad_s)
+    _check_tracks(path, times, angle, valid, omega_c)
     px_per_mm = conditions.px_per_mm or orbit.radius / (0.5 * g.pitch_diameter_m * 1e3)
     qc = build_qc(table, order, valid, orbit, loc, direction, px_per_mm, g.n_balls, warned)
     slip = slip_rate(speed, omega_c)
     qc.warnings.extend(slip_warnings(angle, speed, slip, valid, omega_c, conditions.speed_rpm))
+    qc.selection = selection or {}
     meta = video.metadata
     fps = meta.extra.get("fps_override") or meta.timestamp_fps or meta.header_fps or float("nan")
     trace = Trace(

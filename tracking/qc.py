@@ -28,7 +28,8 @@ from tracking.geometry import Orbit
 from tracking.io import open_video
 from tracking.locate import BearingLocation
 
-__all__ = ["QC_LIMITS", "QCReport", "build_qc", "write_qc", "slip_warnings"]
+__all__ = ["QC_LIMITS", "QCReport", "build_qc", "write_qc", "slip_warnings", "write_selection_qc",
+           "REASON_COLOURS"]
 
 log = logging.getLogger(__name__)
 
@@ -61,6 +62,7 @@ class QCReport:
     ball_order: list[int] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
     overlays: list[str] = field(default_factory=list)
+    selection: dict[str, Any] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready summary."""
@@ -203,3 +205,47 @@ def _write_qc(qc_dir: Path, stem: str, video_path: Path, qc: QCReport, table: pd
     atomic_write_text(qc_dir / f"{stem}.slip_profile.csv", profile.to_csv(index=False, float_format="%.6g"))
     return written[:-1]
 
+
+
+#: Overlay colour (BGR) of each candidate status in the selection image.
+REASON_COLOURS = {
+    "selected": (0, 255, 0), "breaks spacing": (0, 200, 255), "off the ball circle": (255, 128, 0),
+    "static": (0, 0, 255), "turns with the inner ring": (255, 0, 255), "wrong speed": (0, 128, 255),
+    "wrong direction": (128, 0, 255), "too short": (128, 128, 128), "not chosen": (200, 200, 200),
+}
+
+
+def write_selection_qc(qc_dir: Path, stem: str, frame: np.ndarray | None, table: pd.DataFrame, ring: Any,
+                       offset: tuple[int, int], title: str) -> Path:
+    """Write ``<stem>.candidates.csv`` (every candidate tracklet, its status and reason) and
+    ``<stem>.selection.png``: the first frame with every candidate marked in its reason's colour, the
+    chosen ball circle and a legend. Returns the PNG's path."""
+    qc_dir.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(qc_dir / f"{stem}.candidates.csv", table.to_csv(index=False, float_format="%.4f"))
+    target = qc_dir / f"{stem}.selection.png"
+    if frame is None:
+        return target
+    lo, hi = np.percentile(frame, [1, 99.8])
+    img8 = np.clip((frame.astype(np.float32) - lo) * (255.0 / max(hi - lo, 1e-6)), 0, 255).astype(np.uint8)
+    scale = max(1, int(math.ceil(700 / max(frame.shape))))
+    img = cv2.resize(cv2.cvtColor(img8, cv2.COLOR_GRAY2BGR), None, fx=scale, fy=scale,
+                     interpolation=cv2.INTER_NEAREST)
+    if ring is not None:
+        c = (int(round((ring.centre[0] + offset[0]) * scale)), int(round((ring.centre[1] + offset[1]) * scale)))
+        cv2.circle(img, c, int(round(ring.radius * scale)), (0, 200, 255), 1, cv2.LINE_AA)
+    for r in table.itertuples():
+        reason = "selected" if r.status == "selected" else r.reason
+        colour = REASON_COLOURS.get(reason, (255, 255, 255))
+        p = (int(round(r.u_px * scale)), int(round(r.v_px * scale)))
+        cv2.circle(img, p, 3 * scale if r.status == "selected" else 2 * scale, colour, 1, cv2.LINE_AA)
+    counts = table.assign(key=np.where(table.status == "selected", "selected", table.reason)).key.value_counts()
+    y = 18
+    cv2.putText(img, title[:90], (6, y), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (255, 255, 255), 1, cv2.LINE_AA)
+    for reason, n in counts.items():
+        y += 16
+        cv2.putText(img, f"{reason}: {n}", (6, y), cv2.FONT_HERSHEY_SIMPLEX, 0.45,
+                    REASON_COLOURS.get(str(reason), (255, 255, 255)), 1, cv2.LINE_AA)
+    with atomic_path(target) as tmp:
+        _, buf = cv2.imencode(".png", img)
+        tmp.write_bytes(buf.tobytes())
+    return target

@@ -42,11 +42,14 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--scheduler", help="address of a Dask scheduler to run the jobs on")
     p.add_argument("--force", action="store_true", help="compare even when a trace's conditions differ, and accept "
                    "numbers and conditions outside their plausible ranges")
+    p.add_argument("--n-balls", type=int, metavar="N",
+                   help="ball count the videos show, when it differs from the bearing's (default: the bearing's)")
 
 
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Run the workflow and print where the report is."""
     from cageless.config import bearing_from_config
+    from cageless.errors import UsageError
     from cageless.lab import LabOptions, run_lab
     from cageless.calibrate import describe_calibration
     from cageless.cli.common import parameter_values
@@ -54,12 +57,15 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     from cageless.outputs import check_output_dir
     from cageless.validate import check_options
 
+    if args.n_balls is not None and args.n_balls < 3:
+        raise UsageError(f"--n-balls {args.n_balls}: must be a whole number >= 3.")
     values = parameter_values(args, config)  # [parameters] of --config, then --set; before any work starts
     check_options(args, ("duration", "settle", "rtol", "workers"))
     check_output_dir(args.out, "-o")
     note = describe_calibration(config.get("calibration"))
     options = LabOptions(duration_s=args.duration, settle_s=args.settle, rtol=args.rtol, workers=args.workers,
-                         scheduler=args.scheduler, force=args.force, parameters=values, calibration=note)
+                         scheduler=args.scheduler, force=args.force, parameters=values, calibration=note,
+                         n_balls=args.n_balls)
     if note:
         print(f"parameters: {note}")
     res = run_lab(args.lab, args.out, options, bearing_from_config(config), progress=not args.quiet)

@@ -13,7 +13,14 @@ from tqdm.auto import tqdm
 
 from cageless.bearing import Bearing
 from cageless.cli.common import finite_float
-from cageless.conditions import IMAGE_SUFFIXES, LabEntry, OperatingConditions, discover_lab, resolve_conditions
+from cageless.conditions import (
+    IMAGE_SUFFIXES,
+    LabEntry,
+    OperatingConditions,
+    bearing_with_keys,
+    discover_lab,
+    resolve_conditions,
+)
 from cageless.config import bearing_from_config
 from cageless.errors import CagelessError, UsageError
 from cageless.outputs import check_output_dir, clean_stale_parts, output_lock
@@ -51,7 +58,10 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
                    help=f"Savitzky-Golay speed window in frames, odd (default {DEFAULT_WINDOW})")
     p.add_argument("--detector", choices=DETECTORS, default="window",
                    help="centroid method: window refinement (default), weighted, or binary mask")
-    p.add_argument("--strict", action="store_true", help="a wrong ball count is an error, not a warning")
+    p.add_argument("--n-balls", type=int, metavar="N",
+                   help="ball count the video shows, when it differs from the bearing's; otherwise a video that "
+                   "does not show the bearing's count is an error (no trace; the QC image shows what was found)")
+    p.add_argument("--strict", action="store_true", help=argparse.SUPPRESS)  # a wrong count is always an error now
     p.add_argument("--workers", type=int, default=2, help="videos tracked in parallel (default 2)")
     p.add_argument("--allow-truncated", action="store_true",
                    help="track the complete frames of a truncated .cine instead of refusing it")
@@ -112,6 +122,8 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     if args.window < 3 or args.window % 2 == 0:
         raise UsageError(f"--window {args.window}: must be an odd number of frames >= 3.")
     _validate(args)
+    if args.n_balls is not None and args.n_balls < 3:
+        raise UsageError(f"--n-balls {args.n_balls}: must be a whole number >= 3.")
     bearing = bearing_from_config(config)
     entries = [plausible_entry(e, args.force) for e in collect_inputs(args.inputs, args.speed_rpm)]
     _prefetch_first_hash(entries, args.workers)
@@ -119,7 +131,8 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     from tracking.pipeline import TrackOptions
 
     options = TrackOptions(detector=replace(DetectorParams(), method=args.detector), window=args.window,
-                           strict=args.strict, fps=args.fps, allow_truncated=args.allow_truncated)
+                           strict=args.strict, fps=args.fps, allow_truncated=args.allow_truncated,
+                           n_balls=args.n_balls)
     out = Path(args.out)
     with output_lock(out):
         clean_stale_parts(out)
@@ -138,7 +151,14 @@ def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bear
         if not e.ok:
             print(f"FAILED {e.video}: {e.error}")
             failed += 1
-    jobs = [(e.video, e.resolved.conditions, bearing, options, out) for e in entries if e.ok]
+    jobs = []
+    for e in entries:
+        if e.ok:
+            try:  # a sidecar may describe another bearing (n_balls, ball_diameter_mm, pitch_diameter_mm)
+                jobs.append((e.video, e.resolved.conditions, bearing_with_keys(bearing, e.resolved), options, out))
+            except CagelessError as exc:
+                print(f"FAILED {e.video}: {exc}")
+                failed += 1
     workers = max(1, min(args.workers, len(jobs)))
     with tqdm(total=len(jobs), desc="videos", unit="video", disable=args.quiet) as bar:
         results = _map(jobs, workers, bar)

@@ -181,3 +181,27 @@ def test_find_videos_refuses_a_file(tmp_path):
     with pytest.raises(ConditionsError, match="is not a folder"):
         find_videos(_touch(tmp_path / "x.cine"))
     assert find_videos(tmp_path) == [tmp_path / "x.cine"]
+
+
+def test_sidecar_can_describe_the_bearing(tmp_path):
+    """n_balls, ball_diameter_mm and pitch_diameter_mm in a sidecar replace the configured geometry; the
+    races follow as d_m -/+ (D + P_d/2) (Harris & Kotzalas, 5th ed., vol. 1, ch. 2)."""
+    from cageless.bearing import default_bearing
+    from cageless.conditions import bearing_with_keys
+
+    (tmp_path / "n3000.cine").write_bytes(b"")
+    (tmp_path / "n3000.toml").write_text("speed_rpm = 3000\nn_balls = 16\nball_diameter_mm = 6.0\n"
+                                         "pitch_diameter_mm = 31.0\n")
+    r = resolve_conditions(tmp_path / "n3000.cine")
+    assert r.conditions == OperatingConditions(3000.0)
+    assert r.bearing_keys == {"n_balls": 16.0, "ball_diameter_mm": 6.0, "pitch_diameter_mm": 31.0}
+    g = bearing_with_keys(default_bearing(), r).geometry
+    assert (g.n_balls, g.ball_diameter_m, g.pitch_diameter_m) == (16, pytest.approx(6e-3), pytest.approx(31e-3))
+    assert g.diametral_clearance_m == pytest.approx(default_bearing().geometry.diametral_clearance_m, abs=1e-12)
+    assert bearing_with_keys(default_bearing(), resolve_conditions(tmp_path / "n3000.cine")) is not None
+    (tmp_path / "n3000.toml").write_text("speed_rpm = 3000\nn_balls = 40\nball_diameter_mm = 6.0\n")
+    with pytest.raises(ConditionsError, match=r"n3000.cine.*impossible bearing.*do not fit"):
+        bearing_with_keys(default_bearing(), resolve_conditions(tmp_path / "n3000.cine"))
+    (tmp_path / "n3000.toml").write_text("speed_rpm = 3000\nn_balls = 12.5\n")
+    with pytest.raises(ConditionsError, match=r"n3000.cine.*n_balls = 12.5 must be a whole number"):
+        resolve_conditions(tmp_path / "n3000.cine")

@@ -6,6 +6,7 @@ import dataclasses
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from cageless.bearing import default_bearing
@@ -14,7 +15,6 @@ from cageless.conditions import OperatingConditions
 from cageless.errors import TrackingError, VideoError
 from cageless.trace import read_trace
 from tracking.io import write_cine
-from tracking.link import BallCountWarning
 from tracking.pipeline import track_video
 from tracking.synthetic.camera import Appearance, Camera
 from tracking.synthetic.clip import render_clip
@@ -55,18 +55,23 @@ def test_too_short_for_a_speed(tmp_path):
         track_video(video, COND, B, out_dir=tmp_path / "out", progress=False)
 
 
-def test_wrong_ball_count_warns_or_fails_under_strict(tmp_path):
+def test_wrong_ball_count_is_an_error_with_qc_and_no_trace(tmp_path, capsys):
+    """13 balls where the bearing has 14: exit 1, no trace, a QC image and the candidate table with reasons;
+    --n-balls 13 tracks them."""
     g13 = dataclasses.replace(B.geometry, n_balls=13)
     video = _clip(tmp_path / "thirteen.cine", n=30, geometry=g13)
-    with pytest.warns(BallCountWarning, match="shows 13 balls but the bearing has 14"):
-        res = track_video(video, COND, B, progress=False)
-    assert res.trace.n_balls == 13
-    assert any("13 balls" in w for w in res.qc.warnings)
-    from tracking.pipeline import TrackOptions
-
-    with pytest.raises(TrackingError, match="shows 13 balls but the bearing has 14.*--strict"):
-        track_video(video, COND, B, TrackOptions(strict=True), out_dir=tmp_path / "out", progress=False)
+    with pytest.raises(TrackingError, match=r"thirteen.cine: found 13 balls .* the bearing has 14\. No trace written"):
+        track_video(video, COND, B, out_dir=tmp_path / "out", progress=False)
     assert not list(tmp_path.rglob("*.trace.h5"))
+    assert (tmp_path / "out" / "qc" / "thirteen.selection.png").is_file()
+    table = pd.read_csv(tmp_path / "out" / "qc" / "thirteen.candidates.csv")
+    assert set(table.status) <= {"selected", "rejected"} and table.reason.notna().sum() > 0
+    assert main(["track", str(video), "-o", str(tmp_path / "cli"), "-q", "--speed-rpm", "3000"]) == 1
+    text = capsys.readouterr().out
+    assert "FAILED thirteen.cine" in text and "--n-balls 13" in text
+    assert not list((tmp_path / "cli").glob("*.trace.h5"))
+    assert main(["track", str(video), "-o", str(tmp_path / "cli"), "-q", "--speed-rpm", "3000", "--n-balls", "13"]) == 0
+    assert read_trace(tmp_path / "cli" / "thirteen.trace.h5").n_balls == 13
 
 
 def test_frames_of_varying_size(tmp_path):

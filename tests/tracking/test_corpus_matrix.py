@@ -1,0 +1,139 @@
+"""Issue 14's bars on every clip of the independent corpus, both seed sets (tracking/synthetic/matrix.py).
+
+Bars (issue 14, "A corpus that does not flatter the tracker"): exactly Z balls, 0 identity swaps, angle
+RMS <= 0.5 mrad, speed RMS <= 0.5 % of the cage speed, slip-profile MAE <= 0.3 pp (scorer:
+tracking/synthetic/score.py; a perfect highlight detector passes all of them on every clip, see
+test_corpus_renderer.py).
+
+CI runs the first block of 8 seeds of each set (each block covers every factor's range ends); the other
+clips and the long variants are ``slow`` (``--runslow``). Clips render once per session into
+``$CAGELESS_CORPUS_CACHE`` (default: a pytest temporary folder, each video deleted once scored) on two
+processes.
+
+Today's tracker fails most clips, so each known failure is a strict xfail: when a change makes a clip pass,
+pytest reports XPASS(strict) as a failure and the seed must leave :data:`KNOWN_FAILURES`.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+from tracking.synthetic.matrix import HOLDOUT, TUNING
+from tracking.synthetic.runner import run_seeds
+from tracking.synthetic.score import BARS
+
+CI_SEEDS = (*TUNING[:8], *HOLDOUT[:8])
+ALL = [("TUNING", s) for s in TUNING] + [("HOLDOUT", s) for s in HOLDOUT]
+
+#: Seeds today's tracker fails on the short clips, with how (benchmarks/tracking_corpus.py, 2026-11-23: the
+#: tracker of commit e3726da passed TUNING 4 of 32 and HOLDOUT 1 of 32; with the ball selection stage
+#: (tracking/select.py) TUNING 14 of 32 and HOLDOUT 12 of 32). Remove a seed when it passes.
+KNOWN_FAILURES: dict[int, str] = {
+    1000: "angle_rms 0.564 mrad > 0.5",
+    1001: "angle_rms 0.559 mrad > 0.5; speed_rms 0.64 % of cage speed > 0.5; slip_mae 0.382 pp > 0.3",
+    1002: "no trace: the bright region is not circular (fit residual 54.8 px on radius 500.9 px): no bearing in view.",
+    1003: "angle_rms 0.683 mrad > 0.5",
+    1006: "no trace: found 7 balls moving together along one circle, but the bearing has 14.",
+    1011: "angle_rms 1.39 mrad > 0.5; speed_rms 1.38 % of cage speed > 0.5; slip_mae 0.961 pp > 0.3",
+    1012: "no trace: found 15 balls moving together along one circle, but the bearing has 16.",
+    1013: "angle_rms 2.17 mrad > 0.5",
+    1014: "angle_rms 0.639 mrad > 0.5",
+    1015: "no trace: found 14 balls moving together along one circle, but the bearing has 15.",
+    1019: "no trace: found 11 balls moving together along one circle, but the bearing has 17.",
+    1020: "angle_rms 0.667 mrad > 0.5",
+    1022: "no trace: found 11 balls moving together along one circle, but the bearing has 13.",
+    1023: "angle_rms 0.648 mrad > 0.5; speed_rms 0.502 % of cage speed > 0.5",
+    1024: "angle_rms 0.577 mrad > 0.5",
+    1027: "angle_rms 1.52 mrad > 0.5; slip_mae 0.313 pp > 0.3",
+    1029: "no trace: found 13 balls moving together along one circle, but the bearing has 16.",
+    1031: "angle_rms 0.74 mrad > 0.5; speed_rms 0.573 % of cage speed > 0.5",
+    7000: "angle_rms 0.543 mrad > 0.5",
+    7002: "no trace: no bright ring-shaped region found: no bearing in view.",
+    7004: "no trace: found 9 balls moving together along one circle, but the bearing has 12.",
+    7005: "no trace: found 19 balls moving together along one circle, but the bearing has 20.",
+    7006: "angle_rms 0.634 mrad > 0.5; speed_rms 0.598 % of cage speed > 0.5; slip_mae 0.35 pp > 0.3",
+    7007: "angle_rms 0.528 mrad > 0.5",
+    7008: "angle_rms 1.73 mrad > 0.5; speed_rms 0.987 % of cage speed > 0.5; slip_mae 0.403 pp > 0.3",
+    7009: "no trace: no bright ring-shaped region found: no bearing in view.",
+    7011: "angle_rms 0.728 mrad > 0.5; speed_rms 1.2 % of cage speed > 0.5; slip_mae 0.492 pp > 0.3",
+    7012: "angle_rms 8.01 mrad > 0.5; speed_rms 1.28 % of cage speed > 0.5; slip_mae 1.02 pp > 0.3",
+    7013: "no trace: found 16 balls moving together along one circle, but the bearing has 18.",
+    7018: "no trace: no bright ring-shaped region found: no bearing in view.",
+    7020: "angle_rms 1.46 mrad > 0.5; speed_rms 0.502 % of cage speed > 0.5",
+    7023: "angle_rms 0.904 mrad > 0.5",
+    7024: "no trace: no bright ring-shaped region found: no bearing in view.",
+    7025: "angle_rms 1.11 mrad > 0.5; speed_rms 1.01 % of cage speed > 0.5; slip_mae 0.386 pp > 0.3",
+    7026: "no trace: found 8 balls moving together along one circle, but the bearing has 18.",
+    7028: "angle_rms 0.779 mrad > 0.5",
+    7029: "speed_rms 0.55 % of cage speed > 0.5",
+    7031: "no trace: found 10 balls moving together along one circle, but the bearing has 12.",
+}
+
+#: The same for the long variants (one cage revolution each; baseline the same day: TUNING 4 of 32 pass,
+#: HOLDOUT 1 of 32; not yet re-run with the ball selection). Seeds 1005, 1019, 1021, 1025, 7001 pass long
+#: (1018 passes only short, 1019 only long).
+_LONG_PASS = {1005, 1019, 1021, 1025, 7001}
+KNOWN_FAILURES_LONG: dict[int, str] = {
+    s: KNOWN_FAILURES.get(s, "baseline: wrong ball count on the long clip") for _, s in ALL if s not in _LONG_PASS}
+
+_REASON = "tracker not yet robust to this footage (issue 14)"
+
+
+def _params(long: bool = False) -> list:
+    out = []
+    known = KNOWN_FAILURES_LONG if long else KNOWN_FAILURES
+    for name, seed in ALL:
+        marks = []
+        if long or seed not in CI_SEEDS:
+            marks.append(pytest.mark.slow)
+        if seed in known:
+            marks.append(pytest.mark.xfail(strict=True, reason=f"{_REASON}: {known[seed]}"))
+        out.append(pytest.param(seed, id=f"{name}-{seed}", marks=marks))
+    return out
+
+
+@pytest.fixture(scope="session")
+def corpus_dir(tmp_path_factory) -> Path:
+    env = os.environ.get("CAGELESS_CORPUS_CACHE")
+    return Path(env) if env else tmp_path_factory.mktemp("corpus")
+
+
+@pytest.fixture(scope="session")
+def corpus_results(request, corpus_dir):
+    """Render, track and score once per session: the CI seeds, and all seeds with --runslow."""
+    seeds = list(CI_SEEDS)
+    if request.config.getoption("--runslow"):
+        seeds += [s for _, s in ALL if s not in CI_SEEDS]
+    keep = bool(os.environ.get("CAGELESS_CORPUS_CACHE"))  # else delete each video once scored (disk)
+    return {r.seed: r for r in run_seeds(seeds, corpus_dir / "ci", workers=2, progress=False, keep=keep)}
+
+
+@pytest.fixture(scope="session")
+def corpus_results_long(corpus_dir):
+    return {r.seed: r for r in run_seeds([s for _, s in ALL], corpus_dir / "long", workers=2, long=True,
+                                         progress=False, keep=False)}
+
+
+def _assert_bars(result) -> None:
+    assert result.status != "error", f"seed {result.seed}: the tracker gave no trace: {result.message}"
+    s = result.score
+    assert s["n_found"] == s["n_balls"], f"seed {result.seed}: found {s['n_found']} balls, not {s['n_balls']}"
+    assert s["frames_matched"] == result.n_frames
+    assert s["swaps"] == 0
+    assert s["angle_rms_mrad"] <= BARS["angle_rms_mrad"]
+    assert s["speed_rms_pct"] <= BARS["speed_rms_pct"]
+    assert s["slip_mae_pp"] <= BARS["slip_mae_pp"]
+
+
+@pytest.mark.parametrize("seed", _params())
+def test_tracker_meets_the_bars(seed, corpus_results):
+    _assert_bars(corpus_results[seed])
+
+
+@pytest.mark.parametrize("seed", _params(long=True))
+def test_tracker_meets_the_bars_long(seed, corpus_results_long):
+    """The long variants: one cage revolution per clip (slow)."""
+    _assert_bars(corpus_results_long[seed])

@@ -1,0 +1,196 @@
+"""Candidate highlights and short tracklets, for choosing which blobs are the balls (DESIGN §8.3-8.4).
+
+Detection here must not depend on one rendering style, so it asks one question of each pixel:
+is this a small bright *blob* at the scale a ball highlight has? The frame minus the temporal-median
+background (which removes the static ring texture, static glints, vignetting and hot pixels) is
+smoothed at the expected highlight scale and the smallest eigenvalue of the negative Hessian is taken,
+scale-normalised (``sigma^2 lambda_min``, Lindeberg 1998, "Feature detection with automatic scale
+selection", IJCV 30:79). A blob curves down in every direction, so both eigenvalues are large; the
+edge of a dark ball on a bright ring face, or a bright gap between two balls, curves in one direction
+only and gives ``lambda_min`` near 0. Two scales (the expected width and twice it) cover small and
+saturated, flat-topped highlights. Local maxima above a robust noise level (MAD of the response in the
+ball band) are the candidates; the global selection (:mod:`tracking.select`) does the real filtering.
+
+Tracklets link candidates over a burst of consecutive frames by an optimal assignment
+(:func:`scipy.optimize.linear_sum_assignment`) of tracklet predictions (constant velocity) to the next
+frame's candidates, gated by the largest plausible motion per frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+from scipy.optimize import linear_sum_assignment
+
+__all__ = ["Candidates", "Tracklet", "blob_response", "response_map", "bin_mask", "find_candidates", "response_noise",
+           "link_tracklets"]
+
+
+@dataclass(frozen=True)
+class Candidates:
+    """Blob candidates of one frame (pixel coordinates of the image they were found in)."""
+
+    u: npt.NDArray[np.float64]
+    v: npt.NDArray[np.float64]
+    response: npt.NDArray[np.float64]  # blob response in noise units
+    peak: npt.NDArray[np.float64]  # background-subtracted value at the maximum (DN)
+
+    def __len__(self) -> int:
+        return int(self.u.size)
+
+
+@dataclass
+class Tracklet:
+    """Candidates linked over consecutive frames of one burst."""
+
+    frames: list[int] = field(default_factory=list)
+    u: list[float] = field(default_factory=list)
+    v: list[float] = field(default_factory=list)
+    response: list[float] = field(default_factory=list)
+    misses: int = 0
+
+    def predict(self) -> tuple[float, float]:
+        """Position expected in the next frame (constant velocity over the last two samples)."""
+        if len(self.u) < 2:
+            return self.u[-1], self.v[-1]
+        return 2 * self.u[-1] - self.u[-2], 2 * self.v[-1] - self.v[-2]
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Frames, u and v as arrays."""
+        return np.asarray(self.frames), np.asarray(self.u), np.asarray(self.v)
+
+
+def _hessian_min(img: np.ndarray, sigma: float) -> np.ndarray:
+    """``sigma^2`` times the smallest eigenvalue of the negative Hessian of ``img`` smoothed at ``sigma``."""
+    g = cv2.GaussianBlur(img, (0, 0), sigma, borderType=cv2.BORDER_REPLICATE)
+    dxx = cv2.Sobel(g, cv2.CV_32F, 2, 0, ksize=3, borderType=cv2.BORDER_REPLICATE) * 0.25
+    dyy = cv2.Sobel(g, cv2.CV_32F, 0, 2, ksize=3, borderType=cv2.BORDER_REPLICATE) * 0.25
+    dxy = cv2.Sobel(g, cv2.CV_32F, 1, 1, ksize=3, borderType=cv2.BORDER_REPLICATE) * 0.25
+    a, c = -dxx, -dyy
+    half = 0.5 * (a - c)
+    return (sigma * sigma) * (0.5 * (a + c) - np.sqrt(half * half + dxy * dxy))
+
+
+#: Scales searched, in expected highlight widths: small and saturated highlights, and highlights
+#: drawn out along the orbit (motion blur, elongated lobes), which look like blobs at a coarser scale.
+_SCALES = (1.0, 2.0, 4.0)
+
+
+def blob_response(diff: np.ndarray, sigma_px: float) -> np.ndarray:
+    """Largest scale-normalised blob response over the scales :data:`_SCALES` times ``sigma_px``."""
+    d = diff.astype(np.float32, copy=False)
+    out = _hessian_min(d, sigma_px)
+    for k in _SCALES[1:]:
+        np.maximum(out, _hessian_min(d, k * sigma_px), out=out)
+    return out
+
+
+#: The response is computed on an image binned so that the highlight width is at least this (px):
+#: the Hessian needs ~1.5 px of sigma to be sampled well, and binning cuts the cost by the factor squared.
+_WORK_SIGMA = 1.5
+
+
+def response_map(frame: np.ndarray, background: np.ndarray, sigma_px: float) -> tuple[np.ndarray, int]:
+    """Blob response of ``frame - background`` and the binning factor it was computed at."""
+    f = max(1, int(sigma_px // _WORK_SIGMA))
+    diff = np.subtract(frame, background, dtype=np.float32)
+    if f > 1:
+        h, w = diff.shape
+        diff = cv2.resize(diff[: h - h % f, : w - w % f], (w // f, h // f), interpolation=cv2.INTER_AREA)
+    return blob_response(diff, sigma_px / f), f
+
+
+def bin_mask(mask: np.ndarray, f: int) -> np.ndarray:
+    """A mask binned by ``f`` (a binned pixel is in when all its pixels are)."""
+    if f == 1:
+        return mask
+    h, w = mask.shape
+    m = mask[: h - h % f, : w - w % f].astype(np.uint8) * np.uint8(255)
+    return cv2.resize(m, (w // f, h // f), interpolation=cv2.INTER_AREA) == 255
+
+
+def find_candidates(frame: np.ndarray, background: np.ndarray, mask: np.ndarray, sigma_px: float,
+                    k_sigma: float = 5.0, max_n: int = 200, response_sigma: float | None = None) -> Candidates:
+    """Blob candidates in ``frame`` inside ``mask`` (arrays cropped alike).
+
+    Parameters
+    ----------
+    sigma_px
+        Expected highlight width (Gaussian sigma, px).
+    k_sigma
+        A candidate's response must exceed this many robust standard deviations of the response.
+    max_n
+        Keep at most this many, strongest first.
+    response_sigma
+        The response's noise level, if already known (else measured in ``mask``).
+    """
+    resp, f = response_map(frame, background, sigma_px)
+    m = bin_mask(mask, f)
+    if response_sigma is None:
+        response_sigma = response_noise(resp, m)
+    radius = max(1, int(round(1.5 * sigma_px / f)))
+    kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 1, 2 * radius + 1))
+    peak = (resp >= cv2.dilate(resp, kernel)) & m & (resp > k_sigma * response_sigma)
+    vv, uu = np.nonzero(peak)
+    r = resp[vv, uu]
+    order = np.argsort(-r, kind="stable")[:max_n]
+    vv, uu = vv[order], uu[order]
+    u, v = (uu + 0.5) * f - 0.5, (vv + 0.5) * f - 0.5
+    iu = np.clip(np.rint(u).astype(int), 0, frame.shape[1] - 1)
+    iv = np.clip(np.rint(v).astype(int), 0, frame.shape[0] - 1)
+    return Candidates(u=u.astype(np.float64), v=v.astype(np.float64), response=r[order] / response_sigma,
+                      peak=(frame[iv, iu].astype(np.float64) - background[iv, iu]))
+
+
+def response_noise(resp: np.ndarray, mask: np.ndarray) -> float:
+    """Robust standard deviation (1.4826 MAD) of the blob response inside ``mask``."""
+    vals = resp[mask]
+    if vals.size == 0:
+        return 1e-6
+    med = np.median(vals)
+    return float(max(1.4826 * np.median(np.abs(vals - med)), 1e-6))
+
+
+def link_tracklets(cands: list[Candidates], gate_px: float, max_misses: int = 2) -> list[Tracklet]:
+    """Link per-frame candidates of consecutive frames into tracklets.
+
+    Each live tracklet's constant-velocity prediction is assigned to at most one candidate of the
+    next frame by minimum total distance (Hungarian method), within ``gate_px``; a tracklet may miss
+    ``max_misses`` frames in a row. Unclaimed candidates start new tracklets.
+    """
+    live: list[Tracklet] = []
+    done: list[Tracklet] = []
+    for i, c in enumerate(cands):
+        if live and len(c):
+            pred = np.array([t.predict() for t in live])
+            gap = np.array([i - t.frames[-1] for t in live], dtype=np.float64)
+            d = np.hypot(pred[:, :1] - c.u[None, :], pred[:, 1:] - c.v[None, :])
+            gate = gate_px * gap[:, None]
+            cost = np.where(d <= gate, d, 1e9)
+            rows, cols = linear_sum_assignment(cost)
+            ok = cost[rows, cols] < 1e9
+            rows, cols = rows[ok], cols[ok]
+        else:
+            rows = cols = np.zeros(0, dtype=int)
+        claimed = set(cols.tolist())
+        hit = set(rows.tolist())
+        for r, k in zip(rows, cols, strict=True):
+            t = live[r]
+            t.frames.append(i)
+            t.u.append(float(c.u[k]))
+            t.v.append(float(c.v[k]))
+            t.response.append(float(c.response[k]))
+            t.misses = 0
+        still = []
+        for j, t in enumerate(live):
+            if j not in hit:
+                t.misses += 1
+            (still if t.misses <= max_misses else done).append(t)
+        live = still
+        for k in range(len(c)):
+            if k not in claimed:
+                live.append(Tracklet([i], [float(c.u[k])], [float(c.v[k])], [float(c.response[k])]))
+    return done + live

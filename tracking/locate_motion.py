@@ -1,0 +1,103 @@
+"""Find the ball band from what moves, when the ring faces do not frame a dark band (DESIGN §8.2).
+
+The brightness-based localisation (:mod:`tracking.locate`) needs bright ring faces around a dark
+ball band. Footage from another set-up may show dark ring faces, or balls over bright faces. What
+every such video shares is that the balls move and the ring faces do not (the inner ring turns, but
+its face is nearly rotationally symmetric). The per-pixel temporal spread of a sample of frames is
+therefore high on an annulus about the bearing centre, the width of the visible part of a ball:
+
+1. the spread (standard deviation) of frames sampled over the clip;
+2. Otsu's threshold on it and the larger connected moving regions;
+3. a circle fit to each region's outer contour; the outermost ring-shaped one gives the centre
+   (glints turning with the inner ring make a moving ring inside the balls');
+4. the radial mean profile of the spread about that centre; the search annulus spans every radius
+   where it exceeds a fifth of its peak above the floor (the highlights' circle, and glints turning
+   with the inner ring, which the selection rejects by their speed).
+
+The annulus is only a search region: its middle is not the pitch circle, so the selection then
+chooses the ball circle by its support rather than by its radius.
+"""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from tracking.io.base import FrameSource
+from tracking.locate import BearingLocation, _to_u8, fit_circle
+
+__all__ = ["motion_map", "locate_by_motion", "plausible_band"]
+
+log = logging.getLogger(__name__)
+
+
+def motion_map(video: FrameSource, n_sample: int = 25) -> np.ndarray:
+    """Per-pixel standard deviation of up to ``n_sample`` frames spread over the video."""
+    n = len(video)
+    idx = np.unique(np.linspace(0, n - 1, min(n, n_sample)).round().astype(int))
+    acc = np.zeros(video.frame_shape, np.float64)
+    acc2 = np.zeros(video.frame_shape, np.float64)
+    for i in idx:
+        f = video[int(i)].astype(np.float64)
+        acc += f
+        acc2 += f * f
+    mean = acc / idx.size
+    return np.sqrt(np.maximum(acc2 / idx.size - mean * mean, 0.0)).astype(np.float32)
+
+
+def plausible_band(loc: BearingLocation, ball_over_pitch_radius: float) -> bool:
+    """True when the band's width over its mid radius fits a visible ball: 0.3 to 1.3 ball diameters."""
+    mid = 0.5 * (loc.band_inner + loc.band_outer)
+    if mid <= 0:
+        return False
+    frac = (loc.band_outer - loc.band_inner) / mid / ball_over_pitch_radius
+    return 0.3 <= frac <= 1.3
+
+
+def locate_by_motion(spread: np.ndarray, path: str | Path = "video",
+                     ball_over_pitch_radius: float = 0.414) -> BearingLocation | None:
+    """The ball band from the temporal spread (see the module docstring), widened by half a ball
+    diameter each way (``ball_over_pitch_radius`` = D / (d_m / 2)); None when no ring-shaped moving
+    region is found."""
+    img8 = _to_u8(spread)
+    if img8.max() == img8.min():
+        return None
+    _, binary = cv2.threshold(img8, 0, 255, cv2.THRESH_BINARY + cv2.THRESH_OTSU)
+    binary = cv2.morphologyEx(binary, cv2.MORPH_CLOSE, np.ones((5, 5), np.uint8))
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(binary, connectivity=8)
+    if n < 2:
+        return None
+    rings = []
+    for k in 1 + np.argsort(-stats[1:, cv2.CC_STAT_AREA])[:6]:
+        if stats[k, cv2.CC_STAT_AREA] < 0.1 * stats[1:, cv2.CC_STAT_AREA].max():
+            break
+        contours, _ = cv2.findContours((labels == k).astype(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+        outer = max(contours, key=cv2.contourArea).reshape(-1, 2).astype(np.float64)
+        if len(outer) < 20:
+            continue
+        cx, cy, r_out, rms = fit_circle(outer[:, 0], outer[:, 1])
+        if rms <= 0.05 * r_out and r_out >= 20:
+            rings.append((r_out, cx, cy, rms))
+    if not rings:
+        return None
+    r_out, cx, cy, rms = max(rings)  # the outermost moving ring: balls travel outside the inner ring
+    h, w = spread.shape
+    v, u = np.mgrid[0:h, 0:w]
+    r = np.hypot(u - cx, v - cy).astype(np.int64)
+    inside = r <= int(r_out) + 2
+    prof = np.bincount(r[inside], weights=spread[inside], minlength=int(r_out) + 3)
+    cnt = np.bincount(r[inside], minlength=int(r_out) + 3)
+    prof = np.where(cnt > 0, prof / np.maximum(cnt, 1), np.nan)
+    floor, peak = np.nanpercentile(prof, 10), np.nanmax(prof)
+    moving = np.flatnonzero(np.nan_to_num(prof) > floor + 0.2 * (peak - floor))
+    if moving.size == 0 or moving[-1] - moving[0] < 3:
+        return None
+    a, b = int(moving[0]), int(moving[-1])
+    pad = max(2, int(np.ceil(0.5 * ball_over_pitch_radius * b)))
+    a, b = max(a - pad, 0), b + pad
+    log.debug("%s: moving annulus at (%.1f, %.1f), %d..%d px", path, cx, cy, a, b)
+    return BearingLocation(centre=(cx, cy), outer_radius=r_out, band_inner=float(a), band_outer=float(b),
+                           contour_residual=rms, source="motion")

@@ -1,0 +1,517 @@
+"""Which blobs are the balls: exactly Z tracks chosen by their joint consistency (DESIGN §8.4).
+
+The bearing description fixes the ball count Z, the ball diameter D and the pitch circle d_m, and
+the operating conditions fix the inner-ring speed, hence the pure-rolling cage speed
+``omega_c = omega_i (1 - D/d_m) / 2``. The ball highlights share one light, so they all sit at the
+same offset from their ball centres: they travel one circle (the pitch circle, shifted by that
+offset), in a fixed cyclic order, at least one ball diameter apart (balls cannot overlap, and in a
+full-complement bearing they nearly touch), at close to the cage speed. Glints on the outer ring stand
+still; glints and marks on the inner ring turn at ``omega_i``, about 2.5 ``omega_c``; the bright
+wedges between neighbouring balls travel with the balls but on circles at the edges of the band.
+
+The stage runs once per video on a few bursts of consecutive frames spread over the clip:
+
+1. blob candidates in every burst frame (:func:`tracking.candidates.find_candidates`), linked into
+   tracklets;
+2. each tracklet's angular speed about the bearing centre: the plausible band for a ball's mean speed
+   is :data:`SPEED_BAND` times ``omega_c`` (0.6-1.1: slip up to 25 % plus the unloaded-zone slow-down,
+   and balls pushed ahead after impacts, pass; glints at 0 and at 2.5 ``omega_c`` do not); a
+   tracklet's speed over a few milliseconds gets the wider :data:`TRACKLET_BAND` (0.5-1.3), and the
+   tracked balls' mean speeds are checked against :data:`SPEED_BAND` after tracking;
+3. one common circle by RANSAC over the moving tracklets (Fischler & Bolles 1981), the hypotheses
+   with a full complement of balls ranked by their distance from the expected radius (the middle of
+   the ball band, or d_m/2 times px/mm when the scale is given);
+4. per burst, an exact-Z choice with every cyclic neighbour at least :data:`MIN_SPACING` contact
+   spacings apart that maximises the total tracklet weight: a dynamic programme over the cyclic
+   order (a global assignment, not per-blob thresholds), and the largest count the spacing allows.
+
+Every tracklet leaves with a status: selected, or rejected with its reason. A clip that shows a ball
+count other than Z, or whose chosen tracks fail the checks, raises :class:`SelectionError`, which
+carries that table so the QC can show what was found.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+import numpy.typing as npt
+import pandas as pd
+
+from cageless.errors import TrackingError
+from tracking.candidates import Tracklet, bin_mask, find_candidates, link_tracklets, response_map, response_noise
+from tracking.locate import fit_circle
+
+__all__ = ["SPEED_BAND", "MIN_SPACING", "BallRing", "Anchor", "Selection", "SelectionError", "select_balls",
+           "anchor_at", "cyclic_select"]
+
+log = logging.getLogger(__name__)
+
+#: Plausible ball speed over the cage speed, for a ball's mean over the clip (see the module docstring).
+SPEED_BAND = (0.6, 1.1)
+#: The same for one tracklet's speed over a burst of a few milliseconds, measured about the bearing
+#: centre before the ball circle is known: wider, because a ball speeds up and slows down by several
+#: per cent between impacts and a highlight offset of 5 % of the radius biases it by as much.
+TRACKLET_BAND = (0.5, 1.3)
+#: Below this share of the cage speed a tracklet is static; within this share of omega_i it turns with the ring.
+STATIC_BELOW = 0.3
+INNER_RING_TOL = 0.3
+#: Least centre-to-centre angle of two chosen tracks, in contact spacings 2 asin(D/d_m).
+MIN_SPACING = 0.85
+#: Radial tolerance about the ball circle, in ball diameters (highlight jitter, lens distortion).
+RADIAL_TOL = 0.05
+#: A tracklet must cover this share of its burst.
+MIN_COVER = 0.5
+
+
+class SelectionError(TrackingError):
+    """The balls could not be chosen: wrong count or failed consistency checks."""
+
+    def __init__(self, path: object, message: str, hint: str = "", table: pd.DataFrame | None = None,
+                 found: int | None = None, ring: BallRing | None = None) -> None:
+        super().__init__(path, message, hint)  # type: ignore[arg-type]
+        self.table, self.found, self.ring = table, found, ring
+
+
+@dataclass(frozen=True)
+class BallRing:
+    """The circle the highlights travel and how to find them (cropped-image pixels)."""
+
+    centre: tuple[float, float]
+    radius: float
+    direction: int  # +1: counter-clockwise in the image
+    omega: float  # median speed of the chosen tracks (rad/s, >0)
+    ball_px: float
+    sigma_px: float
+    radial_tol_px: float
+    response_sigma: float
+    k_sigma: float
+    z: int
+    gap: float  # least angle between chosen neighbours (rad)
+    omega_c: float  # pure-rolling cage speed (rad/s)
+    omega_i: float  # inner-ring speed (rad/s)
+
+
+@dataclass(frozen=True)
+class Anchor:
+    """Z chosen highlights in one frame, in cyclic (counter-clockwise) order, with their image speeds."""
+
+    frame: int
+    u: npt.NDArray[np.float64]
+    v: npt.NDArray[np.float64]
+    omega: npt.NDArray[np.float64]  # image-frame angular speed (rad/s, signed)
+
+
+@dataclass
+class Selection:
+    """The outcome: the ring, anchors for the per-frame tracker, and every tracklet with its status."""
+
+    ring: BallRing
+    anchors: list[Anchor]
+    table: pd.DataFrame
+    counts: list[int] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class _Context:
+    z: int
+    gap: float  # least angle between chosen neighbours (rad)
+    omega_c: float
+    omega_i: float
+    ball_px: float
+    r_prior: float
+    centre0: tuple[float, float]
+    sigma_px: float
+    k_sigma: float
+    prior_known: bool = True  # False: r_prior is only a scale guess; the circle is chosen by support
+
+
+def _burst_plan(n: int, times: np.ndarray, omega_c: float, n_bursts: int) -> list[tuple[int, int]]:
+    """Bursts of consecutive frames spread over the clip, each long enough for 0.2 rad of cage travel."""
+    dt = float(np.median(np.diff(times))) if n > 1 else 1e-4
+    length = int(np.clip(math.ceil(0.2 / max(omega_c * dt, 1e-9)), 24, 60))
+    length = min(length, n)
+    starts = np.unique(np.linspace(0, n - length, max(1, min(n_bursts, n // length))).astype(int))
+    return [(int(a), int(a + length)) for a in starts]
+
+
+def _features(t: Tracklet, times: np.ndarray, centre: tuple[float, float]) -> dict[str, float]:
+    f, u, v = t.arrays()
+    th = np.unwrap(np.arctan2(-(v - centre[1]), u - centre[0]))
+    tt = times[f]
+    omega = float(np.polyfit(tt - tt.mean(), th, 1)[0]) if f.size >= 3 else 0.0
+    mid = f.size // 2
+    return {"u": float(u[mid]), "v": float(v[mid]), "frame": int(f[mid]), "omega": omega,
+            "radius": float(np.mean(np.hypot(u - centre[0], v - centre[1]))), "n": int(f.size),
+            "response": float(np.median(t.response))}
+
+
+def _speed_reason(ratio: float, omega: float, ctx: _Context) -> str:
+    if abs(ratio) < STATIC_BELOW:
+        return "static"
+    if abs(abs(omega) - ctx.omega_i) <= INNER_RING_TOL * ctx.omega_i:
+        return "turns with the inner ring"
+    if not TRACKLET_BAND[0] <= abs(ratio) <= TRACKLET_BAND[1]:
+        return "wrong speed"
+    return ""
+
+
+def cyclic_select(angles: npt.ArrayLike, weights: npt.ArrayLike, z: int, gap: float
+                  ) -> tuple[npt.NDArray[np.int64] | None, int]:
+    """Choose ``z`` points on a circle, cyclic neighbours at least ``gap`` rad apart, of greatest total weight.
+
+    A dynamic programme over the cyclic order: for each choice of first point, the best total of k
+    points ending at point j is its weight plus the best total of k-1 points ending at least ``gap``
+    before it (a prefix maximum), and the last point must end ``gap`` before the first point comes round
+    again. O(n^2 z) for n points.
+
+    Returns
+    -------
+    chosen, max_count
+        Indices of the chosen points (or None when ``z`` do not fit), and the most points the spacing allows.
+    """
+    a = np.mod(np.asarray(angles, dtype=np.float64), 2 * math.pi)
+    w = np.asarray(weights, dtype=np.float64)
+    n = a.size
+    if n == 0:
+        return None, 0
+    order = np.argsort(a, kind="stable")
+    a, w = a[order], w[order]
+    best_val, best_pick, max_count = -np.inf, None, 0
+    two_pi = 2 * math.pi
+    for s in range(n):
+        idx = (np.arange(n) + s) % n
+        rel = a[idx] + two_pi * ((np.arange(n) + s) >= n) - a[s]
+        ww = w[idx]
+        allowed = rel <= two_pi - gap + 1e-12
+        allowed[1:] &= rel[1:] >= gap - 1e-12
+        max_count = max(max_count, _greedy_count(rel, gap))
+        last = np.searchsorted(rel, rel - gap + 1e-12, side="right") - 1
+        dp = np.full(n, -np.inf)
+        dp[0] = ww[0]
+        back = []
+        for _ in range(1, z):
+            pm = np.maximum.accumulate(dp)
+            arg = _prefix_argmax(dp)
+            src = np.where(last >= 0, last, 0)
+            new = np.where((last >= 0) & allowed, pm[src] + ww, -np.inf)
+            new[0] = -np.inf
+            back.append(arg[src])
+            dp = new
+        j = int(np.argmax(dp))
+        if np.isfinite(dp[j]) and dp[j] > best_val:
+            pick = [j]
+            for b in reversed(back):
+                j = int(b[j])
+                pick.append(j)
+            best_val, best_pick = float(dp[pick[0]]), order[idx[np.array(pick[::-1])]]
+    return best_pick, max_count
+
+
+def _prefix_argmax(x: np.ndarray) -> np.ndarray:
+    out = np.zeros(x.size, dtype=np.int64)
+    best = 0
+    for i in range(x.size):
+        if x[i] > x[best]:
+            best = i
+        out[i] = best
+    return out
+
+
+def _greedy_count(rel: np.ndarray, gap: float) -> int:
+    """Most points (starting with point 0) at least ``gap`` apart, the last ``gap`` before 2 pi."""
+    count, last = 1, 0.0
+    for r in rel[1:]:
+        if r - last >= gap - 1e-12 and r <= 2 * math.pi - gap + 1e-12:
+            count, last = count + 1, r
+    return count
+
+
+def _burst_tracklets(frames: Callable[[int], np.ndarray], span: tuple[int, int], background: np.ndarray,
+                     mask: np.ndarray, ctx: _Context, times: np.ndarray, noise: float | None
+                     ) -> tuple[list[Tracklet], float]:
+    a, b = span
+    cands = []
+    for i in range(a, b):
+        frame = frames(i)
+        if noise is None:
+            resp, f = response_map(frame, background, ctx.sigma_px)
+            noise = response_noise(resp, bin_mask(mask, f))
+        cands.append(find_candidates(frame, background, mask, ctx.sigma_px, ctx.k_sigma, 12 * ctx.z + 32, noise))
+    dt = float(np.median(np.diff(times[a:b]))) if b - a > 1 else 1e-4
+    r_max = ctx.r_prior + ctx.ball_px
+    gate = max(3.0, 1.3 * ctx.omega_i * r_max * dt + 2.0)
+    tracks = link_tracklets(cands, gate, max_misses=6)
+    for t in tracks:
+        t.frames = [f + a for f in t.frames]
+    return tracks, float(noise)
+
+
+def _ransac_circle(pts: np.ndarray, burst: np.ndarray, weight: np.ndarray, ctx: _Context, tol: float,
+                   seed: int = 0) -> tuple[float, float, float] | None:
+    """Circle hypotheses through random triples; among those holding (nearly) a full ring of balls in
+    the most bursts, the one closest to the expected radius (or, when the radius is not known, the one
+    whose members are the strongest blobs)."""
+    n = len(pts)
+    if n < 3:
+        return None
+    rng = np.random.default_rng(seed)
+    n_b = int(burst.max()) + 1
+    hyps = []
+    for _ in range(min(600, n * (n - 1) * (n - 2) // 6 * 2)):
+        i, j, k = rng.choice(n, 3, replace=False)
+        c = _circle3(pts[i], pts[j], pts[k])
+        if c is None:
+            continue
+        cx, cy, r = c
+        if math.hypot(cx - ctx.centre0[0], cy - ctx.centre0[1]) > 0.5 * ctx.ball_px:
+            continue
+        if not 0.6 * ctx.r_prior <= r <= 1.4 * ctx.r_prior:
+            continue
+        res = np.abs(np.hypot(pts[:, 0] - cx, pts[:, 1] - cy) - r)
+        inl = res <= tol
+        score = sum(min(int(np.sum(inl & (burst == b))), ctx.z) for b in range(n_b))
+        hyps.append((score, abs(r - ctx.r_prior) if ctx.prior_known else -float(np.sum(weight[inl])), cx, cy, r))
+    if not hyps:
+        return None
+    top = max(h[0] for h in hyps)
+    full = [h for h in hyps if h[0] >= 0.8 * top]
+    _, _, cx, cy, r = min(full, key=lambda h: (h[1], -h[0]))
+    return cx, cy, r
+
+
+def _circle3(p: np.ndarray, q: np.ndarray, s: np.ndarray) -> tuple[float, float, float] | None:
+    ax, ay = p
+    bx, by = q
+    cx, cy = s
+    d = 2 * (ax * (by - cy) + bx * (cy - ay) + cx * (ay - by))
+    if abs(d) < 1e-9:
+        return None
+    ux = ((ax**2 + ay**2) * (by - cy) + (bx**2 + by**2) * (cy - ay) + (cx**2 + cy**2) * (ay - by)) / d
+    uy = ((ax**2 + ay**2) * (cx - bx) + (bx**2 + by**2) * (ax - cx) + (cx**2 + cy**2) * (bx - ax)) / d
+    return float(ux), float(uy), float(math.hypot(ax - ux, ay - uy))
+
+
+def _refit(tracks: list[Tracklet], idx: np.ndarray, circle: tuple[float, float, float], tol: float
+           ) -> tuple[float, float, float]:
+    """Least-squares circle through every sample of the tracklets within ``tol`` of ``circle``."""
+    cx, cy, r = circle
+    us, vs = [], []
+    for k in idx:
+        _, u, v = tracks[k].arrays()
+        keep = np.abs(np.hypot(u - cx, v - cy) - r) <= tol
+        us.append(u[keep])
+        vs.append(v[keep])
+    u, v = np.concatenate(us), np.concatenate(vs)
+    if u.size < 3:
+        return circle
+    fx, fy, fr, _ = fit_circle(u, v)
+    return fx, fy, fr
+
+
+def _classify(feats: list[dict[str, float]], tracks: list[Tracklet], spans: list[tuple[int, int]],
+              burst: np.ndarray, ctx: _Context, direction: int | None) -> tuple[list[str], int]:
+    """A rejection reason per tracklet ('' for a mover) from its coverage and speed; the image direction."""
+    reasons = []
+    for f, b in zip(feats, burst, strict=True):
+        a, e = spans[b]
+        if f["n"] < MIN_COVER * (e - a):
+            reasons.append("too short")
+        else:
+            reasons.append(_speed_reason(f["omega"] / ctx.omega_c, f["omega"], ctx))
+    if direction is None:
+        moving = [f["omega"] for f, r in zip(feats, reasons, strict=True) if not r]
+        direction = 1 if not moving or np.median(moving) >= 0 else -1
+    for k, f in enumerate(feats):
+        if not reasons[k] and np.sign(f["omega"]) != direction:
+            reasons[k] = "wrong direction"
+    return reasons, direction
+
+
+def _choose_bursts(tracks: list[Tracklet], feats: list[dict[str, float]], reasons: list[str], burst: np.ndarray,
+                   spans: list[tuple[int, int]], times: np.ndarray, circle: tuple[float, float, float], tol: float,
+                   ctx: _Context) -> tuple[list[Anchor | None], list[int]]:
+    """Per burst: the exact-Z choice on the circle (an anchor) and the largest count the spacing allows."""
+    cx, cy, r = circle
+    anchors: list[Anchor | None] = []
+    counts = []
+    for b, (a, e) in enumerate(spans):
+        idx = []
+        for k in np.flatnonzero(burst == b):
+            _, u, v = tracks[k].arrays()
+            if reasons[k]:
+                continue
+            if np.mean(np.abs(np.hypot(u - cx, v - cy) - r)) > tol:
+                reasons[k] = "off the ball circle"
+                continue
+            idx.append(int(k))
+        t_ref = float(times[(a + e - 1) // 2])
+        fits = [_angle_fit(tracks[k], times, (cx, cy)) for k in idx]
+        ang = np.array([th0 + om * (t_ref - tm) for th0, om, tm in fits])
+        weight = np.array([feats[k]["n"] / (e - a) * math.log1p(feats[k]["response"]) for k in idx])
+        pick, count = cyclic_select(ang, weight, ctx.z, ctx.gap) if idx else (None, 0)
+        counts.append(count)
+        chosen = set() if pick is None else {idx[p] for p in pick}
+        for k in idx:
+            reasons[k] = "selected" if chosen and k in chosen else "breaks spacing"
+        if pick is None:
+            anchors.append(None)
+            continue
+        sel = [idx[p] for p in pick]
+        anchors.append(_anchor(tracks, sel, [fits[p] for p in pick], times, (cx, cy), r, a, e))
+    return anchors, counts
+
+
+def _angle_fit(t: Tracklet, times: np.ndarray, centre: tuple[float, float]) -> tuple[float, float, float]:
+    """(angle at the mean time, angular speed, mean time) of a tracklet about ``centre``."""
+    f, u, v = t.arrays()
+    th = np.unwrap(np.arctan2(-(v - centre[1]), u - centre[0]))
+    tt = times[f]
+    tm = float(tt.mean())
+    if f.size < 3:
+        return float(th.mean()), 0.0, tm
+    slope, icpt = np.polyfit(tt - tm, th, 1)
+    return float(icpt), float(slope), tm
+
+
+def _anchor(tracks: list[Tracklet], sel: list[int], fits: list[tuple[float, float, float]], times: np.ndarray,
+            centre: tuple[float, float], r: float, a: int, e: int) -> Anchor:
+    """The first burst frame where every chosen tracklet was seen (else the middle frame, filling the
+    missing ones from their angle fits)."""
+    present = [set(tracks[k].frames) for k in sel]
+    common = sorted(set.intersection(*present)) if present else []
+    frame = common[0] if common else (a + e - 1) // 2
+    u = np.empty(len(sel))
+    v = np.empty(len(sel))
+    for j, k in enumerate(sel):
+        t = tracks[k]
+        if frame in present[j]:
+            i = t.frames.index(frame)
+            u[j], v[j] = t.u[i], t.v[i]
+        else:
+            th0, om, tm = fits[j]
+            th = th0 + om * (float(times[frame]) - tm)
+            u[j], v[j] = centre[0] + r * math.cos(th), centre[1] - r * math.sin(th)
+    omega = np.array([f[1] for f in fits])
+    order = np.argsort(np.arctan2(-(v - centre[1]), u - centre[0]))
+    return Anchor(frame=int(frame), u=u[order], v=v[order], omega=omega[order])
+
+
+def _table(feats: list[dict[str, float]], reasons: list[str], burst: np.ndarray, ctx: _Context,
+           direction: int) -> pd.DataFrame:
+    rows = [{"burst": int(b), "frame": f["frame"], "u_px": f["u"], "v_px": f["v"], "radius_px": f["radius"],
+             "speed_ratio": direction * f["omega"] / ctx.omega_c, "frames_seen": f["n"],
+             "response": f["response"], "status": "selected" if r == "selected" else "rejected",
+             "reason": "" if r == "selected" else (r or "not chosen")}
+            for f, r, b in zip(feats, reasons, burst, strict=True)]
+    cols = ["burst", "frame", "u_px", "v_px", "radius_px", "speed_ratio", "frames_seen", "response", "status",
+            "reason"]
+    return pd.DataFrame(rows, columns=cols)
+
+
+def _context(z: int, ball_diameter_m: float, pitch_diameter_m: float, omega_i: float,
+             centre0: tuple[float, float], r_prior: float, k_sigma: float,
+             sigma_px: float | None = None, prior_known: bool = True) -> _Context:
+    ratio = ball_diameter_m / pitch_diameter_m
+    ball_px = 2.0 * ratio * r_prior
+    return _Context(z=z, gap=MIN_SPACING * 2 * math.asin(min(ratio, 1.0)), omega_c=0.5 * omega_i * (1 - ratio),
+                    omega_i=omega_i, ball_px=ball_px, r_prior=r_prior, centre0=centre0,
+                    sigma_px=sigma_px or max(1.0, 0.05 * ball_px), k_sigma=k_sigma, prior_known=prior_known)
+
+
+def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, background: np.ndarray,
+                 mask: np.ndarray, *, z: int, ball_diameter_m: float, pitch_diameter_m: float, omega_i: float,
+                 centre0: tuple[float, float], r_prior: float, path: object = "video", n_bursts: int = 6,
+                 k_sigma: float = 4.0, prior_known: bool = True) -> Selection:
+    """Choose exactly ``z`` ball tracks from bursts spread over the clip (see the module docstring).
+
+    Parameters
+    ----------
+    frames
+        ``frames(i)`` returns frame i cropped like ``background`` and ``mask`` (the ball band).
+    times
+        Frame times (s).
+    z, ball_diameter_m, pitch_diameter_m
+        The bearing (``z`` may be a user-stated count).
+    omega_i
+        Inner-ring speed (rad/s).
+    centre0, r_prior
+        Bearing centre and the expected radius of the highlight circle (px, cropped image).
+    prior_known
+        False when ``r_prior`` is only a rough scale (then the circle is chosen by its support).
+
+    Raises
+    ------
+    SelectionError
+        When the clip shows a count other than ``z``, or the chosen tracks fail the checks.
+    """
+    ctx = _context(z, ball_diameter_m, pitch_diameter_m, omega_i, centre0, r_prior, k_sigma,
+                   prior_known=prior_known)
+    spans = _burst_plan(len(times), times, ctx.omega_c, n_bursts)
+    tracks: list[Tracklet] = []
+    burst: list[int] = []
+    noise = None
+    for b, span in enumerate(spans):
+        tr, noise = _burst_tracklets(frames, span, background, mask, ctx, times, noise)
+        tracks += tr
+        burst += [b] * len(tr)
+    burst_arr = np.asarray(burst, dtype=int)
+    feats = [_features(t, times, centre0) for t in tracks]
+    reasons, direction = _classify(feats, tracks, spans, burst_arr, ctx, None)
+    movers = np.array([k for k, r in enumerate(reasons) if not r], dtype=int)
+    tol = max(1.5, RADIAL_TOL * ctx.ball_px)
+    circle = None
+    if movers.size >= 3:
+        pts = np.array([[feats[k]["u"], feats[k]["v"]] for k in movers])
+        wts = np.array([math.log1p(feats[k]["response"]) for k in movers])
+        circle = _ransac_circle(pts, burst_arr[movers], wts, ctx, tol)
+    ring_args = dict(ball_px=ctx.ball_px, sigma_px=ctx.sigma_px, radial_tol_px=tol, response_sigma=float(noise or 1),
+                     k_sigma=k_sigma, z=z, gap=ctx.gap, omega_c=ctx.omega_c, omega_i=omega_i)
+    if circle is None:
+        table = _table(feats, reasons, burst_arr, ctx, direction)
+        raise SelectionError(path, f"no {z} highlights moving together along one circle near the cage speed were "
+                             "found (0 balls found).", "Check the lighting, the speed_rpm and the bearing "
+                             "description; the QC image shows every candidate and why it was rejected.",
+                             table=table, found=0)
+    inl = np.array([k for k in movers if np.mean(np.abs(np.hypot(tracks[k].arrays()[1] - circle[0],
+                                                                    tracks[k].arrays()[2] - circle[1]) - circle[2]))
+                    <= 2 * tol], dtype=int)
+    circle = _refit(tracks, inl, circle, 2 * tol) if inl.size else circle
+    feats = [_features(t, times, (circle[0], circle[1])) for t in tracks]
+    anchors, counts = _choose_bursts(tracks, feats, reasons, burst_arr, spans, times, circle, tol, ctx)
+    table = _table(feats, reasons, burst_arr, ctx, direction)
+    sel_speed = table.loc[table.status == "selected", "speed_ratio"]
+    ring = BallRing(centre=(circle[0], circle[1]), radius=circle[2], direction=direction,
+                    omega=float(np.median(sel_speed) * ctx.omega_c) if len(sel_speed) else ctx.omega_c, **ring_args)
+    found = int(np.median(counts)) if counts else 0
+    good = [a for a in anchors if a is not None]
+    log.info("%s: ball circle r = %.1f px, counts per burst %s, %d of %d bursts with %d balls", path, circle[2],
+             counts, len(good), len(spans), z)
+    if found != z:
+        raise SelectionError(path, f"found {found} balls moving together along one circle, but the bearing has {z}.",
+                             f"Check the bearing's ball count, or state the count with --n-balls {found}; the "
+                             "QC image shows what was found.", table=table, found=found, ring=ring)
+    if len(good) < 0.5 * len(spans):
+        raise SelectionError(path, f"{z} consistent balls were found in only {len(good)} of {len(spans)} sampled "
+                             "stretches of the clip.", "Check the lighting and focus; the QC image shows what "
+                             "was found.", table=table, found=found, ring=ring)
+    return Selection(ring=ring, anchors=good, table=table, counts=counts)
+
+
+def anchor_at(frames: Callable[[int], np.ndarray], times: np.ndarray, background: np.ndarray, mask: np.ndarray,
+              ring: BallRing, start: int = 0) -> Anchor | None:
+    """An anchor from one burst at ``start`` on a known ring (for a segment without one); None if not found."""
+    ctx = _Context(z=ring.z, gap=ring.gap, omega_c=ring.omega_c, omega_i=ring.omega_i, ball_px=ring.ball_px,
+                   r_prior=ring.radius, centre0=ring.centre, sigma_px=ring.sigma_px, k_sigma=ring.k_sigma)
+    span = _burst_plan(len(times) - start, times[start:], ctx.omega_c, 1)[0]
+    span = (span[0] + start, span[1] + start)
+    tracks, _ = _burst_tracklets(frames, span, background, mask, ctx, times, ring.response_sigma)
+    burst = np.zeros(len(tracks), dtype=int)
+    feats = [_features(t, times, ring.centre) for t in tracks]
+    reasons, _ = _classify(feats, tracks, [span], burst, ctx, ring.direction)
+    anchors, _ = _choose_bursts(tracks, feats, reasons, burst, [span], times,
+                                (ring.centre[0], ring.centre[1], ring.radius), ring.radial_tol_px, ctx)
+    return anchors[0]
