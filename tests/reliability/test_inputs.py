@@ -43,13 +43,18 @@ def png30(tmp_path_factory) -> Path:
 # -- the weak messages made clear -------------------------------------------------------------------------
 
 def test_r16_stated_speed_is_checked_against_the_video(tmp_path, capsys, mini_lab):
-    """The 3000 r/min clip stated as 2500 r/min: QC warns (speed mismatch and negative slip), never silent."""
+    """The 3000 r/min clip stated as 2800 r/min: QC warns (speed mismatch and negative slip), never silent;
+    stated as 2500 r/min its balls orbit at 1.17 x the cage speed, outside what a ball can do: refused."""
     lab = tmp_path / "lab"
     shutil.copytree(mini_lab, lab)
-    (lab / "clip_3000rpm.toml").write_text("speed_rpm = 2500\n")
+    (lab / "clip_3000rpm.toml").write_text("speed_rpm = 2800\n")
     run = cli(capsys, "track", lab, "-o", tmp_path / "o", "--workers", "1", "-q")
-    assert_clean(run, 0, "the stated speed 2500 r/min disagrees with the video", "check speed_rpm",
+    assert_clean(run, 0, "the stated speed 2800 r/min disagrees with the video", "check speed_rpm",
                  "negative slip")
+    (lab / "clip_3000rpm.toml").write_text("speed_rpm = 2500\n")
+    run = cli(capsys, "track", lab, "-o", tmp_path / "o3", "--workers", "1", "-q")
+    assert_clean(run, 1, "clip_3000rpm.mkv", "outside the plausible 0.6-1.1", "Check speed_rpm")
+    assert not list((tmp_path / "o3").glob("*.trace.h5"))
     # and at its true speed: no such warning (the synthetic law's loaded zone runs ~5 % fast; the limit is 8 %)
     (lab / "clip_3000rpm.toml").unlink()
     run = cli(capsys, "track", lab, "-o", tmp_path / "o2", "--workers", "1", "-q")
