@@ -141,10 +141,32 @@ def _settings(method: str, kw: dict[str, Any]) -> dict[str, Any]:
             "rtol": kw["rtol"] * RTOL_FACTOR.get(method, 1.0)}
 
 
+def _step_chunk(part: Problem, t: npt.NDArray[np.float64], current: str, kw: dict[str, Any],
+                session: CvodeSession | None) -> Solution:
+    """One chunk with the current method (CVODE kept warm across chunks: see simulation.solve.CvodeSession)."""
+    settings = _settings(current, kw)
+    if current == "CVODE":
+        return step_cvode(part, t, settings["rtol"], settings["max_step"], max_steps=settings["max_steps"],
+                          session=session)
+    return solve(part, t, method=current, **settings)
+
+
+def _go_back(stiff_rates: list[float], dp5_rate: float, time_s: float) -> dict[str, Any] | None:
+    """The way back to DP5, when the stiff backend now costs more per simulated second than DP5 did."""
+    # the first chunk after the switch holds the integrator's cold start, paid once: not judged;
+    # then the mean of the last BACK_WINDOW chunks, so that one burst of contacts does not decide
+    recent = stiff_rates[1:][-BACK_WINDOW:]
+    if len(recent) == BACK_WINDOW and np.mean(recent) > dp5_rate:
+        # the probe's chunk was not representative: go back to DP5 for good
+        return {"time_s": time_s, "switch": True, "to": "dp5", "cost_ratio": float(np.mean(recent)) / dp5_rate,
+                "stiff_fraction": None, "wall_s": 0.0}
+    return None
+
+
 def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: str, max_step: float | None,
                  chunks: int, progress: bool, max_steps: int, force_jump: float) -> Solution:
     """Integrate ``pr`` over the samples ``t`` in about ``chunks`` pieces; ``method`` is a key of
-    :data:`simulation.solve.METHODS` or ``"auto"`` (see the module text). ``max_step`` None gives each
+    :data:`simulation.solve.METHODS` (``"auto"``: see the module text). ``max_step`` None gives each
     method its default cap (:func:`default_max_step`), also after a switch; a number applies to all.
     ``rtol`` is scaled per method by :data:`RTOL_FACTOR`."""
     edges = np.unique(np.linspace(0, len(t) - 1, chunks + 1).astype(int))
@@ -153,7 +175,7 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
                             "n_force_jump_retries", "n_stiff_steps"), 0)
     wall = 0.0
     y0, log, t0 = pr.y0.copy(), pr.log.copy(), float(t[0])
-    current = "dp5" if method == "auto" else method
+    auto, current = method == "auto", "dp5" if method == "auto" else method
     probes: list[dict[str, Any]] = []
     dp5_rate, switched_back = np.inf, False
     stiff_rates: list[float] = []  # cost per simulated second of each stiff chunk since the switch
@@ -164,13 +186,8 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
             part = replace(pr, log=log, y0=y0, t0=t0)
             kw = {"rtol": rtol, "max_step": max_step, "force_jump": force_jump,
                   "max_steps": max(1, max_steps - totals["n_steps"] - totals["n_rejected"])}
-            settings = _settings(current, kw)
-            if current == "CVODE":  # kept warm across chunks (see simulation.solve.CvodeSession)
-                sol = step_cvode(part, t[a + 1:b + 1], settings["rtol"], settings["max_step"],
-                                 max_steps=settings["max_steps"], session=session)
-                session = sol.extra["cvode"]
-            else:
-                sol = solve(part, t[a + 1:b + 1], method=current, **settings)
+            sol = _step_chunk(part, t[a + 1:b + 1], current, kw, session)
+            session = sol.extra.get("cvode", session) if current == "CVODE" else session
             ys.append(sol.y)
             for key in totals:
                 totals[key] += getattr(sol, key)
@@ -178,27 +195,27 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
             bar.update(float(t[b] - t[a]))
             if not sol.success:
                 break
-            span = float(t[b] - t[a])
-            rate = _cost(sol, pr.model_id) / span
-            if current == STIFF_METHOD and method == "auto":
+            rate = _cost(sol, pr.model_id) / float(t[b] - t[a])
+            if current == STIFF_METHOD and auto:
                 stiff_rates.append(rate)
-            # the first chunk after the switch holds the integrator's cold start, paid once: not judged;
-            # then the mean of the last BACK_WINDOW chunks, so that one burst of contacts does not decide
-            recent = stiff_rates[1:][-BACK_WINDOW:]
-            if current == STIFF_METHOD and len(recent) == BACK_WINDOW and np.mean(recent) > dp5_rate:
-                # the probe's chunk was not representative: the stiff backend now costs more per simulated
-                # second than DP5 did there, so go back to DP5 for good
-                probes.append({"time_s": float(t[b]), "switch": True, "to": "dp5",
-                               "cost_ratio": float(np.mean(recent)) / dp5_rate, "stiff_fraction": None,
-                               "wall_s": 0.0})
+            back = _go_back(stiff_rates, dp5_rate, float(t[b])) if current == STIFF_METHOD else None
+            if back is not None:
+                probes.append(back)
                 current, switched_back = "dp5", True
-            elif (method == "auto" and current == "dp5" and not switched_back and i in PROBE_CHUNKS
+            elif (auto and current == "dp5" and not switched_back and i in PROBE_CHUNKS
                     and sol.n_stiff_steps >= STIFF_FRACTION * max(sol.n_steps, 1) and _may_switch(pr)):
                 probes.append(_probe(part, t[a + 1:b + 1], sol, float(t[b]), kw))
                 wall += probes[-1]["wall_s"]
                 if probes[-1]["switch"]:
                     current, dp5_rate = STIFF_METHOD, rate
             y0, log, t0 = sol.y[-1].copy(), sol.extra.get("log", log), float(t[b])
+    return _joined(t, ys, sol, method, probes, wall, log, totals)
+
+
+def _joined(t: npt.NDArray[np.float64], ys: list[npt.NDArray[np.float64]], sol: Solution | None, method: str,
+            probes: list[dict[str, Any]], wall: float, log: npt.NDArray[np.float64],
+            totals: dict[str, int]) -> Solution:
+    """The chunks' samples and statistics as one solution (NaN after a failure)."""
     y = np.concatenate(ys)
     if len(y) < len(t):
         y = np.vstack([y, np.full((len(t) - len(y), y.shape[1]), np.nan)])
