@@ -1,6 +1,6 @@
 """cageless: track, simulate and compare the balls of cageless ball bearings.
 
-The shared core holds the vocabulary every package uses (DESIGN §2):
+The shared core holds the vocabulary every package uses:
 
 * :mod:`cageless.bearing` and :mod:`cageless.parameter_sets`: the bearing, in SI units;
 * :mod:`cageless.kinematics`: pure-rolling speeds, slip rate, characteristic frequencies;

@@ -1,4 +1,4 @@
-"""Ball numbering and angle conventions shared by tracking, rendering and simulation (DESIGN §3).
+"""Ball numbering and angle conventions shared by tracking, rendering and simulation.
 
 Balls are numbered 0..Z-1 counter-clockwise; ball 0 is the ball just after the
 largest gap at the start. Unwrapped angles start with ball 0 in [0, 2 pi) and
@@ -14,7 +14,7 @@ __all__ = ["ball_order", "normalise_unwrapped"]
 
 
 def ball_order(first_angles: npt.ArrayLike) -> npt.NDArray[np.int64]:
-    """Column order that numbers balls by DESIGN §3, from their angles (rad) at the start.
+    """Column order that numbers balls counter-clockwise from the ball after the largest gap, from their angles (rad) at the start.
 
     ``order[k]`` is the column that becomes ball k: counter-clockwise, starting with the ball just
     after the largest gap.

@@ -5,7 +5,7 @@ an impossible bearing cannot exist as an object. Every error names the field
 and the rule it broke (:class:`~cageless.errors.GeometryError`,
 :class:`~cageless.errors.ParameterError`).
 
-The default bearing is the paper's (Wang et al. 2026, Table 1; DESIGN §6),
+The default bearing is the paper's (Wang et al. 2026, Table 1),
 defined in :mod:`cageless.parameter_sets.wang2026`.
 """
 

@@ -1,4 +1,4 @@
-"""Operating conditions of a video and where they come from (DESIGN §5).
+"""Operating conditions of a video and where they come from.
 
 A video's conditions are merged key by key from three sources, highest
 precedence first:
@@ -79,7 +79,7 @@ class OperatingConditions:
     speed_rpm
         Inner-ring speed (rpm), finite and > 0.
     radial_load_n
-        Radial load on the inner ring (N), >= 0; it acts toward -z (DESIGN §3).
+        Radial load on the inner ring (N), >= 0; it acts toward -z.
     axial_load_n
         Axial load (N), >= 0.
     fps

@@ -3,7 +3,7 @@
 Every error says *what* is wrong (the parameter, field or file), *which rule*
 was broken and, where possible, *how to fix it*. The CLI maps
 :class:`UsageError` to exit code 2 and every other :class:`CagelessError` to
-exit code 1 (DESIGN §2).
+exit code 1.
 """
 
 from __future__ import annotations

@@ -11,7 +11,7 @@ Kotzalas, *Rolling Bearing Analysis*, 5th ed., vol. 1 (2006), ch. 8
   BSF = f_i (d_m / 2D)(1 - gamma^2).
 
 The theoretical cage speed is the reference of the slip rate
-``s = 1 - theta_dot / omega_c`` (DESIGN §3).
+``s = 1 - theta_dot / omega_c``.
 """
 
 from __future__ import annotations
@@ -169,7 +169,7 @@ def theoretical_cage_speed(
 ) -> float:
     """Pure-rolling cage speed omega_c = omega_i (1 - D cos(alpha)/d_m) / 2 (rad/s).
 
-    This is the reference speed of the slip rate (DESIGN §3).
+    This is the reference speed of the slip rate.
     """
     _check_speed("inner_speed_rad_s", inner_speed_rad_s)
     return kinematic_ratios(geometry, contact_angle_rad).cage_ratio * inner_speed_rad_s
@@ -178,7 +178,7 @@ def theoretical_cage_speed(
 def slip_rate(
     orbital_speed_rad_s: npt.ArrayLike, cage_speed_rad_s: float
 ) -> npt.NDArray[np.float64]:
-    """Slip rate s = 1 - theta_dot / omega_c (DESIGN §3).
+    """Slip rate s = 1 - theta_dot / omega_c.
 
     Parameters
     ----------
@@ -203,7 +203,7 @@ def rereference_slip(slip: npt.ArrayLike, ball_diameter_m: float, pitch_diameter
                      from_angle_rad: float, to_angle_rad: float) -> npt.NDArray[np.float64]:
     """Slip rates referred to the cage speed of another contact angle.
 
-    A slip rate s = 1 - theta_dot / omega_c(alpha) depends on alpha through omega_c (DESIGN §3); with
+    A slip rate s = 1 - theta_dot / omega_c(alpha) depends on alpha through omega_c; with
     gamma = D / d_m, omega_c(a) / omega_c(b) = (1 - gamma cos a) / (1 - gamma cos b), so the same orbital
     speeds give 1 - (1 - s) omega_c(from) / omega_c(to).
     """
@@ -221,7 +221,7 @@ def centrifugal_force(masses: Masses, geometry: Geometry, cage_speed_rad_s: floa
 
 
 
-#: Cage revolutions a simulation takes to forget its packed start (DESIGN §6 "Start").
+#: Cage revolutions a simulation takes to forget its packed start.
 STARTUP_REVOLUTIONS = 3.0
 
 

@@ -1,4 +1,4 @@
-"""The lab-folder workflow behind ``cageless report LAB -o OUT`` (DESIGN §1, §5, §9, §10).
+"""The lab-folder workflow behind ``cageless report LAB -o OUT``.
 
 1. Discover the videos and their conditions.
 2. Track each video (``OUT/traces/<video>.trace.h5`` and ``OUT/traces/qc/``).
@@ -257,7 +257,7 @@ def _run_lab(folder: str | Path, out: Path, options: LabOptions | None, bearing:
     entries = [plausible_entry(e, options.force) for e in discover_lab(folder)]
     if not entries:
         raise CagelessError(f"{folder}: no videos found. A lab folder holds videos (cine, avi/mp4/mkv or image "
-                            "folders) with their conditions (DESIGN §5).")
+                            "folders) with their conditions.")
     failed: list[ComparisonRow] = [_failed_row(e.video.name, None, str(e.error)) for e in entries if not e.ok]
     good = [e for e in entries if e.ok]
     with job_pool(options.workers, options.scheduler) as pool:

@@ -1,7 +1,7 @@
 """Where independent jobs run: local spawned processes on both cores, or an existing Dask cluster.
 
 Both executors offer ``submit(fn, *args)`` returning a future with ``result()``, so callers do not
-care which one they got (DESIGN §10: nothing home-made stands in for a scheduler). Local workers are
+care which one they got (nothing home-made stands in for a scheduler). Local workers are
 spawned, not forked: numba's thread pool does not survive a fork.
 """
 

@@ -1,6 +1,6 @@
 """Profiles against orbital angle: the mean and spread of a per-ball quantity per angle bin.
 
-Used for slip and revolution-speed profiles (DESIGN §8.6, §9): every sample of
+Used for slip and revolution-speed profiles: every sample of
 every ball and revolution falls into the bin of its orbital angle (mod 360 deg),
 and each bin gets the mean, standard deviation and count.
 """

@@ -1,4 +1,4 @@
-"""Trace files: the ``cageless-trace/1`` HDF5 format of DESIGN §4.
+"""Trace files: the ``cageless-trace/1`` HDF5 trace format.
 
 A trace carries per-ball orbital angle, revolution speed, slip and a validity
 mask over time, plus the conditions and the bearing it belongs to. Video
@@ -70,7 +70,7 @@ FloatArray = npt.NDArray[np.float64]
 
 @dataclass(frozen=True)
 class VideoInfo:
-    """Root attributes that only video traces carry (DESIGN §4).
+    """Root attributes that only video traces carry.
 
     The input video's identity is ``input_hash`` (hex) by ``input_hash_algorithm`` (``"sha256"`` or
     ``"blake3"``). ``input_sha256`` is kept for traces that name SHA-256: it equals ``input_hash``
@@ -102,7 +102,7 @@ class VideoInfo:
 
 @dataclass(frozen=True)
 class SimulationInfo:
-    """Root attributes that only simulation traces carry (DESIGN §4)."""
+    """Root attributes that only simulation traces carry."""
 
     scene_json: str
     effects_json: str

@@ -1,6 +1,6 @@
 """Unit conversions used at the user-facing boundary.
 
-Inside the code everything is SI (DESIGN §3); these helpers convert the
+Inside the code everything is SI; these helpers convert the
 user-facing units (rpm, mm, degrees) exactly once, at the boundary.
 """
 

@@ -1,4 +1,4 @@
-"""Align a measured (video) and a simulated trace (DESIGN §9).
+"""Align a measured (video) and a simulated trace.
 
 Both traces become profiles against orbital angle: slip rate and revolution
 speed per angle bin (1 deg by default), over all balls and per ball, each with

@@ -78,7 +78,7 @@ def compare(measured: Trace, simulated: Trace, bin_deg: float = 1.0, settle_s: f
 
 
 def slip_contact_angle(trace: Trace) -> float:
-    """The contact angle alpha (rad) a trace's slip rates are referred to (DESIGN §3): a simulation stores the
+    """The contact angle alpha (rad) a trace's slip rates are referred to: a simulation stores the
     nominal angle it used (``nominal_contact_angle_rad``), a video trace ``slip_contact_angle_rad``; 0 if
     neither is recorded."""
     for key in ("nominal_contact_angle_rad", "slip_contact_angle_rad"):

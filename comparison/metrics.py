@@ -1,4 +1,4 @@
-"""Point-by-point errors between two aligned profiles, and the slip rate of a condition (DESIGN §9).
+"""Point-by-point errors between two aligned profiles, and the slip rate of a condition.
 
 All values are in percentage points of slip (the profiles hold slip as a fraction).
 """
@@ -15,10 +15,10 @@ from cageless.errors import CagelessError
 
 __all__ = ["ProfileErrors", "profile_errors", "unloaded_peak", "UNLOADED_ZONE_DEG", "SLIP_RATE_DEFINITION"]
 
-#: The unloaded zone: the upper half of the bearing, opposite the radial load (DESIGN §3).
+#: The unloaded zone: the upper half of the bearing, opposite the radial load.
 UNLOADED_ZONE_DEG = (0.0, 180.0)
 
-#: Printed under every table (DESIGN §9).
+#: Printed under every table.
 SLIP_RATE_DEFINITION = (
     "Slip rate s = 1 - (ball orbital speed) / (pure-rolling cage speed w_i (1 - D/d_m) / 2). The theoretical "
     "(simulated) and experimental (measured) slip rate of a condition is the peak of the mean slip profile "

@@ -1,4 +1,4 @@
-"""The Table-2-style table in CSV, Markdown, LaTeX and HTML (DESIGN §9).
+"""The Table-2-style table in CSV, Markdown, LaTeX and HTML.
 
 Failed conditions stay in the table as rows with their message, so a report
 never hides what did not run.

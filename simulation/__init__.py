@@ -1,4 +1,4 @@
-"""simulation: the nonlinear dynamics of a cageless ball bearing (DESIGN §6-§7).
+"""simulation: the nonlinear dynamics of a cageless ball bearing.
 
 The model lands with the simulator issues; this package imports only the
 shared core :mod:`cageless` and never ``tracking`` or ``comparison``.

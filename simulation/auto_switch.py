@@ -5,7 +5,7 @@ kept, internal steps not). With ``method="auto"`` it starts with the compiled DP
 stiffness test (:func:`simulation.integrators.dp5.dp5_integrate`, Hairer & Wanner's h |lambda| > 3.25).
 When most steps of a chunk sit at the stability edge (fraction >= :data:`STIFF_FRACTION`), the
 step is set by stiffness rather than accuracy, as the paper's "Adams-GSTIFF" scheme switches to its
-stiff branch once contacts stiffen (DESIGN §7). The driver then probes the stiff backend,
+stiff branch once contacts stiffen. The driver then probes the stiff backend,
 SUNDIALS CVODE's variable-order BDF (:data:`STIFF_METHOD`), on the same chunk from the same state, and
 switches for the rest of the run if its cost is clearly smaller. The probe's result is discarded, so
 the trajectory up to the switch is DP5's. Probes run only at the chunks in :data:`PROBE_CHUNKS` (10 %
@@ -99,7 +99,7 @@ MAX_STEP_S: dict[str, float] = {"CVODE": 5e-6}
 #: held by the cap, so the tighter rtol costs ~6 %). Planar, 20 kN: 1.1e-5 at 1e-6, 9e-7 at 1e-7.
 RTOL_FACTOR: dict[str, float] = {"CVODE": 0.03}
 #: Whether a dry scene (Coulomb-Stribeck friction, no lubricant) may switch. It may not: CVODE's energy
-#: balance there drifts above the 1e-5 of the input work that DESIGN §7 allows (20 ms from the packed start
+#: balance there drifts above the 1e-5 of the input work that the hard cases allow (20 ms from the packed start
 #: at 3000 rpm, spatial level, static 0.15 / Coulomb 0.1: 1.9e-5 with the structured Jacobian, 2.3e-5 with
 #: CVODE's own; DP5 3.4e-7), whatever its Jacobian, and only falls slowly with rtol (10 ms: 1.4e-5 at
 #: 3e-8, 3.8e-6 at 3e-10), while DP5 costs 1.3 times as much there (9.2 s against 7.2 s).

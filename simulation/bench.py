@@ -14,8 +14,8 @@ CVODE and scipy's steppers run one accepted step at a time (:func:`simulation.so
 :func:`simulation.solve.step_scipy`), so the contact bookkeeping after each accepted step is the same
 for every candidate.
 
-The ball ring is chaotic, so the window is kept at a few milliseconds (DESIGN
-§7). Error: the largest difference in slip over all balls and samples, in
+The ball ring is chaotic, so the window is kept at a few milliseconds (two
+correct runs part after that). Error: the largest difference in slip over all balls and samples, in
 percentage points, and the RMS ball-position difference along the orbit (um).
 Times are wall seconds per simulated second; the ratio column divides by the
 default (dp5, rtol 1e-6) measured in the same run, since absolute times on a

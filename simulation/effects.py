@@ -1,4 +1,4 @@
-"""The validated table of effects, and how a scene chooses among them (DESIGN §6).
+"""The validated table of effects, and how a scene chooses among them.
 
 Every effect is one row of :data:`EFFECTS`: a name, the physics, and the rule
 that switches it on for a scene, with the reason in words. :func:`choose_model`

@@ -3,7 +3,7 @@
 Locally the seeds share both cores; ``scheduler`` sends one task per seed to a Dask cluster.
 The ball ring is chaotic: runs that differ only in the seeded initial gaps part
 after a few milliseconds, so the paper's spread is a property of the ensemble,
-not of one trajectory (DESIGN §6). Each seed writes its own trace,
+not of one trajectory. Each seed writes its own trace,
 ``<stem>_seed<k>.trace.h5``; the workers are spawned processes (numba's thread
 pool does not survive a fork).
 """

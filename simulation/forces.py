@@ -9,7 +9,7 @@ soft materials in multibody dynamics", Mech. Mach. Theory 46 (2011) 1359-1369):
 where v_in is the approach speed when the contact began. Flores et al. give
 chi = 8 (1 - R) / (5 R) in closed form, which rebounds a little below R (0.894
 for R = 0.9, 0.256 for R = 0.3). Instead, :func:`damping_factor` calibrates chi
-so that a free two-body impact rebounds with exactly R, as DESIGN §6 asks: in
+so that a free two-body impact rebounds with exactly R, as the design asks: in
 units delta = delta_s x, t = t_s tau with delta_s / t_s = v_in, the impact is
 x'' = -x^1.5 (1 + chi x'), x(0) = 0, x'(0) = 1, and the rebound speed depends on
 chi alone. The force is never tensile.

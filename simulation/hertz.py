@@ -1,4 +1,4 @@
-"""Hertz point contact from the exact elliptic-integral solution (DESIGN §6).
+"""Hertz point contact from the exact elliptic-integral solution.
 
 For two bodies with principal curvatures rho_11, rho_12 (body I) and rho_21,
 rho_22 (body II), Harris & Kotzalas (*Rolling Bearing Analysis*, 5th ed.,

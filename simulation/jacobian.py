@@ -1,4 +1,4 @@
-"""The structured finite-difference Jacobian of the bearing models, for the implicit backend (DESIGN §7).
+"""The structured finite-difference Jacobian of the bearing models, for the implicit backend.
 
 An implicit BDF step solves a Newton system with the matrix I - gamma J, J = df/dy. CVODE's
 default difference-quotient Jacobian perturbs one state at a time: one right-hand side per state

@@ -1,4 +1,4 @@
-"""The model parameters the paper leaves open, with their defaults and sources (DESIGN §6).
+"""The model parameters the paper leaves open, with their defaults and sources.
 
 Every value here can be changed per run (``cageless simulate --set name=value``)
 and is recorded in the trace's configuration. Where a default is a choice inside
@@ -11,7 +11,7 @@ Sources
 * ``film_thickness_m``: the same study varies the oil film thickness h_0 over
   0.1-0.35 um; the default is the middle, 0.225 um. It is the film used by the
   traction law when the ``ehl_film`` effect is off, and the critical film
-  thickness Delta_r of the ball-ball squeeze film (DESIGN §6).
+  thickness Delta_r of the ball-ball squeeze film.
 * ``traction_peak_coefficient``, ``traction_peak_slide_roll``,
   ``traction_sliding_coefficient``: the traction curve of
   :mod:`simulation.traction` (the Sakaguchi & Harada / Gupta regression form the

@@ -1,8 +1,8 @@
-"""Quasi-static load distribution under a radial load (the start of a simulation, DESIGN §6).
+"""Quasi-static load distribution under a radial load (the start of a simulation).
 
 Each ball at orbital angle theta_j is squeezed between the races by the inner
 ring's radial displacement e along the load direction (toward -z, i.e. theta =
-270 deg, DESIGN §3):
+270 deg):
 
     delta_j = e cos(psi_j) - P_d / 2,   psi_j = theta_j - 270 deg,
 

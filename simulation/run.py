@@ -37,7 +37,7 @@ __all__ = ["SimulationResult", "EnergyBalance", "build_problem", "check_supporte
            "peak_unloaded_slip",
            "UNLOADED_ZONE_DEG"]
 
-#: The unloaded zone: the upper half of the bearing, opposite the radial load (DESIGN §3, §9).
+#: The unloaded zone: the upper half of the bearing, opposite the radial load.
 UNLOADED_ZONE_DEG = (0.0, 180.0)
 
 
@@ -52,7 +52,7 @@ class SimulationResult:
 
 
 def peak_unloaded_slip(trace: Trace, settle_s: float = 0.0, bin_deg: float = 1.0) -> float:
-    """The peak of the mean slip profile in the unloaded zone (DESIGN §9), as a fraction.
+    """The peak of the mean slip profile in the unloaded zone, as a fraction.
 
     Samples before ``settle_s`` (the start-up) and invalid samples are left out; the profile is
     the mean over all balls per ``bin_deg`` orbital-angle bin. NaN when no bin of the zone has data.
@@ -116,7 +116,7 @@ def build_problem(scene: Scene, choice: ModelChoice, parameters: ModelParameters
 @dataclass(frozen=True)
 class EnergyBalance:
     """The energy account along a solution's samples (J): the drive's input work, the energy dissipated, and
-    ``balance`` = mechanical energy + dissipated - input, constant when the balance closes (DESIGN §7)."""
+    ``balance`` = mechanical energy + dissipated - input, constant when the balance closes."""
 
     balance: npt.NDArray[np.float64]
     input_work: npt.NDArray[np.float64]
@@ -137,7 +137,7 @@ def energy_balance(problem: Problem, y: npt.NDArray[np.float64]) -> EnergyBalanc
 
 
 def nominal_contact_angle(scene: Scene, groups: dict[str, dict[str, np.ndarray]]) -> float:
-    """The contact angle alpha of the slip rate (DESIGN §3): 0 unless an axial load sets it; then the median
+    """The contact angle alpha of the slip rate: 0 unless an axial load sets it; then the median
     inner contact angle of the loaded contacts over the second half of the run (rad, >= 0)."""
     c = groups["contacts"]
     if scene.conditions.axial_load_n <= 0 or "inner_angle" not in c:

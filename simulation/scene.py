@@ -33,7 +33,7 @@ class Scene:
     gravity_m_s2
         Gravitational acceleration (m/s^2), >= 0; 0 for no gravity.
     orientation
-        ``"horizontal"`` (gravity along -z, DESIGN §3) or ``"vertical"`` shaft (gravity along the axis).
+        ``"horizontal"`` (gravity along -z) or ``"vertical"`` shaft (gravity along the axis).
     misalignment_rad
         Inner-ring tilt (rad), >= 0.
     moment_load_nm
@@ -49,7 +49,7 @@ class Scene:
     initial_gap_fraction
         Share of the free arc (the circumference the balls do not fill) spread between neighbours at the
         start, in [0, 1); the rest is the one gap at the top. 0 starts every ball in contact with its
-        neighbours (DESIGN §6 "Start"); the default 0.05 keeps them a few micrometres apart.
+        neighbours; the default 0.05 keeps them a few micrometres apart.
     """
 
     conditions: OperatingConditions

@@ -130,7 +130,7 @@ def step_scipy(pr: Problem, t_eval: FloatArray, method: str, rtol: float, max_st
     if first_step:
         kw["first_step"] = first_step
     structure = JacobianStructure.for_problem(pr) if fun is None and method in _IMPLICIT else None
-    if structure is not None:  # the compiled path gets the structured Jacobian (DESIGN §7: its sparsity)
+    if structure is not None:  # the compiled path gets the structured Jacobian (its sparsity)
         evaluate, jac = structure.evaluator(pr, log, pr.atol / rtol), np.empty((len(pr.y0), len(pr.y0)))
 
         def jacobian(t: float, y: FloatArray) -> FloatArray:

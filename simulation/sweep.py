@@ -1,8 +1,8 @@
-"""One scene over a parameter grid and seeds, locally or on Dask (``cageless sweep``; DESIGN §10).
+"""One scene over a parameter grid and seeds, locally or on Dask (``cageless sweep``).
 
 This is the paper's lubrication sensitivity study (§4: viscosity, film thickness and damping varied
 at 1800 rpm). Each grid point runs ``seeds`` simulations; the result is the peak of the mean slip
-profile in the unloaded zone (DESIGN §9) after the start-up, per run, and its mean and seed spread
+profile in the unloaded zone after the start-up, per run, and its mean and seed spread
 per point. A parameter name is a scene quantity (``speed_rpm``, ``radial_load_n``, ``axial_load_n``),
 an open model parameter (``cho_n_s_m``, ``film_thickness_m``, ...) or a dotted bearing field
 (``lubricant.dynamic_viscosity_pa_s``; ``lubricant.viscosity`` is accepted for it).

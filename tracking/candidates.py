@@ -1,4 +1,4 @@
-"""Candidate highlights and short tracklets, for choosing which blobs are the balls (DESIGN §8.3-8.4).
+"""Candidate highlights and short tracklets, for choosing which blobs are the balls.
 
 Detection here must not depend on one rendering style, so it asks one question of each pixel:
 is this a small bright *blob* at the scale a ball highlight has? The frame minus the temporal-median

@@ -1,4 +1,4 @@
-"""Stage 2: find the ball highlights in a frame and measure them to sub-pixel (DESIGN §8.3).
+"""Stage 2: find the ball highlights in a frame and measure them to sub-pixel.
 
 Full detection works on the background-subtracted frame inside the ball
 annulus: a local (adaptive) binarisation, dilation and hole filling (so a

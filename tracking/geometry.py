@@ -1,4 +1,4 @@
-"""Stage 4: from tracked pixels to orbital angles in the bearing frame (DESIGN §3, §8.5).
+"""Stage 4: from tracked pixels to orbital angles in the bearing frame.
 
 Angles are measured about the centre of the circle the tracked highlights travel
 over the whole video (a constant highlight offset moves that circle off the

@@ -1,4 +1,4 @@
-"""Stage 5: revolution speed and slip from the unwrapped orbital angles (DESIGN §8.6).
+"""Stage 5: revolution speed and slip from the unwrapped orbital angles.
 
 The revolution speed is a Savitzky-Golay derivative of the unwrapped angle:
 a polynomial of order ``polyorder`` fitted by least squares over ``window``

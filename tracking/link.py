@@ -1,4 +1,4 @@
-"""Stage 3: follow every ball through the video, keeping its identity (DESIGN §8.4).
+"""Stage 3: follow every ball through the video, keeping its identity.
 
 Balls cannot pass each other, so identities come from the cyclic order. The
 tracker starts at the first frame where full detection finds all Z balls,

@@ -1,4 +1,4 @@
-"""Stage 1: find the bearing in the image and the annulus the balls travel in (DESIGN §8.2).
+"""Stage 1: find the bearing in the image and the annulus the balls travel in.
 
 On a background frame (the per-pixel median of a sample of frames, which
 removes the moving highlights), a global Otsu binarisation and a

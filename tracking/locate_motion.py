@@ -1,4 +1,4 @@
-"""Find the ball band from what moves, when the ring faces do not frame a dark band (DESIGN §8.2).
+"""Find the ball band from what moves, when the ring faces do not frame a dark band.
 
 The brightness-based localisation (:mod:`tracking.locate`) needs bright ring faces around a dark
 ball band. Footage from another set-up may show dark ring faces, or balls over bright faces. What

@@ -1,4 +1,4 @@
-"""The tracking pipeline: one video in, one ``cageless-trace/1`` file and its QC out (DESIGN §8).
+"""The tracking pipeline: one video in, one ``cageless-trace/1`` file and its QC out.
 
 :func:`track_video` runs the stages in order: localisation
 (:mod:`tracking.locate`), detection and identity (:mod:`tracking.detect`,

@@ -1,4 +1,4 @@
-"""Stage 6: quality control written beside the trace (DESIGN §8.7).
+"""Stage 6: quality control written beside the trace.
 
 Per video: detection rate per ball, the share of interpolated samples, the
 orbit-circle fit residual, the ball count found, overlay images of chosen

@@ -1,4 +1,4 @@
-"""Which blobs are the balls: exactly Z tracks chosen by their joint consistency (DESIGN §8.4).
+"""Which blobs are the balls: exactly Z tracks chosen by their joint consistency.
 
 The bearing description fixes the ball count Z, the ball diameter D and the pitch circle d_m, and
 the operating conditions fix the inner-ring speed, hence the pure-rolling cage speed

@@ -1,4 +1,4 @@
-"""The ``cageless`` command line: one console script with subcommands (DESIGN §2).
+"""The ``cageless`` command line: one console script with subcommands.
 
 Each subcommand lives in its own module exposing ``register(subparsers, parent)``
 and ``run(args, config) -> int``; :data:`SUBCOMMANDS` lists them in help order and

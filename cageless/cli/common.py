@@ -46,7 +46,7 @@ def finite_float(text: str) -> float:
 
 
 def common_options() -> ArgumentParser:
-    """Return a parent parser with the options every subcommand has (DESIGN §2)."""
+    """Return a parent parser with the options every subcommand has."""
     parent = ArgumentParser(add_help=False)
     group = parent.add_argument_group("common options")
     group.add_argument("--config", metavar="FILE.toml", help="read defaults and bearing overrides from a TOML file")

@@ -27,7 +27,7 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
         "re-run. A video or simulation that fails is a failed row in the report; the rest completes (exit 1).",
         epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("lab", help="lab folder (videos with their conditions, DESIGN §5)")
+    p.add_argument("lab", help="lab folder (videos with their conditions)")
     p.add_argument("-o", "--out", default="report", help="output folder (default ./report)")
     p.add_argument("--duration", type=finite_float,
                    help="simulated time after the start-up (s; default: the longest video, at least one cage "

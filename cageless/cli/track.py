@@ -32,7 +32,7 @@ log = logging.getLogger(__name__)
 
 _EXAMPLES = """\
 examples:
-  cageless track sample_data/lab -o out            every video of a lab folder (conditions per DESIGN §5)
+  cageless track sample_data/lab -o out            every video of a lab folder (sidecar, conditions.csv or file name)
   cageless track clip.cine --speed-rpm 3000 -o out one video whose conditions are nowhere else
   cageless track lab -o out --window 31 --detector weighted --workers 2
 """
@@ -45,7 +45,7 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
 
     p = subparsers.add_parser(
         "track", parents=[parent], help="track the balls in videos and write trace files",
-        description="Track every ball in bearing videos and write <video>.trace.h5 (DESIGN §4) plus QC "
+        description="Track every ball in bearing videos and write <video>.trace.h5 plus QC "
         "(qc/<video>.qc.json and overlay PNGs). A folder is read as a lab folder; one failing video is "
         "reported and the others still run (exit code 1).",
         epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter,

@@ -4,8 +4,7 @@ Source
 ------
 Wang, Zhao, Wang, Jin, *Dynamic Characteristics of Rolling Elements in
 Cageless Bearings Based on a Nonlinear Dynamic Model*, Appl. Sci. 2026,
-16(18), 9284, Table 1 (``shared/reference/paper.txt``), as restated in
-DESIGN §6.
+16(18), 9284, Table 1.
 
 Table 1 gives the race diameters, ball diameter, curvature factors, masses,
 material and lubricant. The pitch diameter (46.005 mm) and the zero

@@ -1,4 +1,4 @@
-"""The planar cageless-bearing model (DESIGN §6, pure radial load on an aligned bearing).
+"""The planar cageless-bearing model (pure radial load on an aligned bearing).
 
 States (n = 5 Z + 6): per ball j the orbital radius r_j, angle theta_j, their
 rates, and the spin omega_j about the shaft axis; then the inner-ring centre
@@ -525,7 +525,7 @@ def planar_jump_floor(p: npt.NDArray[np.float64], lay: PlanarLayout) -> npt.NDAr
 
 
 def contact_events(problem: Problem, log: npt.NDArray[np.float64], t_end: float) -> pd.DataFrame:
-    """The ball-ball contact episodes as the trace's event table (DESIGN §4, ``EVENT_COLUMNS``).
+    """The ball-ball contact episodes as the trace's event table (``EVENT_COLUMNS``).
 
     Episodes still open at ``t_end`` are closed there (their duration is a lower bound). If more
     episodes happened than the capacity, the table holds the first ones and ``attrs["dropped"]``

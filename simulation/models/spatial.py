@@ -1,4 +1,4 @@
-"""The spatial cageless-bearing model (DESIGN §6): axial positions, full spin vectors, contact angles.
+"""The spatial cageless-bearing model: axial positions, full spin vectors, contact angles.
 
 States (n = 9 Z + 12). The first 5 Z + 6 are laid out exactly as in the planar
 model (r, theta, their rates, spin about the shaft axis x, the ring centre

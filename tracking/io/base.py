@@ -1,4 +1,4 @@
-"""The frame-source interface every video reader implements (DESIGN §8.1).
+"""The frame-source interface every video reader implements.
 
 A frame source is lazy and random-access, PIMS style: ``len(src)``,
 ``src[i]`` (one frame as a 2-D array, rows top to bottom as displayed),

@@ -1,6 +1,6 @@
 """Camera and scene appearance of the synthetic bearing video.
 
-Image convention (DESIGN §3): pixel centres sit at integer (u, v), u the
+Image convention: pixel centres sit at integer (u, v), u the
 column and v the row. A bearing-frame point (y, z) maps to
 
     u = cx + s (y cos(roll) - z sin(roll)),   v = cy - s (y sin(roll) + z cos(roll)),

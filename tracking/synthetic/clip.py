@@ -141,7 +141,7 @@ def render_clip(
         "highlight_offset_px": list(renderer._light_px), "direction": motion.direction,
         "motion": _describe_law(law) if law is not None else {"source": "trace"},
         "conventions": "pixel centres at integer (u, v); angle_rad is the unwrapped orbital angle in the "
-                       "bearing frame (DESIGN §3) at mid-exposure; time_s is the frame time stamp",
+                       "bearing frame at mid-exposure; time_s is the frame time stamp",
     }
     truth_json = path.with_name(f"{stem}.truth.json")
     atomic_write_text(truth_json, json.dumps(meta, indent=1, default=float))
@@ -149,7 +149,7 @@ def render_clip(
 
 
 def _number_balls(motion: BallMotion) -> BallMotion:
-    """Renumber balls as DESIGN §3 does: counter-clockwise from the ball just after the largest gap at the
+    """Renumber balls by the project's convention: counter-clockwise from the ball just after the largest gap at the
     start, ball 0's angle in [0, 2 pi) and each next ball ahead of the previous one."""
     order = ball_order(motion.angle[0])
     angle = normalise_unwrapped(motion.angle[:, order])

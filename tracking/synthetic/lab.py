@@ -7,7 +7,7 @@ Two presets:
     4x (320 x 200 px at 3.125 px/mm), 10,000 fps, three conditions (1800, 3000
     and 6000 rpm at 500 N), each clip long enough for every ball to travel a
     third of an orbit, so the 14 balls together cover 360 deg about 4-5 times.
-    The conditions are given in the three ways DESIGN §5 allows, and the clips
+    The conditions are given in the three ways a lab folder allows (sidecar, conditions.csv, file name), and the clips
     use three formats:
 
     * ``run_1800/``: 8-bit PNG sequence, conditions in the sidecar ``run_1800.toml``
@@ -166,7 +166,7 @@ def _readme(preset: str, seed: int, revs: float, results: list[dict[str, Any]]) 
         "Ground truth beside each clip: `<clip>.truth.csv` (one row per frame and ball: frame, time_s, ball,",
         "angle_rad, radius_m, centre and highlight pixel positions, highlight_visible) and `<clip>.truth.json`",
         "(camera, appearance, motion law, dropped frames). Pixel centres are at integer (u, v); angles are",
-        "unwrapped orbital angles in the bearing frame of DESIGN §3.",
+        "unwrapped orbital angles in the bearing frame (counter-clockwise as the camera sees it).",
         "",
     ]
     return "\n".join(lines)
