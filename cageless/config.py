@@ -44,12 +44,16 @@ def load_config(path: str | Path) -> dict[str, Any]:
         If the file is missing or not valid TOML; the message names the file.
     """
     path = Path(path)
+    if path.is_dir():
+        raise UsageError(f"--config {path}: is a folder; give a TOML file.")
     if not path.is_file():
         raise UsageError(f"--config {path}: no such file.")
     try:
         return tomllib.loads(path.read_text(encoding="utf-8"))
     except tomllib.TOMLDecodeError as exc:
         raise UsageError(f"--config {path}: not valid TOML ({exc}).") from exc
+    except UnicodeDecodeError:
+        raise UsageError(f"--config {path}: is not a text file (TOML is UTF-8 text).") from None
 
 
 def bearing_from_config(config: Mapping[str, Any]) -> Bearing:

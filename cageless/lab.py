@@ -49,6 +49,8 @@ from cageless.validate import plausible_entry
 __all__ = ["LabOptions", "LabResult", "run_lab"]
 
 CACHE_NAME = ".cageless-cache.json"
+#: The files a report writes directly in its output folder.
+REPORT_PRODUCTS = ("report.html", "slip_table.csv", "slip_table.md", "slip_table.tex", "slip_table.html")
 
 log = logging.getLogger(__name__)
 

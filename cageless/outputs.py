@@ -63,21 +63,53 @@ def _check_parents(path: Path, option: str) -> None:
                          "Choose another path.") from None
 
 
-def _is_cageless_trace(path: Path) -> bool:
+def _trace_source(path: Path) -> str | None:
+    """``"video"`` or ``"simulation"`` for a cageless trace, ``"damaged"`` for a damaged HDF5 file under a
+    trace name (ours to replace), None for anything else."""
     try:
         with open(path, "rb") as fh:
             head = fh.read(8)
     except OSError:
-        return False
+        return None
     if head != _HDF5_MAGIC:
-        return False
+        return None
     try:
         import h5py
 
         with h5py.File(path, "r") as f:
-            return str(f.attrs.get("schema", "")).startswith("cageless-trace/")
+            if not str(f.attrs.get("schema", "")).startswith("cageless-trace/"):
+                return None
+            return str(f.attrs.get("source", "damaged"))
     except (OSError, RuntimeError):
-        return True  # a damaged HDF5 file under a trace name: ours to replace
+        return "damaged"
+
+
+def _is_cageless_trace(path: Path) -> bool:
+    return _trace_source(path) is not None
+
+
+def is_foreign_file(path: str | Path) -> bool:
+    """True when ``path`` is an existing file that is not a cageless trace: cageless does not replace it."""
+    path = Path(path)
+    return path.is_file() and not _is_cageless_trace(path)
+
+
+def check_products(folder: str | Path, names: tuple[str, ...], marker: str, option: str = "-o") -> None:
+    """Refuse to write a command's named products into ``folder`` when files of those names are there
+    and the folder holds no ``marker`` of an earlier cageless run (so cageless did not write them).
+
+    Raises
+    ------
+    UsageError
+        Naming the files found.
+    """
+    folder = Path(folder)
+    if not folder.is_dir() or (folder / marker).exists():
+        return
+    found = [n for n in names if (folder / n).exists()]
+    if found:
+        raise UsageError(f"{option} {folder}: already holds {', '.join(found)}, which cageless did not write "
+                         "there and would replace. Choose another folder, or move those files.")
 
 
 def check_output_file(path: str | Path, option: str = "-o", suffixes: tuple[str, ...] = (".h5",),
@@ -110,9 +142,13 @@ def check_output_file(path: str | Path, option: str = "-o", suffixes: tuple[str,
         raise UsageError(f"{option} {path}: the output is an HDF5 trace; give a name ending in {want}, "
                          f"e.g. {path.with_name(path.name.split('.')[0] + '.trace.h5')}.")
     _check_parents(path, option)
-    if path.is_file() and not overwrite and not _is_cageless_trace(path):
+    source = _trace_source(path) if path.is_file() else "absent"
+    if path.is_file() and not overwrite and source is None:
         raise UsageError(f"{option} {path}: exists and is not a cageless trace; cageless does not overwrite "
                          "files it did not write. Choose another name, or pass --overwrite.")
+    if source == "video" and not overwrite:
+        raise UsageError(f"{option} {path}: holds a measured (video) trace, which a simulation would replace. "
+                         "Choose another name, or pass --overwrite.")
     return path
 
 

@@ -36,8 +36,11 @@ def die_with_parent(parent_pid: int) -> None:
     """Worker initializer: end this process when its parent dies (even by ``kill -9``).
 
     On Linux the kernel sends SIGKILL on the parent's death (``prctl(PR_SET_PDEATHSIG)``); everywhere,
-    a daemon thread also checks once a second that the parent is still there.
+    a daemon thread also checks once a second that the parent is still there. Ctrl-C is the parent's to
+    handle: a worker ignores SIGINT (an idle worker would otherwise print a traceback), and ends with its
+    parent.
     """
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     if sys.platform.startswith("linux"):
         try:
             import ctypes

@@ -27,6 +27,7 @@ from cageless.bearing import Bearing
 from cageless.conditions import OperatingConditions
 from cageless.errors import ParameterError, TrackingError
 from cageless.kinematics import slip_rate, theoretical_cage_speed
+from cageless.outputs import is_foreign_file
 from cageless.provenance import VIDEO_HASH, Provenance
 from cageless.trace import Trace, VideoInfo, write_trace
 from tracking.detect import DetectorParams, detect_full, noise_sigma, spot_sigma, static_defects
@@ -215,6 +216,10 @@ def track_video(
     """
     options = options or TrackOptions()
     path = Path(path)
+    if out_dir is not None and is_foreign_file(Path(out_dir) / f"{_stem(path)}.trace.h5"):
+        raise TrackingError(path, f"{Path(out_dir) / f'{_stem(path)}.trace.h5'} exists and is not a cageless "
+                                  "trace; cageless does not overwrite files it did not write. Move it, or track "
+                                  "into another folder.")
     fps = options.fps or conditions.fps
     prov = Provenance.start(config={"tracking": options.to_dict(), "conditions": conditions.to_dict(),
                                     **(config or {})}, inputs=[path], background=True,

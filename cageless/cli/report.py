@@ -54,7 +54,8 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     from cageless.calibrate import describe_calibration
     from cageless.cli.common import parameter_values
 
-    from cageless.outputs import check_output_dir
+    from cageless.lab import CACHE_NAME, REPORT_PRODUCTS
+    from cageless.outputs import check_output_dir, check_products
     from cageless.validate import check_options
 
     if args.n_balls is not None and args.n_balls < 3:
@@ -62,6 +63,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     values = parameter_values(args, config)  # [parameters] of --config, then --set; before any work starts
     check_options(args, ("duration", "settle", "rtol", "workers"))
     check_output_dir(args.out, "-o")
+    check_products(args.out, REPORT_PRODUCTS, CACHE_NAME)
     note = describe_calibration(config.get("calibration"))
     options = LabOptions(duration_s=args.duration, settle_s=args.settle, rtol=args.rtol, workers=args.workers,
                          scheduler=args.scheduler, force=args.force, parameters=values, calibration=note,

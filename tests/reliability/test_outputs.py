@@ -4,6 +4,7 @@ and the last-resort handler (issue 17)."""
 from __future__ import annotations
 
 import os
+import shutil
 import time
 from pathlib import Path
 
@@ -160,3 +161,39 @@ def test_r30_disk_full_escaping_anywhere_is_one_line(capsys, monkeypatch):
 
     monkeypatch.setattr("cageless.cli.info.run", full)
     assert_clean(cli(capsys, "info"), 1, "no space left on /data/out/x.png")
+
+
+def test_track_and_report_do_not_replace_files_they_did_not_write(tmp_path, capsys):
+    """A new user's check: track and report into folders holding the user's own files of the same names."""
+    video = Path(__file__).resolve().parents[2] / "sample_data" / "lab" / "n6000_Fr500_Fa0.cine"
+    out = tmp_path / "to"
+    out.mkdir()
+    (out / "n6000_Fr500_Fa0.trace.h5").write_text("MINE")
+    run = cli(capsys, "track", video, "-o", out, "--workers", "1", "-q")
+    assert_clean(run, 1, "n6000_Fr500_Fa0.trace.h5 exists and is not a cageless trace")
+    assert (out / "n6000_Fr500_Fa0.trace.h5").read_text() == "MINE"
+    rep = tmp_path / "ro"
+    rep.mkdir()
+    (rep / "report.html").write_text("MINE")
+    run = cli(capsys, "report", video.parent, "-o", rep, "-q")
+    assert_clean(run, 2, "already holds report.html, which cageless did not write")
+    assert (rep / "report.html").read_text() == "MINE" and not (rep / "traces").exists()
+
+
+def test_simulate_does_not_replace_a_measured_trace(tmp_path, capsys, video_trace):
+    target = tmp_path / "measured.trace.h5"
+    shutil.copy(video_trace, target)
+    before = target.read_bytes()
+    run = cli(capsys, "simulate", "--speed-rpm", "6000", "--radial-load-n", "500", "--duration", "0.002",
+              "-o", target)
+    assert_clean(run, 2, "holds a measured (video) trace")
+    assert target.read_bytes() == before
+
+
+def test_config_that_is_not_text_is_a_usage_error(tmp_path, capsys):
+    bad = tmp_path / "bin.toml"
+    bad.write_bytes(b"\xff\xfe\x00garbage")
+    run = cli(capsys, "info", "--config", bad)
+    assert_clean(run, 2, "--config", "bin.toml", "is not a text file")
+    run = cli(capsys, "info", "--config", tmp_path)
+    assert_clean(run, 2, "is a folder; give a TOML file")
