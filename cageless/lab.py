@@ -253,13 +253,13 @@ def _run_lab(folder: str | Path, out: Path, options: LabOptions | None, bearing:
     options = options or LabOptions()
     bearing = bearing or default_bearing()
     out = Path(out)
+    entries = [plausible_entry(e, options.force) for e in discover_lab(folder)]
+    if not entries:  # before anything is made in the output folder
+        raise CagelessError(f"{folder}: no videos found. A lab folder holds videos (cine, avi/mp4/mkv or image "
+                            "folders) with their conditions.")
     (out / "traces").mkdir(parents=True, exist_ok=True)
     (out / "simulations").mkdir(parents=True, exist_ok=True)
     cache, timings, skipped = _Cache(out), {}, 0
-    entries = [plausible_entry(e, options.force) for e in discover_lab(folder)]
-    if not entries:
-        raise CagelessError(f"{folder}: no videos found. A lab folder holds videos (cine, avi/mp4/mkv or image "
-                            "folders) with their conditions.")
     failed: list[ComparisonRow] = [_failed_row(e.video.name, None, str(e.error)) for e in entries if not e.ok]
     good = [e for e in entries if e.ok]
     with job_pool(options.workers, options.scheduler) as pool:

@@ -150,6 +150,20 @@ def test_r36_cine_realbpp_7_is_refused(tmp_path, capsys, cine40):
     assert_clean(run, 1, "n3000_Fr500.cine", "7 significant bits", "RealBPP", f"byte offset {offset}")
 
 
+def test_r36_packed_cine_realbpp_7_is_refused(tmp_path, capsys):
+    """The bundled 6000 rpm clip is packed 12-bit (P12L); a RealBPP of 7 there is as corrupt as anywhere."""
+    src = Path(__file__).resolve().parents[2] / "sample_data" / "lab" / "n6000_Fr500_Fa0.cine"
+    bad = tmp_path / "n6000_Fr500.cine"
+    data = bytearray(src.read_bytes())
+    with CineReader(src) as r:
+        assert r.metadata.to_dict()["bit_depth"] == 12
+        offset = r.header["off_setup"] + SETUP_FIELDS["real_bpp"][0]
+    struct.pack_into("<I", data, offset, 7)
+    bad.write_bytes(bytes(data))
+    run = cli(capsys, "info", bad)
+    assert_clean(run, 1, "n6000_Fr500.cine", "7 significant bits", "packed 12-bit")
+
+
 def test_r37_dangling_symlink_in_a_lab_is_reported(tmp_path, capsys, mini_lab):
     lab = tmp_path / "lab"
     shutil.copytree(mini_lab, lab)

@@ -197,3 +197,10 @@ def test_config_that_is_not_text_is_a_usage_error(tmp_path, capsys):
     assert_clean(run, 2, "--config", "bin.toml", "is not a text file")
     run = cli(capsys, "info", "--config", tmp_path)
     assert_clean(run, 2, "is a folder; give a TOML file")
+
+
+def test_report_on_an_empty_lab_leaves_no_output_folder(tmp_path, capsys):
+    (tmp_path / "empty").mkdir()
+    run = cli(capsys, "report", tmp_path / "empty", "-o", tmp_path / "out", "-q")
+    assert_clean(run, 1, "no videos found")
+    assert not (tmp_path / "out").exists()

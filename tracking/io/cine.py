@@ -148,6 +148,12 @@ class CineReader(FrameSource):
             self._bit_depth = self._packed_bits
             name = "P10, raw log-encoded codes" if comp == 256 else "P12L"
             self._storage = f"packed {self._packed_bits}-bit ({name})"
+            real = int(s.get("real_bpp") or 0)
+            if real and not 8 <= real <= 16:  # RealBPP is 8..16 in every cine format; 0 means not recorded
+                raise VideoError(self.path, f"declares {real} significant bits per pixel (RealBPP) in packed "
+                                 f"{self._packed_bits}-bit frames; a cine holds 8 to 16.",
+                                 offset=self.header["off_setup"] + SETUP_FIELDS["real_bpp"][0],
+                                 hint="The header is corrupt: re-export the cine.")
         elif comp == 0 and b["bi_bit_count"] in (8, 16):
             self._packed_bits = 0
             self._dtype = np.dtype(np.uint8 if b["bi_bit_count"] == 8 else "<u2")
