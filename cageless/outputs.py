@@ -49,17 +49,20 @@ def _kind(mode: int) -> str:
     return "not a regular file"
 
 
-def _check_parents(path: Path, option: str) -> None:
-    """Refuse a path under a file, and a parent folder that cannot be created or written."""
+def _check_parents(path: Path, option: str, shown: Path | None = None) -> None:
+    """Refuse a path under a file, and a parent folder that cannot be created or written; messages name
+    ``shown`` (default ``path``)."""
+    shown = path if shown is None else shown
     for parent in reversed(path.parents):
         if parent.exists() and not parent.is_dir():
-            raise UsageError(f"{option} {path}: {parent} is a file, not a folder. Choose another path.")
+            what = "a file" if parent.is_file() else _kind(parent.stat().st_mode)
+            raise UsageError(f"{option} {shown}: {parent} is {what}, not a folder. Choose another path.")
     existing = next((p for p in path.parents if p.exists()), Path("."))
     try:  # a real probe: access() says yes to root on read-only and virtual file systems such as /proc
         with tempfile.TemporaryFile(dir=existing):
             pass
     except OSError as exc:
-        raise UsageError(f"{option} {path}: cannot write in {existing} ({exc.strerror}). "
+        raise UsageError(f"{option} {shown}: cannot write in {existing} ({exc.strerror}). "
                          "Choose another path.") from None
 
 
@@ -164,7 +167,7 @@ def check_output_dir(path: str | Path, option: str = "-o") -> Path:
     if path.exists() and not path.is_dir():
         raise UsageError(f"{option} {path}: is {_kind(path.stat().st_mode) if not path.is_file() else 'a file'}, "
                          "not a folder. Give a folder (it is created if needed).")
-    _check_parents(path / "x", option)
+    _check_parents(path / "x", option, shown=path)
     return path
 
 

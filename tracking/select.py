@@ -492,8 +492,9 @@ def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, backgro
              counts, len(good), len(spans), z)
     if found != z:
         raise SelectionError(path, f"found {found} balls moving together along one circle, but the bearing has {z}.",
-                             f"Check the bearing's ball count, or state the count with --n-balls {found}; the "
-                             "QC image shows what was found.", table=table, found=found, ring=ring)
+                             f"Check the stated speed (speed_rpm: balls far from the expected cage speed are "
+                             f"rejected) and the bearing's ball count; if the video really shows {found} balls, "
+                             f"state it with --n-balls {found}. The QC image shows what was found.", table=table, found=found, ring=ring)
     if len(good) < 0.5 * len(spans):
         raise SelectionError(path, f"{z} consistent balls were found in only {len(good)} of {len(spans)} sampled "
                              "stretches of the clip.", "Check the lighting and focus; the QC image shows what "

@@ -124,7 +124,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return EXIT_FAILED
     except KeyboardInterrupt:
-        print("error: interrupted; finished outputs are kept and a re-run continues from them.", file=sys.stderr)
+        print("error: interrupted; outputs that were complete are kept, nothing partial is left "
+              "(a report re-run skips the finished jobs).", file=sys.stderr)
         return 130
     except Exception as exc:  # noqa: BLE001 - the last line of defence: one line, never a bare traceback
         return _unexpected(exc, argv)

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import shutil
 import struct
+import subprocess
+import sys
 from pathlib import Path
 
 import h5py
@@ -81,7 +83,7 @@ def test_r31_truncated_cine_has_a_cli_flag(tmp_path, capsys, cine40):
     assert_clean(run, 1, "n3000_Fr500.cine", "is truncated", "--allow-truncated")
     assert "allow_truncated=True" not in run.text
     run = cli(capsys, "track", cut, "-o", tmp_path / "o", "--workers", "1", "-q", "--allow-truncated")
-    assert_clean(run, 0, "frames")
+    assert_clean(run, 0, "frames", "truncated; using its 34 complete frames of 40 (6 dropped)")
     assert (tmp_path / "o" / "n3000_Fr500.trace.h5").is_file()
 
 
@@ -299,3 +301,15 @@ def test_held_write_cine_roundtrip_is_untouched_by_checks(tmp_path):
                        fps=1000, fmt=fmt)
         with CineReader(p) as r:
             assert len(r) == 3
+
+
+def test_a_cine_renamed_avi_gives_one_clean_line(tmp_path, capsys):
+    """A new user's check: OpenCV's own console warning must not leak past the one-line error."""
+    src = Path(__file__).resolve().parents[2] / "sample_data" / "lab" / "n6000_Fr500_Fa0.cine"
+    bad = tmp_path / "n6000_Fr500.avi"
+    shutil.copy(src, bad)
+    # OpenCV writes to the process's stderr, below Python's: run the command in its own process
+    run = subprocess.run([sys.executable, "-m", "cageless", "track", str(bad), "-o", str(tmp_path / "o"),
+                          "--workers", "1", "-q"], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 1 and "n6000_Fr500.avi" in run.stdout + run.stderr
+    assert "[ WARN" not in run.stderr and "Traceback" not in run.stderr

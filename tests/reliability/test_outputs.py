@@ -204,3 +204,9 @@ def test_report_on_an_empty_lab_leaves_no_output_folder(tmp_path, capsys):
     run = cli(capsys, "report", tmp_path / "empty", "-o", tmp_path / "out", "-q")
     assert_clean(run, 1, "no videos found")
     assert not (tmp_path / "out").exists()
+
+
+def test_figures_under_a_device_names_the_device_once(tmp_path, capsys, video_trace, sim_trace):
+    run = cli(capsys, "compare", video_trace, sim_trace, "--figures", "/dev/full/x")
+    assert_clean(run, 2, "--figures /dev/full/x: /dev/full is a character device, not a folder")
+    assert "/dev/full/x/x" not in run.text

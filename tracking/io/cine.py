@@ -22,6 +22,7 @@ second copy), packed runs are unpacked by a compiled loop.
 
 from __future__ import annotations
 
+import logging
 import mmap
 import os
 import struct
@@ -205,12 +206,13 @@ class CineReader(FrameSource):
         finally:
             os.close(fd)
         if complete < n:
-
             bad = int(starts[complete])
             if not allow_truncated or complete == 0:
                 raise VideoError(self.path, f"is truncated: frame {complete} of {n} starts at or runs past the end of "
                                  f"the file ({self._size} bytes).", offset=bad,
                                  hint="Re-copy the file, or re-run with --allow-truncated to use the complete frames.")
+            logging.getLogger(__name__).warning("%s: truncated; using its %d complete frames of %d (%d dropped).",
+                                                self.path, complete, n, n - complete)
         self._data_start = data_start[:complete]
         self._n = complete
 

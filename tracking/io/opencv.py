@@ -33,6 +33,11 @@ __all__ = ["OpenCVReader", "write_ffv1"]
 
 log = logging.getLogger(__name__)
 
+try:  # OpenCV's own console warnings (e.g. on a file it cannot open) would leak past our one-line errors
+    cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_ERROR)
+except AttributeError:  # pragma: no cover - builds without the logging utilities
+    pass
+
 _EXACT_SEEK = {".avi"}
 _AVI_MAX_FPS = 1000.0
 
