@@ -216,10 +216,10 @@ def track_video(
     """
     options = options or TrackOptions()
     path = Path(path)
-    if out_dir is not None and is_foreign_file(Path(out_dir) / f"{_stem(path)}.trace.h5"):
-        raise TrackingError(path, f"{Path(out_dir) / f'{_stem(path)}.trace.h5'} exists and is not a cageless "
-                                  "trace; cageless does not overwrite files it did not write. Move it, or track "
-                                  "into another folder.")
+    target = None if out_dir is None else Path(out_dir) / f"{_stem(path)}.trace.h5"
+    if target is not None and is_foreign_file(target):
+        raise TrackingError(path, f"{target} exists and is not a cageless trace; cageless does not overwrite files "
+                                  "it did not write. Move it, or track into another folder.")
     fps = options.fps or conditions.fps
     prov = Provenance.start(config={"tracking": options.to_dict(), "conditions": conditions.to_dict(),
                                     **(config or {})}, inputs=[path], background=True,
@@ -258,7 +258,7 @@ def track_video(
     written = None
     if out_dir is not None:
         out_dir = Path(out_dir)
-        written = write_trace(out_dir / f"{_stem(path)}.trace.h5", trace)
+        written = write_trace(target, trace)
         try:
             write_qc(out_dir / "qc", _stem(path), path, qc, table, trace, options.qc_frames, fps,
                      allow_truncated=options.allow_truncated)

@@ -10,7 +10,7 @@
 Each block of 8 consecutive seeds is a Latin hypercube over every factor
 (:mod:`tracking.synthetic.appearance`), so each set reaches both ends of every
 range and every level of every categorical factor; :func:`coverage` checks it
-and ``python -m tracking.synthetic.matrix`` prints the table.
+and ``python benchmarks/tracking_corpus.py`` prints the table.
 """
 
 from __future__ import annotations
@@ -103,6 +103,3 @@ def format_coverage() -> str:
         lines.append(f"| {row['factor']} | {row['required']} | {marks[0]} | {marks[1]} |")
     return "\n".join(lines)
 
-
-if __name__ == "__main__":  # pragma: no cover
-    print(format_coverage())
