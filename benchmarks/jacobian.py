@@ -18,9 +18,9 @@ import argparse
 
 import numpy as np
 
-from simulation.bench import _settled_problem
-from simulation.auto_switch import RTOL_FACTOR
-from simulation.solve import JACOBIAN_DEFAULT, JACOBIANS, step_cvode
+from cageless.simulation.bench import _settled_problem
+from cageless.simulation.auto_switch import RTOL_FACTOR
+from cageless.simulation.solve import JACOBIAN_DEFAULT, JACOBIANS, step_cvode
 
 SCENES = (("planar, 500 N", "planar", 500.0, 0.0), ("planar, 20 kN", "planar", 20000.0, 0.0),
           ("spatial, 500 N + 400 N axial", "spatial", 500.0, 400.0), ("spatial, 500 N", "spatial", 500.0, 0.0))

@@ -18,8 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
-from tracking.io import open_video, write_cine
-from tracking.io.cine import CineReader
+from cageless.tracking.io import open_video, write_cine
+from cageless.tracking.io.cine import CineReader
 
 W, H, CHUNK = 1280, 800, 32
 

@@ -16,7 +16,7 @@ import argparse
 import json
 from pathlib import Path
 
-from simulation.bench import accuracy_study, format_accuracy, plot_accuracy
+from cageless.simulation.bench import accuracy_study, format_accuracy, plot_accuracy
 
 
 def main() -> None:

@@ -4,14 +4,14 @@
     python benchmarks/track.py --speed [--dir bench_footage] [--lengths 1000 5000 10000]
                                [--baseline OLD_SOURCE_TREE] [--repeats 2] [--json out.json]
 
-Without ``--speed`` it runs the accuracy-versus-time study of :mod:`tracking.bench`
+Without ``--speed`` it runs the accuracy-versus-time study of :mod:`cageless.tracking.bench`
 (detectors, smoothing windows, trackpy on the same frames, peak memory).
 
 With ``--speed`` it renders one full-size clip (1280 x 800 px, 16-bit cine words, 12.5 px/mm,
 3000 rpm at 10,000 frames/s; 2 MB a frame) of the longest length once, cuts the shorter
 lengths from its start, and for each length measures, each in a fresh process:
 
-* **pipeline frames/s**: :func:`tracking.pipeline.track_video` in process, input hash cached
+* **pipeline frames/s**: :func:`cageless.tracking.pipeline.track_video` in process, input hash cached
   and imports done (what the tracker itself sustains on both cores);
 * **end to end, cold**: ``cageless track clip.cine --speed-rpm 3000`` from a new interpreter
   with an empty hash cache (imports, hashing, tracking, writing the trace and its QC);
@@ -50,7 +50,7 @@ _PRELUDE = (
 )
 _PIPELINE = _PRELUDE + (
     "import time, json; from cageless.bearing import default_bearing; "
-    "from cageless.conditions import OperatingConditions; import tracking.pipeline as p; "
+    "from cageless.conditions import OperatingConditions; import cageless.tracking.pipeline as p; "
     "import cageless.provenance as pv; "
     "h = pv.hash_file({clip!r}, getattr(p, 'INPUT_HASH', 'sha256')) if hasattr(pv, 'hash_file') "
     "else pv.sha256_file({clip!r}); "
@@ -58,7 +58,7 @@ _PIPELINE = _PRELUDE + (
     "default_bearing(), progress=False); "
     "print(json.dumps({{'s': time.perf_counter() - t, 'n': int(r.trace.n_samples)}}))"
 )
-_CLI = _PRELUDE + "from cageless.cli import main; sys.exit(main({argv!r}))"
+_CLI = _PRELUDE + "from cageless.app.cli import main; sys.exit(main({argv!r}))"
 
 
 def _child(code: str, env: dict[str, str] | None = None) -> tuple[float, float, str]:
@@ -81,8 +81,8 @@ def _child(code: str, env: dict[str, str] | None = None) -> tuple[float, float, 
 
 def _clips(folder: Path, lengths: list[int], footage: int | None = None) -> dict[int, Path]:
     """A clip of ``footage`` frames (default the longest length) rendered once; the others are its first frames."""
-    from tracking.bench import prepare_footage
-    from tracking.io import open_video, write_cine
+    from cageless.tracking.bench import prepare_footage
+    from cageless.tracking.io import open_video, write_cine
 
     longest = footage or max(lengths)
     video, _ = prepare_footage(folder, longest)
@@ -114,7 +114,7 @@ def _version_s(src: Path, repeats: int) -> float:
 
 def _trackpy_fps(clip: Path, n: int = 100) -> float | None:
     try:
-        from tracking.bench import _trackpy
+        from cageless.tracking.bench import _trackpy
     except ImportError:
         return None
     import pandas as pd
@@ -197,7 +197,7 @@ def main() -> None:
         result = speed_table(args.dir, args.lengths, args.repeats, args.baseline, args.footage)
         print(format_speed(result))
     else:
-        from tracking.bench import format_tables, run_benchmark
+        from cageless.tracking.bench import format_tables, run_benchmark
 
         result = run_benchmark(args.dir, args.frames, args.repeats)
         print(format_tables(result))

@@ -22,10 +22,10 @@ from pathlib import Path
 
 from cageless.bearing import default_bearing
 from cageless.conditions import OperatingConditions
-from tracking.io import open_video
-from tracking.link import track_frames
-from tracking.locate import background_frame, locate_bearing
-from tracking.pipeline import TrackOptions, _CroppedFrames, _setup
+from cageless.tracking.io import open_video
+from cageless.tracking.link import track_frames
+from cageless.tracking.locate import background_frame, locate_bearing
+from cageless.tracking.pipeline import TrackOptions, _CroppedFrames, _setup
 
 
 def main() -> None:

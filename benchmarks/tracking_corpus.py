@@ -21,8 +21,8 @@ import time
 from dataclasses import asdict
 from pathlib import Path
 
-from tracking.synthetic.matrix import SETS, format_coverage
-from tracking.synthetic.runner import ClipResult, badness, run_seeds
+from cageless.tracking.synthetic.matrix import SETS, format_coverage
+from cageless.tracking.synthetic.runner import ClipResult, badness, run_seeds
 
 _COLS = ("Z", "res", "px/mm", "bits", "fmt", "rpm", "slip%", "faces", "lands", "sat", "dbl", "jpeg", "dir")
 

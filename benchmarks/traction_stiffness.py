@@ -25,10 +25,10 @@ import math
 
 from cageless.bearing import default_bearing
 from cageless.kinematics import theoretical_cage_speed
-from simulation.hertz import compliance, hertz_contact, race_curvatures
-from simulation.parameters import ModelParameters
-from simulation.physics import film_traction as ft
-from simulation.physics.viscosity import barus, roelands
+from cageless.simulation.hertz import compliance, hertz_contact, race_curvatures
+from cageless.simulation.parameters import ModelParameters
+from cageless.simulation.physics import film_traction as ft
+from cageless.simulation.physics.viscosity import barus, roelands
 
 
 def _today_slope(q: float, u_r: float, par: ModelParameters) -> float:

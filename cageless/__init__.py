@@ -8,7 +8,7 @@ The shared core holds the vocabulary every package uses:
 * :mod:`cageless.trace`: the ``cageless-trace/1`` HDF5 format;
 * :mod:`cageless.errors` and :mod:`cageless.provenance`.
 
-The app layer (:mod:`cageless.cli`) is the only place that imports
+The app layer (:mod:`cageless.app.cli`) is the only place that imports
 ``tracking``, ``simulation`` and ``comparison``.
 """
 

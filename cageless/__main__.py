@@ -1,5 +1,5 @@
 """``python -m cageless`` runs the CLI."""
 
-from cageless.cli import entry_point
+from cageless.app.cli import entry_point
 
 entry_point()

@@ -8,8 +8,8 @@ from typing import Any
 
 from cageless.kinematics import rereference_slip
 from cageless.trace import Trace
-from comparison.align import MismatchError, Profiles, check_compatible, profiles, simulation_settle_s
-from comparison.metrics import profile_errors, unloaded_peak
+from cageless.comparison.align import MismatchError, Profiles, check_compatible, profiles, simulation_settle_s
+from cageless.comparison.metrics import profile_errors, unloaded_peak
 
 __all__ = ["ComparisonRow", "Comparison", "compare", "match_contact_angle", "slip_contact_angle"]
 
@@ -51,7 +51,7 @@ def compare(measured: Trace, simulated: Trace, bin_deg: float = 1.0, settle_s: f
     """Align the traces and compute the row.
 
     ``settle_s`` is the simulated start-up left out of the simulation's profiles; by default three cage
-    revolutions (:func:`~comparison.align.simulation_settle_s`).
+    revolutions (:func:`~cageless.comparison.align.simulation_settle_s`).
 
     Raises
     ------

@@ -14,8 +14,8 @@ from pathlib import Path
 import pandas as pd
 
 from cageless.atomic import atomic_write_text
-from comparison.compare import ComparisonRow
-from comparison.metrics import SLIP_RATE_DEFINITION
+from cageless.comparison.compare import ComparisonRow
+from cageless.comparison.metrics import SLIP_RATE_DEFINITION
 
 __all__ = ["table_frame", "to_csv", "to_markdown", "to_latex", "to_html", "write_tables", "HEADERS"]
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-from tracking.synthetic.lab import make_lab
+from cageless.tracking.synthetic.lab import make_lab
 
 SEED = 2026
 

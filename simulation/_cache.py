@@ -7,7 +7,7 @@ modules (``models/*``, ``forces.py``, ``traction.py``) and compile in their slot
 the old physics. So every kernel of this package is cached under an explicit key: its own file's
 stamp together with the SHA-256 of every ``.py`` file of the package (:func:`source_digest`, computed
 once, when the first kernel of the package is decorated) and the digest of the race-contact laws
-registered at run time (:func:`simulation.models.race_laws.key`). A cache written under another digest no
+registered at run time (:func:`cageless.simulation.models.race_laws.key`). A cache written under another digest no
 longer matches; numba recompiles and overwrites it. Nothing is deleted behind the user's back:
 :func:`clear_cache` removes the package's cache files when asked.
 
@@ -68,7 +68,7 @@ class PackageSourcesLocator(caching._CacheLocator):
         return self._base.get_cache_path()
 
     def get_source_stamp(self) -> Any:
-        from simulation.models import race_laws  # laws registered at run time compile into the race contacts
+        from cageless.simulation.models import race_laws  # laws registered at run time compile into the race contacts
 
         return (self._base.get_source_stamp(), source_digest(), race_laws.key())
 

@@ -2,7 +2,7 @@
 
 :func:`solve_chunks` integrates a problem chunk by chunk (one progress-bar update per chunk, samples
 kept, internal steps not). With ``method="auto"`` it starts with the compiled DP5 and watches its
-stiffness test (:func:`simulation.integrators.dp5.dp5_integrate`, Hairer & Wanner's h |lambda| > 3.25).
+stiffness test (:func:`cageless.simulation.integrators.dp5.dp5_integrate`, Hairer & Wanner's h |lambda| > 3.25).
 When most steps of a chunk sit at the stability edge (fraction >= :data:`STIFF_FRACTION`), the
 step is set by stiffness rather than accuracy, as the paper's "Adams-GSTIFF" scheme switches to its
 stiff branch once contacts stiffen. The driver then probes the stiff backend,
@@ -35,7 +35,7 @@ throughout; with no way back CVODE ran to the end at 1.7 times DP5's
 wall time.
 
 The stiff backend cannot take a step back; after a switch it is stopped ahead of predicted contact
-onsets instead (see :func:`simulation.solve.step_cvode`).
+onsets instead (see :func:`cageless.simulation.solve.step_cvode`).
 """
 
 from __future__ import annotations
@@ -47,9 +47,9 @@ import numpy as np
 import numpy.typing as npt
 from tqdm.auto import tqdm
 
-from simulation.kernels import PLANAR, SPATIAL
-from simulation.problem import Problem
-from simulation.solve import CvodeSession, Solution, solve, step_cvode
+from cageless.simulation.kernels import PLANAR, SPATIAL
+from cageless.simulation.problem import Problem
+from cageless.simulation.solve import CvodeSession, Solution, solve, step_cvode
 
 __all__ = ["solve_chunks", "default_max_step", "CONTACT_MAX_STEP_S", "MAX_STEP_S", "RTOL_FACTOR", "STIFF_FRACTION",
            "RHS_COST_US", "STEP_COST_US", "SWITCH_GAIN", "STIFF_METHOD", "PROBE_CHUNKS",
@@ -67,7 +67,7 @@ STIFF_METHOD = "CVODE"
 RHS_COST_US: dict[int, float] = {PLANAR: 1.8, SPATIAL: 6.0}
 #: Overhead of one accepted step by (method, model id) in us, beyond the right-hand sides the solve counted:
 #: measured as (wall - evaluations x RHS cost) / steps, best of 3 over 5 ms windows at 3000 rpm from a
-#: settled state. CVODE with the structured Jacobian (:mod:`simulation.jacobian`, its evaluations counted
+#: settled state. CVODE with the structured Jacobian (:mod:`cageless.simulation.jacobian`, its evaluations counted
 #: with the right-hand sides): planar 15.6 (20 kN) and 17.2 (500 N), taken as 17; spatial 29.2 (500 N) and
 #: 30.5 (500 N + 400 N axial; a 138-state dense LU and back-substitutions), taken as 30. scipy's LSODA ~21
 #: (its Python step loop). The compiled DP5 0 (its loop overhead is inside its per-evaluation cost).
@@ -86,7 +86,7 @@ SWITCH_GAIN = 0.6
 #: DP5 never reaches it in practice (the race damping holds its step at ~1.2 us) and checks onsets itself.
 CONTACT_MAX_STEP_S = 2e-6
 #: Per-method default caps where they differ. CVODE is stopped ahead of contact onsets rather than retried
-#: across them (:func:`simulation.solve.step_cvode`); with at least 6 steps per impact its error control
+#: across them (:func:`cageless.simulation.solve.step_cvode`); with at least 6 steps per impact its error control
 #: resolves the impacts (measured before that onset control): over 5 ms at 1800 rpm from a bunched state (105 ball-ball
 #: episodes) a 5 us cap logged the same episodes as a DP5 rtol 1e-10 reference, with peak forces within
 #: 0.8 % and slip within 1.7e-3 pp, in 1126 steps (a 2 us cap: 4.4e-3 pp, 2608 steps; 20 us: 8.7e-3 pp).
@@ -166,7 +166,7 @@ def _go_back(stiff_rates: list[float], dp5_rate: float, time_s: float) -> dict[s
 def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: str, max_step: float | None,
                  chunks: int, progress: bool, max_steps: int, force_jump: float) -> Solution:
     """Integrate ``pr`` over the samples ``t`` in about ``chunks`` pieces; ``method`` is a key of
-    :data:`simulation.solve.METHODS` (``"auto"``: see the module text). ``max_step`` None gives each
+    :data:`cageless.simulation.solve.METHODS` (``"auto"``: see the module text). ``max_step`` None gives each
     method its default cap (:func:`default_max_step`), also after a switch; a number applies to all.
     ``rtol`` is scaled per method by :data:`RTOL_FACTOR`."""
     edges = np.unique(np.linspace(0, len(t) - 1, chunks + 1).astype(int))

@@ -6,12 +6,12 @@ error is measured against a tight-tolerance reference run in the same process:
 
 * the compiled Dormand-Prince loop across tolerances (rtol 1e-4 ... 1e-8);
 * SUNDIALS CVODE (BDF) across tolerances and step caps (2, 5, 20 us), and at its default settings
-  with each Jacobian of :data:`simulation.solve.JACOBIANS` and without its onset control;
+  with each Jacobian of :data:`cageless.simulation.solve.JACOBIANS` and without its onset control;
 * scipy's LSODA, BDF and DOP853 on the same compiled right-hand side;
 * scipy's LSODA on the plain-numpy right-hand side (the "numpy" baseline).
 
-CVODE and scipy's steppers run one accepted step at a time (:func:`simulation.solve.step_cvode`,
-:func:`simulation.solve.step_scipy`), so the contact bookkeeping after each accepted step is the same
+CVODE and scipy's steppers run one accepted step at a time (:func:`cageless.simulation.solve.step_cvode`,
+:func:`cageless.simulation.solve.step_scipy`), so the contact bookkeeping after each accepted step is the same
 for every candidate.
 
 The ball ring is chaotic, so the window is kept at a few milliseconds (two
@@ -32,15 +32,15 @@ import numpy.typing as npt
 
 from cageless.conditions import OperatingConditions
 from cageless.kinematics import theoretical_cage_speed
-from simulation.auto_switch import RTOL_FACTOR
-from simulation.effects import choose_model
-from simulation.models.planar_reference import reference_rhs
-from simulation.problem import Problem
+from cageless.simulation.auto_switch import RTOL_FACTOR
+from cageless.simulation.effects import choose_model
+from cageless.simulation.models.planar_reference import reference_rhs
+from cageless.simulation.problem import Problem
 
-from simulation.parameters import ModelParameters
-from simulation.scene import Scene
-from simulation.simulation import Choices, Simulation
-from simulation.solve import solve, step_cvode, step_scipy
+from cageless.simulation.parameters import ModelParameters
+from cageless.simulation.scene import Scene
+from cageless.simulation.simulation import Choices, Simulation
+from cageless.simulation.solve import solve, step_cvode, step_scipy
 
 __all__ = ["accuracy_study", "format_accuracy", "plot_accuracy", "model_study", "format_models", "effects_study",
            "format_effects", "OPTIONAL_EFFECTS"]
@@ -56,7 +56,7 @@ CANDIDATES: tuple[tuple[str, float, float], ...] = (
     ("LSODA", 1e-6, 2e-6), ("BDF", 1e-6, 2e-6), ("DOP853", 1e-6, 2e-6),
 )
 #: CVODE as ``simulate`` runs it (rtol 3e-8, 5 us) with one setting changed: the other Jacobians of
-#: :data:`simulation.solve.JACOBIANS` (the rows above use the structured one: what it saves, and what
+#: :data:`cageless.simulation.solve.JACOBIANS` (the rows above use the structured one: what it saves, and what
 #: SuperLU_MT's sparse factorisation costs at this size), and without the onset control (what stopping
 #: ahead of contact changes costs). Variant names are keys of :data:`_VARIANT_LABELS`.
 CVODE_VARIANTS: tuple[tuple[str, float, float, str], ...] = (
@@ -255,7 +255,7 @@ def effects_study(rpm: float = 1800.0, radial_load_n: float = 500.0, axial_load_
     that is off for the scene (e.g. drag without an oil-air mixture) is listed as not applicable.
     """
     from cageless.profiles import angle_profile
-    from simulation.run import peak_unloaded_slip
+    from cageless.simulation.run import peak_unloaded_slip
 
     from cageless.bearing import default_bearing
     from cageless.kinematics import startup_duration

@@ -23,7 +23,7 @@ from dataclasses import asdict, dataclass
 from typing import Any
 
 from cageless.errors import UsageError, suggest
-from simulation.scene import Scene
+from cageless.simulation.scene import Scene
 
 __all__ = [
     "EffectSpec", "EffectChoice", "ModelChoice", "EFFECTS", "LEVELS", "choose_model", "parse_effect_overrides",
@@ -41,13 +41,13 @@ class EffectSpec:
     physics: str
     rule: Callable[[Scene], tuple[bool, str]]
     needs_lubricant: bool = False
-    #: Slot of the effect's on/off flag in the models' parameter vector (:mod:`simulation.layout`).
+    #: Slot of the effect's on/off flag in the models' parameter vector (:mod:`cageless.simulation.layout`).
     flag: str = ""
     #: Slots of the parameters the effect's unit reads (filled by the model from
-    #: :class:`~simulation.parameters.ModelParameters` and the bearing).
+    #: :class:`~cageless.simulation.parameters.ModelParameters` and the bearing).
     slots: tuple[str, ...] = ()
     #: For an effect added by :func:`register_effect`: its slot values (name -> value) from the run's
-    #: :class:`~simulation.parameters.ModelParameters` (the built-in rows are filled by the models).
+    #: :class:`~cageless.simulation.parameters.ModelParameters` (the built-in rows are filled by the models).
     fill: Callable[[Any], Mapping[str, float]] | None = None
 
 
@@ -97,7 +97,7 @@ _BY_NAME = {e.name: e for e in EFFECTS}
 
 
 def register_effect(spec: EffectSpec) -> None:
-    """Add a row to the effects table (a new physics unit: see :mod:`simulation.models.race_laws`).
+    """Add a row to the effects table (a new physics unit: see :mod:`cageless.simulation.models.race_laws`).
 
     Raises
     ------

@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from cageless.parallel import gather, job_pool
-from simulation.simulation import Simulation
+from cageless.simulation.simulation import Simulation
 
 __all__ = ["run_ensemble", "seed_path"]
 
@@ -28,7 +28,7 @@ def seed_path(out: str | Path, seed: int) -> Path:
 
 
 def _one(sim: Simulation, out: str, config: dict[str, Any] | None) -> dict[str, Any]:
-    from simulation.run import peak_unloaded_slip
+    from cageless.simulation.run import peak_unloaded_slip
 
     tr = sim.run(out=out, progress=False, config=config)
     sol = sim.solution
@@ -41,7 +41,7 @@ def _one(sim: Simulation, out: str, config: dict[str, Any] | None) -> dict[str, 
 
 def run_ensemble(sim: Simulation, n_seeds: int, out: str | Path, workers: int = 2, progress: bool = True,
                  scheduler: str | None = None, config: dict[str, Any] | None = None) -> list[dict[str, Any]]:
-    """Run seeds 0..n_seeds-1 of ``sim`` (:meth:`~simulation.simulation.Simulation.with_seed`); one row per seed,
+    """Run seeds 0..n_seeds-1 of ``sim`` (:meth:`~cageless.simulation.simulation.Simulation.with_seed`); one row per seed,
     in seed order. ``config`` adds to each trace's recorded configuration.
 
     Locally the seeds run in ``workers`` spawned processes; with ``scheduler`` (a Dask scheduler

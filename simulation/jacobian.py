@@ -17,7 +17,7 @@ estimation of sparse Jacobian matrices", J. Inst. Math. Appl. 13 (1974) 117-119)
 three apart round the ring share no ball row, so one right-hand side with the same state of every
 ball of one colour perturbed gives all their ball rows at once. The ring and counter rows are sums
 over the balls and contacts, so each perturbed ball's own share of them is evaluated separately
-(:func:`simulation.kernels.model_ring_share`: its race contacts, its drag and the two ball-ball
+(:func:`cageless.simulation.kernels.model_ring_share`: its race contacts, its drag and the two ball-ball
 contacts it takes part in, a fraction of a right-hand side): with balls of one colour three apart,
 no contact joins two perturbed balls, so the change of a ball's share is the change of the sum.
 Fourteen balls need four colours: 5 x 4 + 4 = 24 right-hand sides per planar Jacobian instead of 76,
@@ -36,9 +36,9 @@ import numba
 import numpy as np
 import numpy.typing as npt
 
-from simulation.kernels import PLANAR, SPATIAL, model_rhs, model_ring_share
-from simulation.models import planar, spatial
-from simulation.problem import Problem
+from cageless.simulation.kernels import PLANAR, SPATIAL, model_rhs, model_ring_share
+from cageless.simulation.models import planar, spatial
+from cageless.simulation.problem import Problem
 
 __all__ = ["JacobianStructure", "ball_colours", "dense_fd_jacobian"]
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numba
 
-from simulation.models import planar, spatial, textbook, two_balls
+from cageless.simulation.models import planar, spatial, textbook, two_balls
 
 __all__ = ["PLANAR", "SPATIAL", "TWO_BALLS", "OSCILLATOR", "RICCATI", "model_rhs", "model_post", "model_signature",
            "model_ring_share", "model_gaps"]
@@ -55,7 +55,7 @@ def model_signature(model_id, y, p):  # pragma: no cover - compiled
 @numba.njit(cache=True)
 def model_gaps(model_id, y, p, out):  # pragma: no cover - compiled
     """Every contact's overlap (m, > 0 closed) for the ball-bearing models (3 Z values; see
-    :func:`simulation.models.planar.planar_gaps`)."""
+    :func:`cageless.simulation.models.planar.planar_gaps`)."""
     if model_id == PLANAR:
         planar.planar_gaps(y, p, out)
     elif model_id == SPATIAL:
@@ -65,7 +65,7 @@ def model_gaps(model_id, y, p, out):  # pragma: no cover - compiled
 @numba.njit(cache=True)
 def model_ring_share(model_id, t, y, p, log, j, out):  # pragma: no cover - compiled
     """Ball j's additive share of the rows every ball reaches (the ring's accelerations), for the structured
-    Jacobian of :mod:`simulation.jacobian`. Only the ball-bearing models have one."""
+    Jacobian of :mod:`cageless.simulation.jacobian`. Only the ball-bearing models have one."""
     if model_id == PLANAR:
         planar.planar_ring_share(t, y, p, log, j, out)
     elif model_id == SPATIAL:

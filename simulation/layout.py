@@ -3,11 +3,11 @@
 The compiled kernels take their parameters as one float array (numba compiles and caches one variant
 for it). Which number sits where is decided here, once, from names: a model's own body slots (its
 geometry, masses and drive), then, for every row of the effects table
-(:data:`simulation.effects.EFFECTS`), the effect's on/off flag and the slots of the parameters its
+(:data:`cageless.simulation.effects.EFFECTS`), the effect's on/off flag and the slots of the parameters its
 unit reads. A model reads a slot through a module-level integer constant taken from its layout
 (``P_KO = LAYOUT.index("KO")``), which numba freezes into the compiled code as a literal, so a named
 slot costs nothing at run time. Code outside a model reads a value by name
-(:meth:`simulation.problem.Problem.parameter`), never by position.
+(:meth:`cageless.simulation.problem.Problem.parameter`), never by position.
 """
 
 from __future__ import annotations

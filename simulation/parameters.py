@@ -14,7 +14,7 @@ Sources
   thickness Delta_r of the ball-ball squeeze film.
 * ``traction_peak_coefficient``, ``traction_peak_slide_roll``,
   ``traction_sliding_coefficient``: the traction curve of
-  :mod:`simulation.traction` (the Sakaguchi & Harada / Gupta regression form the
+  :mod:`cageless.simulation.traction` (the Sakaguchi & Harada / Gupta regression form the
   paper cites as [22], [23]), stated by its peak 0.06 at a slide-to-roll ratio of
   2 % and its sliding value 0.04. **These are representative values of mineral
   oil traction curves, not the coefficients of the paper's oil**: the paper does
@@ -77,7 +77,7 @@ class ModelParameters:
         sliding friction of a lubricated bearing.
     restitution
         Ball-ball coefficient of restitution R, in [0, 1]; 0 is perfectly plastic (represented by a
-        rebound below 0.1 %, :data:`simulation.forces.PLASTIC_CHI`).
+        rebound below 0.1 %, :data:`cageless.simulation.forces.PLASTIC_CHI`).
     drag_coefficient
         Drag coefficient C_D of a ball in the oil-air mixture, >= 0.
     dry_friction_coefficient
@@ -86,7 +86,7 @@ class ModelParameters:
         Sliding speed (m/s) over which the dry Coulomb friction builds up (tanh), > 0.
     dry_static_coefficient
         Static friction of a dry steel contact, at least ``dry_friction_coefficient`` and below 1, or None
-        (no Stribeck effect). See :func:`simulation.traction.dry_friction`.
+        (no Stribeck effect). See :func:`cageless.simulation.traction.dry_friction`.
     stribeck_speed_m_s
         Stribeck speed v_s (m/s) over which dry friction falls from the static to the Coulomb value, > 0.
     strips
@@ -157,8 +157,8 @@ class ModelParameters:
 
     @property
     def traction_coefficients(self) -> tuple[float, float, float, float]:
-        """(A, B, C, D) of the traction regression (:func:`simulation.traction.regression_coefficients`)."""
-        from simulation.traction import regression_coefficients
+        """(A, B, C, D) of the traction regression (:func:`cageless.simulation.traction.regression_coefficients`)."""
+        from cageless.simulation.traction import regression_coefficients
 
         return regression_coefficients(self.traction_peak_coefficient, self.traction_peak_slide_roll,
                                        self.traction_sliding_coefficient)

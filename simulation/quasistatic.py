@@ -24,7 +24,7 @@ import numpy.typing as npt
 
 from cageless.bearing import Geometry, Material
 from cageless.errors import ParameterError, SolverError
-from simulation.hertz import compliance, hertz_contact, race_curvatures
+from cageless.simulation.hertz import compliance, hertz_contact, race_curvatures
 
 __all__ = ["LoadDistribution", "series_stiffness", "radial_load_distribution"]
 

@@ -13,7 +13,7 @@ Sources
   brackets it by a factor 2 below and about 3 above.
 * ``restitution``: a coefficient of restitution lies in [0, 1] by definition.
 * traction coefficients: a choice bracketing the representative curve of
-  :mod:`simulation.parameters` (peak 0.06 at 2 %, sliding 0.04) by a factor 5 to 10 each way;
+  :mod:`cageless.simulation.parameters` (peak 0.06 at 2 %, sliding 0.04) by a factor 5 to 10 each way;
   the model additionally needs the peak above the sliding value.
 * ``drag_coefficient``: the smooth-sphere drag curve runs from about 4 at Re = 10 through 0.47
   (subcritical) to about 0.1 past the drag crisis (F. M. White, *Fluid Mechanics*, Fig. 7.16);

@@ -21,16 +21,16 @@ from cageless.errors import UsageError
 from cageless.kinematics import slip_rate, theoretical_cage_speed
 from cageless.profiles import angle_profile
 from cageless.trace import SimulationInfo, Trace
-from simulation.effects import ModelChoice
-from simulation.hertz import compliance, hertz_contact, race_curvatures
-from simulation.models import planar as P
-from simulation.models import spatial as S
-from simulation.models.observables import observables
-from simulation.parameters import ModelParameters
-from simulation.quasistatic import radial_load_distribution
-from simulation.scene import Scene
-from simulation.problem import Problem
-from simulation.solve import FORCE_JUMP, Solution
+from cageless.simulation.effects import ModelChoice
+from cageless.simulation.hertz import compliance, hertz_contact, race_curvatures
+from cageless.simulation.models import planar as P
+from cageless.simulation.models import spatial as S
+from cageless.simulation.models.observables import observables
+from cageless.simulation.parameters import ModelParameters
+from cageless.simulation.quasistatic import radial_load_distribution
+from cageless.simulation.scene import Scene
+from cageless.simulation.problem import Problem
+from cageless.simulation.solve import FORCE_JUMP, Solution
 
 __all__ = ["SimulationResult", "EnergyBalance", "build_problem", "check_supported", "energy_balance", "initial_state",
            "simulate", "to_trace",
@@ -75,7 +75,7 @@ def initial_state(scene: Scene) -> tuple[npt.NDArray[np.float64], npt.NDArray[np
     """Balls packed around the loaded zone (gap at the top), ring and balls in quasi-static equilibrium.
 
     The ring sinks by the displacement e that carries the radial load and the ring's weight
-    (Newton-Raphson, :func:`~simulation.quasistatic.radial_load_distribution`); each loaded ball sits
+    (Newton-Raphson, :func:`~cageless.simulation.quasistatic.radial_load_distribution`); each loaded ball sits
     where its inner and outer Hertz forces balance: delta_o = e cos(psi) / (1 + (K_o / K_i)^(2/3)).
     """
     b = scene.bearing
@@ -152,13 +152,13 @@ def simulate(scene: Scene, choice: ModelChoice, parameters: ModelParameters | No
              sample_rate_hz: float = 10_000.0, method: str = "auto", max_step: float | None = None,
              out: str | Path | None = None, progress: bool = True, config: dict[str, Any] | None = None,
              max_steps: int = 50_000_000, force_jump: float = FORCE_JUMP) -> SimulationResult:
-    """Run ``scene`` with the model ``choice``: :class:`simulation.simulation.Simulation` with these settings
-    (see :class:`~simulation.simulation.Choices` for them), its solution, trace and problem together.
+    """Run ``scene`` with the model ``choice``: :class:`cageless.simulation.simulation.Simulation` with these settings
+    (see :class:`~cageless.simulation.simulation.Choices` for them), its solution, trace and problem together.
 
     A solver failure does not raise: the result's ``solution.success`` is False and the trace's
     ``status`` says ``"incomplete: <why>"``; samples after the failure are NaN.
     """
-    from simulation.simulation import Choices, Simulation
+    from cageless.simulation.simulation import Choices, Simulation
 
     sim = Simulation(scene, parameters, Choices(method=method, rtol=rtol, max_step=max_step,
                                                 sample_rate_hz=sample_rate_hz, max_steps=max_steps,

@@ -2,10 +2,10 @@
 
 Every run is set up here and nowhere else, whoever asks for it (``cageless simulate``, its
 ensembles, ``cageless sweep``, the lab workflow, the benchmarks): the scene decides the model
-(:func:`simulation.effects.choose_model`, with the user's level and effect overrides from the
+(:func:`cageless.simulation.effects.choose_model`, with the user's level and effect overrides from the
 choices), the parameters fill its named slots, and the solver settings of the choices run it. All
 checks happen when the object is made, before anything compiles; :meth:`Simulation.run` builds the
-problem from the quasi-static start, solves it (:func:`simulation.auto_switch.solve_chunks`) and
+problem from the quasi-static start, solves it (:func:`cageless.simulation.auto_switch.solve_chunks`) and
 returns the trace, written atomically when asked. Shaped after PyBaMM's ``Simulation``
 (model, parameter values, solver; Sulzer et al., J. Open Res. Softw. 9 (2021) 14).
 """
@@ -25,11 +25,11 @@ import numpy as np
 from cageless.errors import ParameterError, suggest
 from cageless.provenance import Provenance
 from cageless.trace import Trace, write_trace
-from simulation.effects import ModelChoice, choose_model
-from simulation.parameters import ModelParameters
-from simulation.problem import Problem
-from simulation.scene import Scene
-from simulation.solve import FORCE_JUMP, METHODS, Solution
+from cageless.simulation.effects import ModelChoice, choose_model
+from cageless.simulation.parameters import ModelParameters
+from cageless.simulation.problem import Problem
+from cageless.simulation.scene import Scene
+from cageless.simulation.solve import FORCE_JUMP, METHODS, Solution
 
 __all__ = ["Choices", "Simulation"]
 
@@ -43,24 +43,24 @@ class Choices:
     level
         Force the model level (``"planar"`` or ``"spatial"``); None lets the scene choose.
     effects
-        Effect overrides, name -> on (see :func:`simulation.effects.choose_model`).
+        Effect overrides, name -> on (see :func:`cageless.simulation.effects.choose_model`).
     force
         Allow overrides that contradict the scene.
     method
-        A key of :data:`simulation.solve.METHODS`: ``"auto"`` (compiled DP5, switching to a stiff solver when
-        that pays: see :mod:`simulation.auto_switch`), ``"dp5"``, ``"CVODE"``, or one of scipy's.
+        A key of :data:`cageless.simulation.solve.METHODS`: ``"auto"`` (compiled DP5, switching to a stiff solver when
+        that pays: see :mod:`cageless.simulation.auto_switch`), ``"dp5"``, ``"CVODE"``, or one of scipy's.
     rtol
         Relative tolerance; CVODE runs at ``rtol x 0.03`` to match DP5's accuracy
-        (:data:`simulation.auto_switch.RTOL_FACTOR`).
+        (:data:`cageless.simulation.auto_switch.RTOL_FACTOR`).
     max_step
         Step cap (s) for every step; None gives each method its default
-        (:func:`simulation.auto_switch.default_max_step`: 2 us, 5 us for CVODE, also after a switch).
+        (:func:`cageless.simulation.auto_switch.default_max_step`: 2 us, 5 us for CVODE, also after a switch).
     sample_rate_hz
         Samples of the trace per simulated second.
     max_steps
         Bound on the accepted plus rejected steps of the whole run.
     force_jump
-        The force-jump fraction of :func:`simulation.solve.solve`.
+        The force-jump fraction of :func:`cageless.simulation.solve.solve`.
     """
 
     level: str | None = None
@@ -84,7 +84,7 @@ class Choices:
 
     def solver_config(self) -> dict[str, Any]:
         """The solver settings as the trace records them."""
-        from simulation.auto_switch import CONTACT_MAX_STEP_S, MAX_STEP_S, RTOL_FACTOR
+        from cageless.simulation.auto_switch import CONTACT_MAX_STEP_S, MAX_STEP_S, RTOL_FACTOR
 
         return {"method": self.method, "rtol": self.rtol, "max_step": self.max_step,
                 "default_max_step_s": {**MAX_STEP_S, "others": CONTACT_MAX_STEP_S}, "rtol_factor": RTOL_FACTOR,
@@ -99,7 +99,7 @@ class Simulation:
     scene
         What to simulate.
     parameters
-        The open model parameters (default :class:`~simulation.parameters.ModelParameters`).
+        The open model parameters (default :class:`~cageless.simulation.parameters.ModelParameters`).
     choices
         Model overrides and solver settings (default :class:`Choices`).
     model
@@ -115,7 +115,7 @@ class Simulation:
 
     def __init__(self, scene: Scene, parameters: ModelParameters | None = None, choices: Choices | None = None,
                  model: ModelChoice | None = None) -> None:
-        from simulation.run import check_supported
+        from cageless.simulation.run import check_supported
 
         self.scene = scene
         self.parameters = parameters or ModelParameters()
@@ -134,7 +134,7 @@ class Simulation:
 
     def build(self) -> Problem:
         """The planar or spatial problem from the quasi-static start (nothing is solved)."""
-        from simulation.run import build_problem
+        from cageless.simulation.run import build_problem
 
         return build_problem(self.scene, self.model, self.parameters)
 
@@ -151,8 +151,8 @@ class Simulation:
         A solver failure does not raise: :attr:`solution` ``.success`` is False and the trace's ``status``
         says ``"incomplete: <why>"``; samples after the failure are NaN.
         """
-        from simulation.auto_switch import solve_chunks
-        from simulation.run import to_trace
+        from cageless.simulation.auto_switch import solve_chunks
+        from cageless.simulation.run import to_trace
 
         c = self.choices
         prov = Provenance.start(config={"scene": self.scene.to_dict(), "model": json.loads(self.model.to_json()),

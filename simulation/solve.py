@@ -7,12 +7,12 @@
   force jumps by more than the fraction ``force_jump`` (see :func:`solve`), and counts both;
 * ``"CVODE"``: SUNDIALS CVODE's variable-order BDF (orders 1-5, Newton iteration) through
   scikit-sundae, on the compiled right-hand side, with the structured Jacobian of
-  :mod:`simulation.jacobian` (see :data:`JACOBIANS`): the stiff backend the automatic switch of
-  :mod:`simulation.auto_switch` goes to. Its loop is compiled C, so a step costs the right-hand-side calls
+  :mod:`cageless.simulation.jacobian` (see :data:`JACOBIANS`): the stiff backend the automatic switch of
+  :mod:`cageless.simulation.auto_switch` goes to. Its loop is compiled C, so a step costs the right-hand-side calls
   plus 17 us (planar) to 30 us (spatial) of Python and dense linear algebra;
 * ``"RK45"``, ``"DOP853"``, ``"LSODA"``, ``"BDF"``, ``"Radau"``: scipy's ``solve_ivp`` steppers on the
   same compiled right-hand side, as references; the implicit ones get the structured Jacobian too;
-* ``"auto"``: compiled DP5 switching to CVODE where that pays (:mod:`simulation.auto_switch`).
+* ``"auto"``: compiled DP5 switching to CVODE where that pays (:mod:`cageless.simulation.auto_switch`).
 
 CVODE and scipy's steppers are stepped one accepted step at a time here, so the accepted-step
 bookkeeping (contact episodes) runs after every step as it does in the compiled loop. They cannot
@@ -39,10 +39,10 @@ import numpy.typing as npt
 from scipy.integrate import BDF, DOP853, LSODA, RK45, Radau
 
 from cageless.errors import ParameterError, suggest
-from simulation.integrators.dp5 import STATUS_OK, dp5_integrate
-from simulation.jacobian import JacobianStructure
-from simulation.kernels import model_gaps, model_post, model_rhs
-from simulation.problem import Problem
+from cageless.simulation.integrators.dp5 import STATUS_OK, dp5_integrate
+from cageless.simulation.jacobian import JacobianStructure
+from cageless.simulation.kernels import model_gaps, model_post, model_rhs
+from cageless.simulation.problem import Problem
 
 __all__ = ["FORCE_JUMP", "Problem", "Solution", "Method", "METHODS", "CvodeSession", "solve", "step_scipy", "step_cvode"]
 
@@ -178,7 +178,7 @@ def _cvode_status(y: FloatArray, status: int) -> int:
 #: 10 ms at 1800 rpm from the packed start: no control 16 of 19, 1257 / 9 of 204, 12497 steps; 1.0: 6, 1330
 #: / 3, 12597; 0.7: 0, 1357 / 0, 12822; 0.5: 0, 1401 / 0, 12440.
 ONSET_APPROACH = 0.7
-#: CVODE's Jacobian and linear solver: ``"sparse"``, the structured Jacobian of :mod:`simulation.jacobian`
+#: CVODE's Jacobian and linear solver: ``"sparse"``, the structured Jacobian of :mod:`cageless.simulation.jacobian`
 #: factorised by SuperLU_MT; ``"structured"``, the same Jacobian in CVODE's dense LU; ``"dense"``, CVODE's own
 #: difference quotients (one right-hand side per state) and dense LU. Models without a structure (the test
 #: models) always use ``"dense"``.
@@ -236,7 +236,7 @@ class CvodeSession:
     n_rhs: int = 0
     #: Jacobians evaluated by the structured routine (CVODE's own difference quotients are not counted here).
     n_jac: int = 0
-    #: Onset control (see :func:`step_cvode`): the contact overlaps (:func:`simulation.kernels.model_gaps`)
+    #: Onset control (see :func:`step_cvode`): the contact overlaps (:func:`cageless.simulation.kernels.model_gaps`)
     #: at the last step end and before it, and the predicted time from there to the next contact change.
     gaps: FloatArray | None = None
     gaps_before: FloatArray | None = None
@@ -383,9 +383,9 @@ def _scipy(method: str) -> Callable[..., Solution]:
 
 def _auto(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float, first_step: float | None,
           max_steps: int, force_jump: float) -> Solution:
-    """The automatic switch (:mod:`simulation.auto_switch`): compiled DP5, then CVODE where that pays, in up to
+    """The automatic switch (:mod:`cageless.simulation.auto_switch`): compiled DP5, then CVODE where that pays, in up to
     50 chunks. An infinite ``max_step`` gives each method its default cap; ``first_step`` is not used."""
-    from simulation.auto_switch import solve_chunks
+    from cageless.simulation.auto_switch import solve_chunks
 
     cap = max_step if np.isfinite(max_step) else None
     start = t_eval if t_eval[0] == pr.t0 else np.concatenate([[pr.t0], t_eval])
@@ -398,8 +398,8 @@ def _auto(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float, first_s
 class Method(Protocol):
     """What every entry of :data:`METHODS` is: a function from a problem and its sample times to a
     :class:`Solution` (the arguments of :func:`solve`, checked there). A method sees the right-hand side, the
-    contact hooks and the Jacobian structure through :mod:`simulation.kernels` and
-    :mod:`simulation.jacobian`, never the model's parameter layout."""
+    contact hooks and the Jacobian structure through :mod:`cageless.simulation.kernels` and
+    :mod:`cageless.simulation.jacobian`, never the model's parameter layout."""
 
     def __call__(self, pr: Problem, t_eval: FloatArray, rtol: float, max_step: float, first_step: float | None,
                  max_steps: int, force_jump: float) -> Solution: ...

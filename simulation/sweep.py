@@ -49,7 +49,7 @@ def _values(name: str, spec: str) -> list[float]:
 
 def parse_vary(items: Sequence[str], bearing: Bearing | None = None) -> dict[str, list[float]]:
     """``NAME=start:stop:count`` or ``NAME=v1,v2`` items into {canonical name: values}; names are checked."""
-    from simulation.parameters import ModelParameters
+    from cageless.simulation.parameters import ModelParameters
 
     bearing = bearing or default_bearing()
     model = [f.name for f in dataclasses.fields(ModelParameters)]
@@ -86,9 +86,9 @@ def simulate_point(point: Mapping[str, Any], base: Mapping[str, Any]) -> tuple[A
     from cageless.conditions import OperatingConditions
     from cageless.errors import CagelessError
     from cageless.kinematics import startup_duration
-    from simulation.parameters import ModelParameters
-    from simulation.scene import Scene
-    from simulation.simulation import Simulation
+    from cageless.simulation.parameters import ModelParameters
+    from cageless.simulation.scene import Scene
+    from cageless.simulation.simulation import Simulation
 
     scene_kw = {n: point.get(n, base[n]) for n in SCENE_NAMES}
     model = {k: v for k, v in point.items() if k not in SCENE_NAMES and "." not in k and k != "seed"}
@@ -109,7 +109,7 @@ def simulate_point(point: Mapping[str, Any], base: Mapping[str, Any]) -> tuple[A
 
 
 def _run_point(point: dict[str, Any], base: dict[str, Any]) -> dict[str, Any]:
-    from simulation.run import peak_unloaded_slip
+    from cageless.simulation.run import peak_unloaded_slip
 
     trace, sol, settle, error = simulate_point(point, base)
     if trace is None:

@@ -12,7 +12,7 @@ speed, floored at ``u_floor`` so a contact that barely rolls is sliding. The
 curve starts at mu(0) = 0 (A = -D), rises steeply to a peak mu_peak at a
 slide-to-roll ratio s_peak and falls to the sliding value D as s grows.
 :func:`regression_coefficients` turns those three readable quantities into
-(A, B, C, D), so the defaults of :class:`~simulation.parameters.ModelParameters`
+(A, B, C, D), so the defaults of :class:`~cageless.simulation.parameters.ModelParameters`
 are stated in the units a tribologist reads off a traction curve.
 
 Dry contacts use Coulomb friction with the Stribeck effect, regularised over a sliding speed v_reg:
@@ -38,8 +38,8 @@ import numba
 from scipy import optimize
 
 from cageless.errors import ParameterError
-from simulation.film import hamrock_dowson
-from simulation.hertz import HertzContact
+from cageless.simulation.film import hamrock_dowson
+from cageless.simulation.hertz import HertzContact
 
 __all__ = ["regression_traction", "dry_friction", "regression_coefficients", "traction_coefficient",
            "film_coefficient"]

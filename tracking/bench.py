@@ -3,12 +3,12 @@
 On full-size rendered footage (1280 x 800 px at 12.5 px/mm, 10,000 fps, 12-bit
 data in 16-bit cine words, read from the page cache) it measures:
 
-* end-to-end frames/s of :func:`tracking.pipeline.track_video` with both cores,
+* end-to-end frames/s of :func:`cageless.tracking.pipeline.track_video` with both cores,
   with the input hash cached (re-runs) and on a first run (hashing included,
   estimated as the slower of tracking and hashing, which overlap);
 * per detector (``mask`` / ``weighted`` / ``window``): frames/s, the RMS
   highlight-centroid error against the truth, and its ratio to the Cramér-Rao
-  bound (:mod:`tracking.synthetic.crb`);
+  bound (:mod:`cageless.tracking.synthetic.crb`);
 * per Savitzky-Golay window: the RMS revolution-speed error against the
   truth's instantaneous speed (a central difference of the noise-free truth
   angles), in % of the cage speed;
@@ -35,15 +35,15 @@ from cageless.bearing import default_bearing
 from cageless.conditions import OperatingConditions
 from cageless.kinematics import theoretical_cage_speed
 from cageless.provenance import hash_file
-from tracking.detect import DETECTORS, DetectorParams
-from tracking.io import open_video
-from tracking.kinematics import revolution_speed
-from tracking.pipeline import INPUT_HASH, TrackOptions, track_video
-from tracking.synthetic.camera import Appearance, Camera
-from tracking.synthetic.clip import render_clip
-from tracking.synthetic.crb import position_crb
-from tracking.synthetic.motion import KinematicLaw
-from tracking.synthetic.render import Renderer
+from cageless.tracking.detect import DETECTORS, DetectorParams
+from cageless.tracking.io import open_video
+from cageless.tracking.kinematics import revolution_speed
+from cageless.tracking.pipeline import INPUT_HASH, TrackOptions, track_video
+from cageless.tracking.synthetic.camera import Appearance, Camera
+from cageless.tracking.synthetic.clip import render_clip
+from cageless.tracking.synthetic.crb import position_crb
+from cageless.tracking.synthetic.motion import KinematicLaw
+from cageless.tracking.synthetic.render import Renderer
 
 __all__ = ["prepare_footage", "run_benchmark", "format_tables"]
 
@@ -131,7 +131,7 @@ def _trackpy(video: Path, truth: pd.DataFrame, n: int) -> dict[str, float]:
 def _peak_memory(video: Path) -> float:
     code = (
         "import resource; from cageless.bearing import default_bearing; "
-        "from cageless.conditions import OperatingConditions; from tracking.pipeline import track_video; "
+        "from cageless.conditions import OperatingConditions; from cageless.tracking.pipeline import track_video; "
         f"track_video(r'{video}', OperatingConditions({SPEED_RPM}, 500.0), default_bearing(), progress=False); "
         "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)"
     )

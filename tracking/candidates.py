@@ -9,7 +9,7 @@ selection", IJCV 30:79). A blob curves down in every direction, so both eigenval
 edge of a dark ball on a bright ring face, or a bright gap between two balls, curves in one direction
 only and gives ``lambda_min`` near 0. Two scales (the expected width and twice it) cover small and
 saturated, flat-topped highlights. Local maxima above a robust noise level (MAD of the response in the
-ball band) are the candidates; the global selection (:mod:`tracking.select`) does the real filtering.
+ball band) are the candidates; the global selection (:mod:`cageless.tracking.select`) does the real filtering.
 
 Tracklets link candidates over a burst of consecutive frames by an optimal assignment
 (:func:`scipy.optimize.linear_sum_assignment`) of tracklet predictions (constant velocity) to the next

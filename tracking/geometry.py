@@ -19,7 +19,7 @@ import numpy.typing as npt
 import pandas as pd
 
 from cageless.balls import ball_order, normalise_unwrapped
-from tracking.locate import fit_circle
+from cageless.tracking.locate import fit_circle
 
 __all__ = ["Orbit", "fit_orbit", "orbital_angles"]
 

@@ -27,10 +27,10 @@ import numpy.typing as npt
 import pandas as pd
 
 from cageless.errors import TrackingError
-from tracking.candidates import find_candidates
-from tracking.detect import Detections, DetectorParams, centroid_windows, detect_full
-from tracking.locate import fit_circle
-from tracking.select import Anchor, BallRing, anchor_at
+from cageless.tracking.candidates import find_candidates
+from cageless.tracking.detect import Detections, DetectorParams, centroid_windows, detect_full
+from cageless.tracking.locate import fit_circle
+from cageless.tracking.select import Anchor, BallRing, anchor_at
 
 __all__ = ["TRACK_COLUMNS", "TrackSetup", "BallCountWarning", "track_frames", "find_start"]
 

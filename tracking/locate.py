@@ -21,7 +21,7 @@ import numpy.typing as npt
 from scipy import optimize
 
 from cageless.errors import TrackingError
-from tracking.io.base import FrameSource
+from cageless.tracking.io.base import FrameSource
 
 __all__ = ["BearingLocation", "background_frame", "locate_bearing", "fit_circle"]
 

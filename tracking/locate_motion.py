@@ -1,6 +1,6 @@
 """Find the ball band from what moves, when the ring faces do not frame a dark band.
 
-The brightness-based localisation (:mod:`tracking.locate`) needs bright ring faces around a dark
+The brightness-based localisation (:mod:`cageless.tracking.locate`) needs bright ring faces around a dark
 ball band. Footage from another set-up may show dark ring faces, or balls over bright faces. What
 every such video shares is that the balls move and the ring faces do not (the inner ring turns, but
 its face is nearly rotationally symmetric). The per-pixel temporal spread of a sample of frames is
@@ -26,8 +26,8 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from tracking.io.base import FrameSource
-from tracking.locate import BearingLocation, _to_u8, fit_circle
+from cageless.tracking.io.base import FrameSource
+from cageless.tracking.locate import BearingLocation, _to_u8, fit_circle
 
 __all__ = ["motion_map", "locate_by_motion", "plausible_band"]
 

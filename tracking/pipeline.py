@@ -1,9 +1,9 @@
 """The tracking pipeline: one video in, one ``cageless-trace/1`` file and its QC out.
 
 :func:`track_video` runs the stages in order: localisation
-(:mod:`tracking.locate`), detection and identity (:mod:`tracking.detect`,
-:mod:`tracking.link`), geometry (:mod:`tracking.geometry`), kinematics
-(:mod:`tracking.kinematics`) and QC (:mod:`tracking.qc`). Frames stream in
+(:mod:`cageless.tracking.locate`), detection and identity (:mod:`cageless.tracking.detect`,
+:mod:`cageless.tracking.link`), geometry (:mod:`cageless.tracking.geometry`), kinematics
+(:mod:`cageless.tracking.kinematics`) and QC (:mod:`cageless.tracking.qc`). Frames stream in
 chunks, cropped to the ball annulus; memory does not grow with video length
 beyond the per-frame track table.
 """
@@ -30,15 +30,15 @@ from cageless.kinematics import slip_rate, theoretical_cage_speed
 from cageless.outputs import is_foreign_file
 from cageless.provenance import VIDEO_HASH, Provenance
 from cageless.trace import Trace, VideoInfo, write_trace
-from tracking.detect import DetectorParams, detect_full, noise_sigma, spot_sigma, static_defects
-from tracking.geometry import fit_orbit, orbital_angles
-from tracking.io import CineReader, FrameSource, open_video
-from tracking.kinematics import DEFAULT_WINDOW, revolution_speed
-from tracking.link import BallCountWarning, TrackSetup, track_frames
-from tracking.locate import BearingLocation, background_frame, locate_bearing
-from tracking.locate_motion import locate_by_motion, motion_map, plausible_band
-from tracking.qc import QCReport, build_qc, slip_warnings, write_qc, write_selection_qc
-from tracking.select import SPEED_BAND, Selection, SelectionError, select_balls
+from cageless.tracking.detect import DetectorParams, detect_full, noise_sigma, spot_sigma, static_defects
+from cageless.tracking.geometry import fit_orbit, orbital_angles
+from cageless.tracking.io import CineReader, FrameSource, open_video
+from cageless.tracking.kinematics import DEFAULT_WINDOW, revolution_speed
+from cageless.tracking.link import BallCountWarning, TrackSetup, track_frames
+from cageless.tracking.locate import BearingLocation, background_frame, locate_bearing
+from cageless.tracking.locate_motion import locate_by_motion, motion_map, plausible_band
+from cageless.tracking.qc import QCReport, build_qc, slip_warnings, write_qc, write_selection_qc
+from cageless.tracking.select import SPEED_BAND, Selection, SelectionError, select_balls
 
 __all__ = ["TrackOptions", "TrackResult", "track_video"]
 
@@ -171,7 +171,7 @@ def _locate(video: FrameSource, background: np.ndarray, bearing: Bearing, path: 
 def _setup(video: FrameSource, loc: BearingLocation, background: np.ndarray, bearing: Bearing,
            options: TrackOptions, frames: _CroppedFrames, conditions: OperatingConditions,
            path: Path) -> tuple[TrackSetup, Selection]:
-    """Masks and noise level, then the ball selection (:mod:`tracking.select`) and the highlight width."""
+    """Masks and noise level, then the ball selection (:mod:`cageless.tracking.select`) and the highlight width."""
     rows, cols = frames.rows, frames.cols
     margin = max(1.5, 0.04 * (loc.band_outer - loc.band_inner))
     mask = loc.annulus_mask(video.frame_shape, margin)[rows, cols]

@@ -24,9 +24,9 @@ import pandas as pd
 from cageless.atomic import atomic_path, atomic_write_text
 from cageless.profiles import angle_profile
 from cageless.trace import Trace
-from tracking.geometry import Orbit
-from tracking.io import open_video
-from tracking.locate import BearingLocation
+from cageless.tracking.geometry import Orbit
+from cageless.tracking.io import open_video
+from cageless.tracking.locate import BearingLocation
 
 __all__ = ["QC_LIMITS", "QCReport", "build_qc", "write_qc", "slip_warnings", "write_selection_qc",
            "REASON_COLOURS"]

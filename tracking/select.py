@@ -11,7 +11,7 @@ wedges between neighbouring balls travel with the balls but on circles at the ed
 
 The stage runs once per video on a few bursts of consecutive frames spread over the clip:
 
-1. blob candidates in every burst frame (:func:`tracking.candidates.find_candidates`), linked into
+1. blob candidates in every burst frame (:func:`cageless.tracking.candidates.find_candidates`), linked into
    tracklets;
 2. each tracklet's angular speed about the bearing centre: the plausible band for a ball's mean speed
    is :data:`SPEED_BAND` times ``omega_c`` (0.6-1.1: slip up to 25 % plus the unloaded-zone slow-down,
@@ -42,8 +42,8 @@ import numpy.typing as npt
 import pandas as pd
 
 from cageless.errors import TrackingError
-from tracking.candidates import Tracklet, bin_mask, find_candidates, link_tracklets, response_map, response_noise
-from tracking.locate import fit_circle
+from cageless.tracking.candidates import Tracklet, bin_mask, find_candidates, link_tracklets, response_map, response_noise
+from cageless.tracking.locate import fit_circle
 
 __all__ = ["SPEED_BAND", "MIN_SPACING", "BallRing", "Anchor", "Selection", "SelectionError", "select_balls",
            "anchor_at", "cyclic_select"]

@@ -11,7 +11,7 @@ import numpy.typing as npt
 import pandas as pd
 
 from cageless.trace import Trace
-from comparison.compare import Comparison, ComparisonRow
+from cageless.comparison.compare import Comparison, ComparisonRow
 
 __all__ = ["ConditionDescription", "describe_condition", "poincare_section", "tracking_verdict"]
 

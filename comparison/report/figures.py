@@ -13,7 +13,7 @@ from typing import Any
 import matplotlib
 import numpy as np
 
-from comparison.report.describe import ConditionDescription
+from cageless.comparison.report.describe import ConditionDescription
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)

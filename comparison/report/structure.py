@@ -8,11 +8,11 @@ from datetime import datetime, timezone
 from typing import Any
 
 from cageless import __version__
-from comparison.compare import ComparisonRow
-from comparison.metrics import SLIP_RATE_DEFINITION
-from comparison.report import figures
-from comparison.report.describe import ConditionDescription, tracking_verdict
-from comparison.table import table_frame, to_html
+from cageless.comparison.compare import ComparisonRow
+from cageless.comparison.metrics import SLIP_RATE_DEFINITION
+from cageless.comparison.report import figures
+from cageless.comparison.report.describe import ConditionDescription, tracking_verdict
+from cageless.comparison.table import table_frame, to_html
 
 __all__ = ["build_report"]
 

@@ -19,7 +19,7 @@ def _help(parser: argparse.ArgumentParser) -> str:
 
 
 def _reference() -> str:
-    from cageless.cli import SUBCOMMANDS, build_parser
+    from cageless.app.cli import SUBCOMMANDS, build_parser
 
     parser = build_parser()
     parts = ["## cageless", "", "```text", _help(parser), "```", ""]

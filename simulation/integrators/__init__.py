@@ -1,1 +1,1 @@
-"""Compiled integrators (see :mod:`simulation.solve` for the public entry point)."""
+"""Compiled integrators (see :mod:`cageless.simulation.solve` for the public entry point)."""

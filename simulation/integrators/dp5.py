@@ -12,8 +12,8 @@ the step ends (values and derivatives, both known), accurate to O(h^4), far
 below the tolerance at the small steps contact problems take.
 
 The right-hand side is the compiled kernel of the problem's model
-(:func:`simulation.kernels.model_rhs`, writing into ``dydt``, no allocation);
-:func:`~simulation.kernels.model_post` runs after every accepted step and may
+(:func:`cageless.simulation.kernels.model_rhs`, writing into ``dydt``, no allocation);
+:func:`~cageless.simulation.kernels.model_post` runs after every accepted step and may
 update the contact log ``log`` (contact bookkeeping). The kernels are
 reached by a static switch on the model id, so this loop is cached on disk.
 """
@@ -23,7 +23,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from simulation.kernels import model_post, model_rhs, model_signature
+from cageless.simulation.kernels import model_post, model_rhs, model_signature
 
 __all__ = ["dp5_integrate", "STATUS_OK", "STATUS_MAX_STEPS", "STATUS_STEP_UNDERFLOW", "STATUS_NONFINITE"]
 

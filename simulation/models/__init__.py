@@ -1,1 +1,1 @@
-"""Dynamical models assembled from the force laws of :mod:`simulation.forces`."""
+"""Dynamical models assembled from the force laws of :mod:`cageless.simulation.forces`."""

@@ -1,16 +1,16 @@
 """The parameter layout the ball-bearing models share, generated from the effects table.
 
 The planar model's slots are its body (ball count and size, masses, race diameters, the load and the
-drive) followed by every effect's flag and parameter slots (:func:`simulation.effects.parameter_slots`);
-the spatial model extends them (:data:`simulation.models.spatial.LAYOUT`). The ``P_*`` constants are
+drive) followed by every effect's flag and parameter slots (:func:`cageless.simulation.effects.parameter_slots`);
+the spatial model extends them (:data:`cageless.simulation.models.spatial.LAYOUT`). The ``P_*`` constants are
 the slot positions, module-level integers that numba compiles in as literals; only the models and
-their physics modules (:mod:`simulation.models.contact_laws`) use them.
+their physics modules (:mod:`cageless.simulation.models.contact_laws`) use them.
 """
 
 from __future__ import annotations
 
-from simulation.effects import parameter_slots
-from simulation.layout import ParameterLayout
+from cageless.simulation.effects import parameter_slots
+from cageless.simulation.layout import ParameterLayout
 
 __all__ = ["BODY_SLOTS", "LAYOUT"]
 

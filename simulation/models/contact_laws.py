@@ -2,18 +2,18 @@
 
 :func:`tangential` is the friction law of every sliding contact (race and ball-ball, planar and
 spatial): the lubricated traction curve, or dry Coulomb-Stribeck friction when the ``dry_friction``
-effect is on (:mod:`simulation.traction` holds the formulas). :data:`race_extra` adds the registered extra
-race-contact laws (:mod:`simulation.models.race_laws`).
+effect is on (:mod:`cageless.simulation.traction` holds the formulas). :data:`race_extra` adds the registered extra
+race-contact laws (:mod:`cageless.simulation.models.race_laws`).
 """
 
 from __future__ import annotations
 
 import numba
 
-from simulation.models import race_laws
-from simulation.models.base import (LAYOUT, P_DRY, P_MU_DRY, P_MU_STATIC, P_TA, P_TB, P_TC, P_TD, P_U_FLOOR, P_V_REG,
+from cageless.simulation.models import race_laws
+from cageless.simulation.models.base import (LAYOUT, P_DRY, P_MU_DRY, P_MU_STATIC, P_TA, P_TB, P_TC, P_TD, P_U_FLOOR, P_V_REG,
                                     P_V_STRIBECK)
-from simulation.traction import dry_friction, regression_traction
+from cageless.simulation.traction import dry_friction, regression_traction
 
 __all__ = ["tangential", "race_extra", "RACE_LAWS"]
 
@@ -26,7 +26,7 @@ def tangential(u_s, u_r, q, p):  # pragma: no cover - compiled
     return regression_traction(u_s, u_r, q, p[P_TA], p[P_TB], p[P_TC], p[P_TD], p[P_U_FLOOR])
 
 
-#: The registered extra race-contact laws (:mod:`simulation.models.race_laws`), summed under their flags, and
+#: The registered extra race-contact laws (:mod:`cageless.simulation.models.race_laws`), summed under their flags, and
 #: whether there are any (a compile-time constant: with none, the race contacts compile without them).
 race_extra = race_laws.compose(LAYOUT)
 RACE_LAWS = race_laws.freeze()

@@ -1,7 +1,7 @@
 """What a run reports besides the states: contact forces, films, contact angles, positions and spins.
 
 Computed along the samples from the states with the models' named parameter slots (the plain-numpy
-traction law of :mod:`simulation.models.planar_reference`); the trace's ``balls``, ``contacts`` and
+traction law of :mod:`cageless.simulation.models.planar_reference`); the trace's ``balls``, ``contacts`` and
 ``inner_ring`` groups.
 """
 
@@ -10,13 +10,13 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from simulation.hertz import compliance, hertz_contact, race_curvatures
-from simulation.models import base as B
-from simulation.models import spatial as S
-from simulation.models.planar_reference import tangential_force
-from simulation.problem import Problem
-from simulation.scene import Scene
-from simulation.traction import film_coefficient
+from cageless.simulation.hertz import compliance, hertz_contact, race_curvatures
+from cageless.simulation.models import base as B
+from cageless.simulation.models import spatial as S
+from cageless.simulation.models.planar_reference import tangential_force
+from cageless.simulation.problem import Problem
+from cageless.simulation.scene import Scene
+from cageless.simulation.traction import film_coefficient
 
 __all__ = ["observables", "films"]
 

@@ -12,13 +12,13 @@ Effects, each gated by its flag so that an effect that is off is never evaluated
 * race contact: Hertz, ball to outer groove delta = r + D/2 - d_o/2, ball to the
   displaced inner groove delta = d_i/2 + D/2 - |P - C|;
 * lubricant damping C_ho d(delta)/dt at the race contacts, the total normal
-  force never tensile (default C_ho from :class:`~simulation.parameters.ModelParameters`);
-* race traction: the tangential force of :mod:`simulation.traction` against the
+  force never tensile (default C_ho from :class:`~cageless.simulation.parameters.ModelParameters`);
+* race traction: the tangential force of :mod:`cageless.simulation.traction` against the
   sliding of the ball surface on the race surface, with its moment on the spin;
   the ring's share is the drive's input power;
 * EHL film: the Hamrock-Dowson film feeds the traction law (off: a fixed film h_0);
 * ball-ball contact: Hertz with restitution-calibrated damping
-  (:func:`simulation.forces.hertz_damped`) and friction from the sliding of the
+  (:func:`cageless.simulation.forces.hertz_damped`) and friction from the sliding of the
   two surfaces (the same traction law, or dry Coulomb friction);
 * ball-ball film: squeeze film 6 pi eta (D/4)^2 (-dh/dt) / h between approaching
   neighbours with a gap below 4/3 Delta_r, h floored at Delta_r (= h_0);
@@ -44,23 +44,23 @@ import pandas as pd
 
 from cageless.bearing import Bearing
 from cageless.errors import ParameterError
-from simulation.forces import FASTMATH, damping_factor, hertz_damped, hertz_impact_duration
-from simulation.hertz import ball_ball_contact, compliance, hertz_contact, race_curvatures
-from simulation import effects as effects_table
-from simulation.effects import check_lubricant, effect_flags
-from simulation.parameters import ModelParameters
-from simulation.problem import Problem
-from simulation.models.base import (LAYOUT, P_CD, P_CHI, P_CHO, P_D, P_DI, P_DO, P_DRY, P_ETA0, P_FR,
+from cageless.simulation.forces import FASTMATH, damping_factor, hertz_damped, hertz_impact_duration
+from cageless.simulation.hertz import ball_ball_contact, compliance, hertz_contact, race_curvatures
+from cageless.simulation import effects as effects_table
+from cageless.simulation.effects import check_lubricant, effect_flags
+from cageless.simulation.parameters import ModelParameters
+from cageless.simulation.problem import Problem
+from cageless.simulation.models.base import (LAYOUT, P_CD, P_CHI, P_CHO, P_D, P_DI, P_DO, P_DRY, P_ETA0, P_FR,
                                     P_F_BB, P_F_BBFILM, P_F_DRAG, P_F_GRAV, P_F_LUB, P_F_RACE, P_F_TRAC, P_G, P_H0,
                                     P_I, P_KB, P_KI, P_KO, P_M, P_MR, P_RAMP, P_RHO_MIX, P_V_IN_MIN, P_WI, P_Z)
-from simulation.models.contact_laws import RACE_LAWS, race_extra, tangential
+from cageless.simulation.models.contact_laws import RACE_LAWS, race_extra, tangential
 
 __all__ = [
     "PlanarLayout", "planar_problem", "planar_energy", "packed_start", "contact_events", "DEFAULT_CHO_N_S_M",
     "RUBBING_FACTOR", "planar_ring_share", "planar_ring_rows", "planar_gaps",
 ]
 
-#: Id of this model in :mod:`simulation.kernels`.
+#: Id of this model in :mod:`cageless.simulation.kernels`.
 MODEL_ID = 0
 
 #: Lubricant damping coefficient at the race contacts (N s/m): the middle of the paper's 2500-7500 range.
@@ -261,7 +261,7 @@ def planar_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def planar_ring_share(t, y, p, log, j, out):  # pragma: no cover - compiled
-    """Ball j's share of the rows every ball reaches (see :mod:`simulation.jacobian`), in the order of
+    """Ball j's share of the rows every ball reaches (see :mod:`cageless.simulation.jacobian`), in the order of
     :func:`planar_ring_rows`: its inner-race force on the ring over the ring's mass (y'', z''), its
     race input power, and the dissipation that depends on its state (its race contacts, its drag and
     the two ball-ball contacts it takes part in)."""
@@ -325,7 +325,7 @@ def planar_gaps(y, p, out):  # pragma: no cover - compiled
     """Every contact's overlap (m; > 0 closed; :func:`_overlaps`), the quantities :func:`planar_signature`
     tests: outer race j at ``out[j]``, inner race j at ``out[z + j]``, balls j and j + 1 at
     ``out[2 z + j]``. CVODE's steps are stopped ahead of their predicted sign changes
-    (:mod:`simulation.solve`), so it does not step over a contact onset."""
+    (:mod:`cageless.simulation.solve`), so it does not step over a contact onset."""
     z = int(p[P_Z])
     d = p[P_D]
     for j in range(z):
@@ -464,10 +464,10 @@ def planar_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLi
                    theta_dot0: npt.ArrayLike | None = None, event_capacity: int = 10_000,
                    parameters: ModelParameters | None = None, speed_ramp_s: float = 0.0,
                    oil_air_density_kg_m3: float | None = None, spin0: npt.ArrayLike | None = None) -> Problem:
-    """The planar model from a given state, as a :class:`~simulation.solve.Problem`.
+    """The planar model from a given state, as a :class:`~cageless.simulation.solve.Problem`.
 
-    ``effects`` (name -> on, names of :data:`simulation.effects.EFFECTS`) says which effects are on; an
-    effect it does not name is off (:func:`simulation.effects.choose_model` gives a scene's choice). ``parameters`` holds
+    ``effects`` (name -> on, names of :data:`cageless.simulation.effects.EFFECTS`) says which effects are on; an
+    effect it does not name is off (:func:`cageless.simulation.effects.choose_model` gives a scene's choice). ``parameters`` holds
     the open model parameters; ``restitution`` and ``cho_n_s_m``, when given, replace theirs.
     The absolute tolerances (0.1 nm on positions, 0.1 um/s on speeds) are multiplied by ``atol_scale``;
     contact overlaps are micrometres, so energy-level checks want a smaller scale.
@@ -513,7 +513,7 @@ def planar_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLi
 
 def planar_jump_floor(p: npt.NDArray[np.float64], lay: PlanarLayout) -> npt.NDArray[np.float64]:
     """The accelerations a 1 N force (or a 1 N force at the ball's surface) gives each body: the floor of
-    the force-jump test on every velocity state, zero on the rest (see :class:`~simulation.problem.Problem`)."""
+    the force-jump test on every velocity state, zero on the rest (see :class:`~cageless.simulation.problem.Problem`)."""
     sl = lay.slices()
     z = lay.n_balls
     floor = np.zeros(lay.size)

@@ -1,6 +1,6 @@
 """A plain-numpy right-hand side of the planar model, for tests and the benchmark baseline only.
 
-It computes the same forces as :mod:`simulation.models.planar` with vectorised
+It computes the same forces as :mod:`cageless.simulation.models.planar` with vectorised
 numpy instead of compiled loops; the tests assert the two agree, and
 ``benchmarks`` time the compiled path against this one under ``solve_ivp``.
 """
@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from simulation.models import base as B
+from cageless.simulation.models import base as B
 
 __all__ = ["reference_rhs", "tangential_force"]
 

@@ -5,13 +5,13 @@ contact of overlap ``delta`` (m) closing at ``delta_dot`` (m/s), where the Hertz
 ``q`` (N); ``p`` is the model's parameter vector, which the law reads through its own named slots. It is
 registered with its row of the effects table (:func:`register_race_law`): the row's flag switches it
 (an effect that is off is never evaluated) and the row's slots, filled by the row's ``fill`` from the
-run's :class:`~simulation.parameters.ModelParameters`, are its parameters. Its force acts along the
+run's :class:`~cageless.simulation.parameters.ModelParameters`, are its parameters. Its force acts along the
 contact normal in both models (planar and spatial, both races), and its power ``f delta_dot`` is booked
 as dissipated.
 
 The models compile the registered laws into their race contact (:data:`race_extra`, generated here), so
 laws are registered before the models are imported (before the parameter layout is generated), and the
-cache key of the compiled kernels includes them (:func:`key`, :mod:`simulation._cache`). With none
+cache key of the compiled kernels includes them (:func:`key`, :mod:`cageless.simulation._cache`). With none
 registered, :data:`ANY` is False and the models' race contact compiles exactly as without this module.
 """
 
@@ -24,7 +24,7 @@ from typing import Any
 
 import numba
 
-from simulation.effects import EffectSpec, register_effect
+from cageless.simulation.effects import EffectSpec, register_effect
 
 __all__ = ["register_race_law", "compose", "key", "registered"]
 
@@ -39,7 +39,7 @@ def register_race_law(effect: EffectSpec, law: Any) -> None:
     RuntimeError
         When the models are already imported: their parameter layout and kernels are fixed then.
     """
-    if "simulation.models.base" in sys.modules:
+    if "cageless.simulation.models.base" in sys.modules:
         raise RuntimeError("register race-contact laws before the models are imported (simulation.models.base "
                            "generates the parameter layout from the effects table once)")
     register_effect(effect)
@@ -77,7 +77,7 @@ ANY = False
 
 
 def freeze() -> bool:
-    """Fix :data:`ANY` when the models import (called by :mod:`simulation.models.contact_laws`)."""
+    """Fix :data:`ANY` when the models import (called by :mod:`cageless.simulation.models.contact_laws`)."""
     global ANY
     ANY = bool(_LAWS)
     return ANY

@@ -41,12 +41,12 @@ import numpy as np
 import numpy.typing as npt
 
 from cageless.bearing import Bearing
-from simulation.forces import FASTMATH, hertz_damped
-from simulation.hertz import compliance, hertz_contact, race_curvatures
-from simulation.models import base as B
-from simulation.models import planar as P
-from simulation.models.contact_laws import RACE_LAWS, race_extra, tangential
-from simulation.problem import Problem
+from cageless.simulation.forces import FASTMATH, hertz_damped
+from cageless.simulation.hertz import compliance, hertz_contact, race_curvatures
+from cageless.simulation.models import base as B
+from cageless.simulation.models import planar as P
+from cageless.simulation.models.contact_laws import RACE_LAWS, race_extra, tangential
+from cageless.simulation.problem import Problem
 
 __all__ = ["MODEL_ID", "SpatialLayout", "spatial_problem", "spatial_rhs", "spatial_signature", "race_geometry",
            "spatial_energy", "spatial_ring_share", "spatial_ring_rows", "spatial_gaps"]
@@ -371,7 +371,7 @@ def spatial_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def spatial_ring_share(t, y, p, log, j, out):  # pragma: no cover - compiled
-    """Ball j's share of the rows every ball reaches (see :mod:`simulation.jacobian`), in the order of
+    """Ball j's share of the rows every ball reaches (see :mod:`cageless.simulation.jacobian`), in the order of
     :func:`spatial_ring_rows`: the ring's y'', z'', x'' and tilt accelerations from its inner-race contact,
     its race input power, and the dissipation that depends on its state (both race contacts, its drag
     and the two ball-ball contacts it takes part in)."""
@@ -414,7 +414,7 @@ def spatial_ring_rows(n_balls: int) -> list[int]:
 
 @numba.njit(cache=True, inline="always")
 def _overlaps(y, p, j, z, rot):  # pragma: no cover - compiled
-    """Ball j's contacts in three dimensions, as :func:`simulation.models.planar._overlaps` returns them."""
+    """Ball j's contacts in three dimensions, as :func:`cageless.simulation.models.planar._overlaps` returns them."""
     b = 5 * z + 6
     c, s = math.cos(y[z + j]), math.sin(y[z + j])
     k = j + 1 if j + 1 < z else 0
@@ -427,7 +427,7 @@ def _overlaps(y, p, j, z, rot):  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def spatial_signature(y, p):  # pragma: no cover - compiled
-    """Which contacts are closed, as a number (see :func:`simulation.models.planar.planar_signature`)."""
+    """Which contacts are closed, as a number (see :func:`cageless.simulation.models.planar.planar_signature`)."""
     z = int(p[B.P_Z])
     rot = _tilt(y, p)
     sig = 0.0
@@ -444,7 +444,7 @@ def spatial_signature(y, p):  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def spatial_gaps(y, p, out):  # pragma: no cover - compiled
-    """Every contact's overlap (m), as :func:`simulation.models.planar.planar_gaps` orders them, in three
+    """Every contact's overlap (m), as :func:`cageless.simulation.models.planar.planar_gaps` orders them, in three
     dimensions (the quantities :func:`spatial_signature` tests)."""
     z = int(p[B.P_Z])
     rot = _tilt(y, p)
@@ -459,7 +459,7 @@ def spatial_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayL
                     strips: int = 5, axial0: npt.ArrayLike | None = None, ring_axial0: float = 0.0,
                     moment_load_nm: float = 0.0, ring_tilt_inertia_kg_m2: float | None = None,
                     axial_gravity_m_s2: float = 0.0, **kw: object) -> Problem:
-    """The spatial model from a given state; keyword arguments as :func:`~simulation.models.planar.planar_problem`.
+    """The spatial model from a given state; keyword arguments as :func:`~cageless.simulation.models.planar.planar_problem`.
 
     ``strips`` is the number m of strips across each race contact ellipse (an accuracy knob; 1 is a
     point contact). ``misalignment_rad`` tilts the inner ring about y and z; the ring then tilts further

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from simulation.problem import Problem
+from cageless.simulation.problem import Problem
 
 __all__ = ["oscillator_problem", "riccati_problem", "OSCILLATOR", "RICCATI"]
 

@@ -10,12 +10,12 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from simulation.forces import damping_factor, hertz_damped
-from simulation.problem import Problem
+from cageless.simulation.forces import damping_factor, hertz_damped
+from cageless.simulation.problem import Problem
 
 __all__ = ["two_ball_problem", "MODEL_ID"]
 
-#: Id of this model in :mod:`simulation.kernels`.
+#: Id of this model in :mod:`cageless.simulation.kernels`.
 MODEL_ID = 1
 
 

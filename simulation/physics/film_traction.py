@@ -15,7 +15,7 @@ constitutive law at constant shear rate (no elastic transient):
     tau = tau_L [1 - exp(-eta_e |u_s| / (h tau_L))] sign(u_s),   tau_L = Lambda_LSS p,     (T2)
 
 u_s the sliding speed, h the film, eta_e the effective viscosity of the film (for example
-:func:`simulation.physics.viscosity.roelands` at the mean Hertz pressure), p the mean contact pressure. Over
+:func:`cageless.simulation.physics.viscosity.roelands` at the mean Hertz pressure), p the mean contact pressure. Over
 the contact, with p = Q / A:
 
     F_film = Lambda_LSS Q [1 - exp(-|u_s| / u_L)] sign(u_s),   u_L = max(tau_L h / eta_e, u_min),   (T3)
@@ -28,7 +28,7 @@ and |u_s| >> u_L the traction coefficient is Lambda_LSS (limiting-shear-stress-l
 :data:`DEFAULT_MIN_SLIP_SPEED_M_S`) floors u_L; the force is then within Lambda_LSS Q exp(-|u_s|/u_min) of
 (T3) and equal to it for |u_s| >> u_min. ``docs/physics/lubricant.md`` gives the measured slopes.
 
-Boundary: Coulomb friction with mu_b, regularised over v_reg (as :func:`simulation.traction.dry_friction`):
+Boundary: Coulomb friction with mu_b, regularised over v_reg (as :func:`cageless.simulation.traction.dry_friction`):
 
     F_b = mu_b Q tanh(u_s / v_reg).                                                  (T4)
 
@@ -43,7 +43,7 @@ C-infinity.
 
 The film thickness: Hamrock & Dowson, "Isothermal elastohydrodynamic lubrication of point contacts, Part
 III - Fully flooded results", J. Lubr. Technol. 99 (1977) 264-276, eqs. for H_c and H_min (as in
-:mod:`simulation.film`), compiled here for the right-hand sides.
+:mod:`cageless.simulation.film`), compiled here for the right-hand sides.
 """
 
 from __future__ import annotations

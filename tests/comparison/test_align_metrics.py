@@ -8,10 +8,10 @@ import pytest
 
 from cageless.errors import CagelessError
 from cageless.trace import SimulationInfo, Trace, VideoInfo
-from comparison.align import MismatchError, align_time, check_compatible, profiles
-from comparison.compare import ComparisonRow, compare
-from comparison.metrics import profile_errors, unloaded_peak
-from comparison.table import table_frame, to_csv, to_html, to_latex, to_markdown, write_tables
+from cageless.comparison.align import MismatchError, align_time, check_compatible, profiles
+from cageless.comparison.compare import ComparisonRow, compare
+from cageless.comparison.metrics import profile_errors, unloaded_peak
+from cageless.comparison.table import table_frame, to_csv, to_html, to_latex, to_markdown, write_tables
 
 VIDEO = VideoInfo(fps=10000.0, px_per_mm=12.5, centre_px=(640.0, 400.0), camera_roll_rad=0.0,
                   input_file="x.cine", input_sha256="ab" * 32)
@@ -107,7 +107,7 @@ def test_figures_restore_rcparams_and_close(tmp_path):
     import matplotlib
     import matplotlib.pyplot as plt
 
-    from comparison.report import describe_condition, figures
+    from cageless.comparison.report import describe_condition, figures
 
     measured = orbit_trace("video", bump(0.06), t_end=0.2)
     simulated = orbit_trace("simulation", bump(0.04), t_end=0.25)

@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 
 from cageless.conditions import OperatingConditions
-from comparison.report.describe import contact_track
-from simulation.effects import choose_model
-from simulation.models.spatial import ring_rotations
-from simulation.run import simulate
-from simulation.scene import Scene
+from cageless.comparison.report.describe import contact_track
+from cageless.simulation.effects import choose_model
+from cageless.simulation.models.spatial import ring_rotations
+from cageless.simulation.run import simulate
+from cageless.simulation.scene import Scene
 
 
 @pytest.fixture(scope="module")
@@ -46,8 +46,8 @@ def test_contact_points_lie_on_the_ball_surface_at_the_contact_angle(spatial):
 
 
 def test_contact_track_is_described_and_drawn(spatial):
-    from comparison.report.describe import ConditionDescription
-    from comparison.report.figures import contact_track_figure
+    from cageless.comparison.report.describe import ConditionDescription
+    from cageless.comparison.report.figures import contact_track_figure
 
     track = contact_track(spatial.trace, 0.005, max_points=500)
     assert track is not None and len(track["orbital_angle"]) <= 500
@@ -70,10 +70,10 @@ def test_the_report_of_a_spatial_condition_shows_the_contact_trajectory(spatial,
     from dataclasses import replace
 
     from cageless.trace import VideoInfo
-    from comparison.compare import compare
-    from comparison.report.describe import describe_condition
-    from comparison.report.render import write_report
-    from comparison.report.structure import build_report
+    from cageless.comparison.compare import compare
+    from cageless.comparison.report.describe import describe_condition
+    from cageless.comparison.report.render import write_report
+    from cageless.comparison.report.structure import build_report
 
     sim = spatial.trace
     video = replace(sim, source="video", simulation=None, groups={}, events=None, config={"slip_contact_angle_rad": 0.0},

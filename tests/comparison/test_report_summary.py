@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from comparison.compare import ComparisonRow
-from comparison.report.describe import ConditionDescription, tracking_verdict
-from comparison.report.render import render_html
-from comparison.report.structure import build_report
+from cageless.comparison.compare import ComparisonRow
+from cageless.comparison.report.describe import ConditionDescription, tracking_verdict
+from cageless.comparison.report.render import render_html
+from cageless.comparison.report.structure import build_report
 
 GOOD = {"n_balls_found": 14, "n_balls_expected": 14, "detection_rate": [1.0] * 14, "interpolated_share": 0.0,
         "orbit_residual_px": 0.02, "warnings": []}

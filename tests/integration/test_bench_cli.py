@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from cageless.cli import main
+from cageless.app.cli import main
 
 
 @pytest.mark.slow

@@ -12,8 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cageless.calibrate import Bound, calibrate, describe_calibration, parse_bounds, target_from_peak
-from cageless.cli import main
+from cageless.app.calibrate import Bound, calibrate, describe_calibration, parse_bounds, target_from_peak
+from cageless.app.cli import main
 from cageless.errors import ParameterError
 from cageless.trace import SimulationInfo, Trace, read_trace, write_trace
 
@@ -64,7 +64,7 @@ def test_ranges_are_canonical_and_aliases_accepted():
 
 
 def test_every_documented_range_names_a_parameter_and_is_accepted_whole():
-    from simulation.ranges import DOCUMENTED_RANGES
+    from cageless.simulation.ranges import DOCUMENTED_RANGES
 
     bounds = parse_bounds([f"{n}={r.low!r}:{r.high!r}" for n, r in DOCUMENTED_RANGES.items()])
     assert [b.name for b in bounds] == list(DOCUMENTED_RANGES)
@@ -182,10 +182,10 @@ TRUE, RANGE = 0.02, (0.012, 0.03)
 def _measured(tmp_path: Path, seed: int) -> tuple[Path, float]:
     from cageless.bearing import default_bearing
     from cageless.conditions import OperatingConditions
-    from simulation.parameters import ModelParameters
-    from simulation.run import peak_unloaded_slip
-    from simulation.scene import Scene
-    from simulation.simulation import Simulation
+    from cageless.simulation.parameters import ModelParameters
+    from cageless.simulation.run import peak_unloaded_slip
+    from cageless.simulation.scene import Scene
+    from cageless.simulation.simulation import Simulation
 
     scene = Scene(OperatingConditions(6000.0, 500.0, 0.0), default_bearing(), duration_s=0.07, seed=seed)
     trace = Simulation(scene, ModelParameters(traction_sliding_coefficient=TRUE)).run()
@@ -213,7 +213,7 @@ def test_calibration_recovers_a_known_traction_coefficient_from_a_trace(tmp_path
 def test_calibration_recovers_it_from_other_measurements_and_from_the_peak(tmp_path, seed):
     path, peak = _measured(tmp_path, seed)
     bound = [Bound("traction_sliding_coefficient", *RANGE)]
-    from cageless.calibrate import target_from_trace
+    from cageless.app.calibrate import target_from_trace
 
     by_trace = calibrate(target_from_trace(path, 0.05), bound, budget=10, seeds=2, settle_s=0.02, progress=False)
     by_peak = calibrate(target_from_peak(6000.0, 500.0, peak, duration_s=0.05), bound, budget=10, seeds=2,

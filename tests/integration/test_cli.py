@@ -10,7 +10,7 @@ import sys
 import pytest
 
 from cageless import __version__
-from cageless.cli import main
+from cageless.app.cli import main
 
 
 def test_version(capsys):
@@ -106,7 +106,7 @@ def test_console_script():
 def test_info_video_json(tmp_path, capsys):
     import numpy as np
 
-    from tracking.io import write_cine
+    from cageless.tracking.io import write_cine
 
     path = write_cine(tmp_path / "n3000.cine", np.zeros((4, 8, 8), np.uint16), fps=10000, fmt="p12",
                       timestamps_s=[0, 1e-4, 2e-4, 4e-4])

@@ -12,11 +12,11 @@ import sys
 
 import pytest
 
-from cageless.cli import SUBCOMMANDS, SUMMARIES, build_parser
+from cageless.app.cli import SUBCOMMANDS, SUMMARIES, build_parser
 
 #: Libraries that cost 0.1-1 s each to import; none is needed to print the version or the help.
 HEAVY = ("numpy", "numba", "scipy", "pandas", "matplotlib", "cv2", "h5py", "dask", "tqdm",
-         "tracking", "simulation", "comparison")
+         "cageless.tracking", "cageless.simulation", "cageless.comparison")
 
 
 def _modules_after(code: str) -> set[str]:
@@ -30,11 +30,11 @@ def _modules_after(code: str) -> set[str]:
 
 
 @pytest.mark.parametrize("code", [
-    "import cageless.cli",
+    "import cageless.app.cli",
     "import cageless",
-    "from cageless.cli import main; main(['--version'])",
-    "from cageless.cli import main; main(['--help'])",
-    "from cageless.cli import main; main([])",
+    "from cageless.app.cli import main; main(['--version'])",
+    "from cageless.app.cli import main; main(['--help'])",
+    "from cageless.app.cli import main; main([])",
 ])
 def test_startup_imports_no_heavy_module(code):
     loaded = {m.split(".")[0] for m in _modules_after(code)}
@@ -42,9 +42,9 @@ def test_startup_imports_no_heavy_module(code):
 
 
 def test_a_subcommand_imports_its_own_module_only():
-    loaded = _modules_after("from cageless.cli import main; main(['compare', '--help'])")
-    assert "cageless.cli.compare" in loaded
-    assert not {f"cageless.cli.{name}" for name in SUBCOMMANDS if name != "compare"} & loaded
+    loaded = _modules_after("from cageless.app.cli import main; main(['compare', '--help'])")
+    assert "cageless.app.cli.compare" in loaded
+    assert not {f"cageless.app.cli.{name}" for name in SUBCOMMANDS if name != "compare"} & loaded
 
 
 def test_summaries_match_the_registered_help():

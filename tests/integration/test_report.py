@@ -1,7 +1,7 @@
 """`cageless report` end to end: the sample lab, re-runs, failures, and footage of a simulation.
 
 The end-to-end check follows the comparison issue: render footage of a known simulation (the renderer
-of :mod:`tracking.synthetic`), run the report on it, and require MAE <= 0.5 percentage points between the
+of :mod:`cageless.tracking.synthetic`), run the report on it, and require MAE <= 0.5 percentage points between the
 measured and simulated slip profiles, since the "experiment" is the simulation itself; what remains is
 the tracking error (<= 0.3 pp slip-profile MAE in the tracking tests).
 """
@@ -17,13 +17,13 @@ import numpy as np
 import pandas as pd
 
 from cageless.bearing import default_bearing
-from cageless.cli import main
+from cageless.app.cli import main
 from cageless.conditions import OperatingConditions
 from cageless.kinematics import startup_duration
 from cageless.trace import Trace
-from simulation.effects import choose_model
-from simulation.run import simulate
-from simulation.scene import Scene
+from cageless.simulation.effects import choose_model
+from cageless.simulation.run import simulate
+from cageless.simulation.scene import Scene
 
 LAB = Path(__file__).resolve().parents[2] / "sample_data" / "lab"
 
@@ -83,9 +83,9 @@ def _after(trace: Trace, start_s: float) -> Trace:
 
 
 def test_footage_of_a_simulation_compares_within_tracking_accuracy(tmp_path, capsys):
-    from tracking.synthetic.camera import Appearance, Camera
-    from tracking.synthetic.clip import render_clip
-    from tracking.synthetic.render import Renderer
+    from cageless.tracking.synthetic.camera import Appearance, Camera
+    from cageless.tracking.synthetic.clip import render_clip
+    from cageless.tracking.synthetic.render import Renderer
 
     duration = 0.05
     bearing = default_bearing()

@@ -16,7 +16,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from cageless.lab import LabOptions, run_lab
+from cageless.app.lab import LabOptions, run_lab
 
 ROOT = Path(__file__).resolve().parents[2]
 LAB = ROOT / "sample_data" / "lab"

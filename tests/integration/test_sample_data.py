@@ -9,9 +9,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from cageless.cli import main
+from cageless.app.cli import main
 from cageless.conditions import discover_lab
-from tracking.io import open_video
+from cageless.tracking.io import open_video
 
 LAB = Path(__file__).resolve().parents[2] / "sample_data" / "lab"
 

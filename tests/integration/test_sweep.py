@@ -5,9 +5,9 @@ from __future__ import annotations
 import pandas as pd
 import pytest
 
-from cageless.cli import main
+from cageless.app.cli import main
 from cageless.errors import ParameterError
-from simulation.sweep import parse_vary, run_sweep, sweep_grid
+from cageless.simulation.sweep import parse_vary, run_sweep, sweep_grid
 
 
 def test_vary_specs_and_grid():

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from cageless.cli import SUBCOMMANDS, main
+from cageless.app.cli import SUBCOMMANDS, main
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 

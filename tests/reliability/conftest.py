@@ -28,7 +28,7 @@ def mini_lab(tmp_path_factory: pytest.TempPathFactory) -> Path:
 @pytest.fixture
 def in_process_pool(monkeypatch: pytest.MonkeyPatch) -> None:
     """Run the report's jobs in threads of this process (the fast path for tests of the workflow itself)."""
-    monkeypatch.setattr("cageless.lab.job_pool", lambda workers=2, scheduler=None: ThreadPoolExecutor(1))
+    monkeypatch.setattr("cageless.app.lab.job_pool", lambda workers=2, scheduler=None: ThreadPoolExecutor(1))
 
 
 @pytest.fixture(scope="session")
@@ -36,7 +36,7 @@ def video_trace(tmp_path_factory: pytest.TempPathFactory, mini_lab: Path) -> Pat
     """A video trace of the mini lab's clip."""
     from cageless.bearing import default_bearing
     from cageless.conditions import discover_lab
-    from tracking.pipeline import track_video
+    from cageless.tracking.pipeline import track_video
 
     out = tmp_path_factory.mktemp("video_trace")
     entry = discover_lab(mini_lab)[0]
@@ -48,9 +48,9 @@ def sim_trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A 5 ms simulation trace at the mini lab's conditions (3000 r/min, 500 N)."""
     from cageless.bearing import default_bearing
     from cageless.conditions import OperatingConditions
-    from simulation.effects import choose_model
-    from simulation.run import simulate
-    from simulation.scene import Scene
+    from cageless.simulation.effects import choose_model
+    from cageless.simulation.run import simulate
+    from cageless.simulation.scene import Scene
 
     out = tmp_path_factory.mktemp("sim_trace") / "sim.trace.h5"
     scene = Scene(conditions=OperatingConditions(3000.0, 500.0), bearing=default_bearing(), duration_s=0.005)
@@ -61,11 +61,11 @@ def sim_trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
 @pytest.fixture(scope="session")
 def report_template(tmp_path_factory: pytest.TempPathFactory, mini_lab: Path) -> Path:
     """A finished report of the mini lab (made once; tests copy it and re-run on the copy)."""
-    from cageless.lab import LabOptions, run_lab
+    from cageless.app.lab import LabOptions, run_lab
 
     out = tmp_path_factory.mktemp("report_template") / "report"
     mp = pytest.MonkeyPatch()
-    mp.setattr("cageless.lab.job_pool", lambda workers=2, scheduler=None: ThreadPoolExecutor(1))
+    mp.setattr("cageless.app.lab.job_pool", lambda workers=2, scheduler=None: ThreadPoolExecutor(1))
     try:
         res = run_lab(mini_lab, out, LabOptions(duration_s=0.003, settle_s=0.002), progress=False)
     finally:

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from cageless.cli import main
+from cageless.app.cli import main
 
 REPO = Path(__file__).resolve().parents[2]
 SAMPLE_LAB = REPO / "sample_data" / "lab"

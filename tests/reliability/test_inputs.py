@@ -15,13 +15,13 @@ import pytest
 from faultlib import assert_clean, cli, flip_bits, parts
 
 from cageless.bearing import default_bearing
-from tracking.io import write_cine
-from tracking.io.cine import CineReader
-from tracking.io.cine_layout import SETUP_FIELDS
-from tracking.synthetic.camera import Appearance, Camera
-from tracking.synthetic.clip import render_clip
-from tracking.synthetic.motion import KinematicLaw
-from tracking.synthetic.render import Renderer
+from cageless.tracking.io import write_cine
+from cageless.tracking.io.cine import CineReader
+from cageless.tracking.io.cine_layout import SETUP_FIELDS
+from cageless.tracking.synthetic.camera import Appearance, Camera
+from cageless.tracking.synthetic.clip import render_clip
+from cageless.tracking.synthetic.motion import KinematicLaw
+from cageless.tracking.synthetic.render import Renderer
 
 G = default_bearing().geometry
 SMALL = Camera(width=320, height=200, px_per_mm=3.125, bit_depth=8)

@@ -31,7 +31,7 @@ def test_r01_sample_does_not_overwrite_a_users_recording(tmp_path, capsys):
 def test_r01_sample_may_replace_what_it_wrote_itself(tmp_path, capsys, monkeypatch):
     """A re-run into a folder that ``cageless sample`` filled is allowed (its manifest lists the names)."""
     calls = []
-    monkeypatch.setattr("tracking.synthetic.lab.make_lab", lambda out, **kw: calls.append(out) or [])
+    monkeypatch.setattr("cageless.tracking.synthetic.lab.make_lab", lambda out, **kw: calls.append(out) or [])
     lab = tmp_path / "s"
     assert_clean(cli(capsys, "sample", lab, "-q"), 0)
     for name in ("n6000_Fr500_Fa0.cine", "conditions.csv"):
@@ -143,7 +143,7 @@ def test_r30_unexpected_error_is_one_line_with_a_log(capsys, monkeypatch):
     def boom(args, config):
         raise RuntimeError("something nobody planned for\nsecond line")
 
-    monkeypatch.setattr("cageless.cli.info.run", boom)
+    monkeypatch.setattr("cageless.app.cli.info.run", boom)
     run = cli(capsys, "info")
     assert_clean(run, 1, "unexpected RuntimeError: something nobody planned for", "run with -v for the traceback")
     assert run.err.count("\n") == 1
@@ -159,7 +159,7 @@ def test_r30_disk_full_escaping_anywhere_is_one_line(capsys, monkeypatch):
     def full(args, config):
         raise OSError(errno.ENOSPC, "No space left on device", "/data/out/x.png")
 
-    monkeypatch.setattr("cageless.cli.info.run", full)
+    monkeypatch.setattr("cageless.app.cli.info.run", full)
     assert_clean(cli(capsys, "info"), 1, "no space left on /data/out/x.png")
 
 

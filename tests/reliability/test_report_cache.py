@@ -12,7 +12,7 @@ import shutil
 import pandas as pd
 from faultlib import QUICK_REPORT, assert_clean, cli, flip_bits, parts
 
-from cageless.lab import CACHE_NAME
+from cageless.app.lab import CACHE_NAME
 
 
 def _copy(report_template, tmp_path, name="report"):

@@ -14,10 +14,10 @@ import pytest
 
 from cageless.conditions import OperatingConditions
 from cageless.errors import ParameterError
-from simulation.effects import choose_model
-from simulation.parameters import ModelParameters
-from simulation.run import simulate
-from simulation.scene import Scene
+from cageless.simulation.effects import choose_model
+from cageless.simulation.parameters import ModelParameters
+from cageless.simulation.run import simulate
+from cageless.simulation.scene import Scene
 
 
 def _run(load: float, duration: float = 0.03, **par):
@@ -49,9 +49,9 @@ def test_a_switch_that_stops_paying_is_undone(monkeypatch):
     (simulation.auto_switch.SWITCH_WHEN_DRY: CVODE's energy balance drifts there), so the test allows it."""
     from dataclasses import replace
 
-    import simulation.auto_switch
+    import cageless.simulation.auto_switch
 
-    monkeypatch.setattr(simulation.auto_switch, "SWITCH_WHEN_DRY", True)
+    monkeypatch.setattr(cageless.simulation.auto_switch, "SWITCH_WHEN_DRY", True)
 
     scene = Scene(conditions=OperatingConditions(3000.0, 500.0), duration_s=0.02)
     scene = replace(scene, bearing=replace(scene.bearing, lubricant=None))

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from simulation.bench import CANDIDATES, CVODE_VARIANTS, accuracy_study, format_accuracy, plot_accuracy
+from cageless.simulation.bench import CANDIDATES, CVODE_VARIANTS, accuracy_study, format_accuracy, plot_accuracy
 
 
 def test_accuracy_study_table_and_plot(tmp_path):
@@ -21,7 +21,7 @@ def test_accuracy_study_table_and_plot(tmp_path):
 
 
 def test_model_fidelity_study_table():
-    from simulation.bench import format_models, model_study
+    from cageless.simulation.bench import format_models, model_study
 
     result = model_study(window_s=0.001, settle_s=0.01)
     rows = result["rows"]
@@ -40,7 +40,7 @@ def test_model_fidelity_study_table():
 
 
 def test_effects_ablation_table():
-    from simulation.bench import OPTIONAL_EFFECTS, effects_study, format_effects
+    from cageless.simulation.bench import OPTIONAL_EFFECTS, effects_study, format_effects
 
     result = effects_study(rpm=6000.0, duration_s=0.02, settle_s=0.01)
     rows = {r["removed"]: r for r in result["rows"]}

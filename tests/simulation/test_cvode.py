@@ -12,9 +12,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from simulation.bench import _settled_problem
-from simulation.models import planar as P
-from simulation.solve import solve
+from cageless.simulation.bench import _settled_problem
+from cageless.simulation.models import planar as P
+from cageless.simulation.solve import solve
 
 
 @pytest.fixture(scope="module")
@@ -40,7 +40,7 @@ def test_a_run_in_chunks_keeps_one_warm_integrator(settled):
     """In chunks, CVODE continues one integrator (simulation.solve.CvodeSession) instead of restarting cold
     at order 1 with a new Jacobian each time; measured over 20 ms at the spatial level, 50 cold restarts
     cost 35 % more right-hand-side calls (18506 against 13663), warm chunks 13657."""
-    from simulation.auto_switch import solve_chunks
+    from cageless.simulation.auto_switch import solve_chunks
 
     pr, cage = settled
     z = pr.n_balls
@@ -61,11 +61,11 @@ def test_cvode_is_stopped_ahead_of_contact_onsets():
     spreading): measured 204 contact changes, 9 of them inside longer steps without the control, 0 of 194
     with it, for 2.6 % more steps."""
     from cageless.conditions import OperatingConditions
-    from simulation.effects import choose_model
-    from simulation.parameters import ModelParameters
-    from simulation.run import build_problem
-    from simulation.scene import Scene
-    from simulation.solve import step_cvode
+    from cageless.simulation.effects import choose_model
+    from cageless.simulation.parameters import ModelParameters
+    from cageless.simulation.run import build_problem
+    from cageless.simulation.scene import Scene
+    from cageless.simulation.solve import step_cvode
 
     scene = Scene(conditions=OperatingConditions(1800.0, 500.0))
     pr = build_problem(scene, choose_model(scene), ModelParameters())

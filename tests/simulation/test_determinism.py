@@ -15,11 +15,11 @@ import sys
 _SCRIPT = """
 import hashlib, numpy as np
 from cageless.conditions import OperatingConditions
-from simulation.effects import choose_model
-from simulation.parameters import ModelParameters
-from simulation.scene import Scene
-from simulation.run import build_problem
-from simulation.solve import solve
+from cageless.simulation.effects import choose_model
+from cageless.simulation.parameters import ModelParameters
+from cageless.simulation.scene import Scene
+from cageless.simulation.run import build_problem
+from cageless.simulation.solve import solve
 scene = Scene(conditions=OperatingConditions(3000.0, 500.0, 0.0))
 pr = build_problem(scene, choose_model(scene), ModelParameters())
 sol = solve(pr, np.linspace(0.0, 2e-3, 21), rtol=1e-6, max_step=2e-6)

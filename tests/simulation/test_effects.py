@@ -8,11 +8,11 @@ import json
 import pytest
 
 from cageless.bearing import default_bearing
-from cageless.cli import main
+from cageless.app.cli import main
 from cageless.conditions import OperatingConditions
 from cageless.errors import ParameterError, UsageError
-from simulation.effects import EFFECTS, choose_model
-from simulation.scene import Scene
+from cageless.simulation.effects import EFFECTS, choose_model
+from cageless.simulation.scene import Scene
 
 
 def scene(**kw):
@@ -77,8 +77,8 @@ def test_impossible_scenes_fail_before_anything_runs():
 def test_the_parameter_layout_comes_from_the_table():
     """Every effect's flag and parameter slots are named slots of both models' parameter vectors, and the
     flags a builder writes are those of the effects it is given (an unnamed effect is off)."""
-    from simulation.effects import effect_flags
-    from simulation.models import planar, spatial
+    from cageless.simulation.effects import effect_flags
+    from cageless.simulation.models import planar, spatial
 
     for layout in (planar.LAYOUT, spatial.LAYOUT):
         for e in EFFECTS:

@@ -10,7 +10,7 @@ import math
 import pytest
 
 from cageless.errors import ParameterError
-from simulation.film import hamrock_dowson
+from cageless.simulation.film import hamrock_dowson
 
 
 def test_film_by_hand():

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from cageless.errors import ParameterError
-from simulation.models.textbook import oscillator_problem, riccati_problem
-from simulation.models.two_balls import two_ball_problem
-from simulation.solve import METHODS, solve
+from cageless.simulation.models.textbook import oscillator_problem, riccati_problem
+from cageless.simulation.models.two_balls import two_ball_problem
+from cageless.simulation.solve import METHODS, solve
 
 
 def oscillator(w: float = 2 * np.pi * 50):

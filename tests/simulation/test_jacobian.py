@@ -14,14 +14,14 @@ import pytest
 
 from cageless.conditions import OperatingConditions
 from cageless.errors import ParameterError
-from simulation.bench import _settled_problem
-from simulation.effects import choose_model
-from simulation.jacobian import JacobianStructure, ball_colours, dense_fd_jacobian
-from simulation.models import planar as P
-from simulation.parameters import ModelParameters
-from simulation.run import build_problem
-from simulation.scene import Scene
-from simulation.solve import step_cvode
+from cageless.simulation.bench import _settled_problem
+from cageless.simulation.effects import choose_model
+from cageless.simulation.jacobian import JacobianStructure, ball_colours, dense_fd_jacobian
+from cageless.simulation.models import planar as P
+from cageless.simulation.parameters import ModelParameters
+from cageless.simulation.run import build_problem
+from cageless.simulation.scene import Scene
+from cageless.simulation.solve import step_cvode
 
 
 @pytest.mark.parametrize("n_balls", range(1, 31))
@@ -94,7 +94,7 @@ def test_scipy_implicit_methods_use_it_and_follow_a_tight_reference(method):
     sparsity pattern). Over 2 ms from a settled 3000 rpm state they must follow a DP5 rtol 1e-10
     reference; bound 5e-3 pp, above the 1.7e-4 (LSODA) and 2.8e-3 pp (BDF) the README's work-precision
     table measures over 5 ms."""
-    from simulation.solve import solve
+    from cageless.simulation.solve import solve
 
     pr, cage = _settled_problem(3000.0, 500.0, 0.03)
     z = pr.n_balls

@@ -7,7 +7,7 @@ from types import SimpleNamespace
 
 import numba
 
-from simulation import _cache
+from cageless.simulation import _cache
 
 
 def test_the_key_follows_every_source_of_the_package(tmp_path):
@@ -23,7 +23,7 @@ def test_the_key_follows_every_source_of_the_package(tmp_path):
 
 
 def test_package_kernels_carry_the_digest_and_others_do_not():
-    from simulation.models import planar
+    from cageless.simulation.models import planar
 
     locator = planar.planar_rhs._cache._impl.locator
     assert isinstance(locator, _cache.PackageSourcesLocator)

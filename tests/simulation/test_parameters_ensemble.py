@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from cageless.cli import main
+from cageless.app.cli import main
 from cageless.errors import ParameterError
 from cageless.trace import read_trace
-from simulation.parameters import ModelParameters, parse_set_overrides
-from simulation.traction import regression_coefficients, traction_coefficient
+from cageless.simulation.parameters import ModelParameters, parse_set_overrides
+from cageless.simulation.traction import regression_coefficients, traction_coefficient
 
 
 def test_set_overrides_are_parsed_validated_and_suggested():
@@ -48,7 +48,7 @@ def test_dry_friction_follows_the_coulomb_stribeck_curve():
     """mu(u) = [mu_c + (mu_s - mu_c) exp(-(u/v_s)^2)] tanh(u/v_reg) (Olsson et al., Eur. J. Control 4 (1998)
     176-195, with the tanh regularisation of Andersson et al., Tribol. Int. 40 (2007) 580-587), evaluated
     by hand: static 0.15, Coulomb 0.1, v_s = 0.01 m/s, v_reg = 1e-3 m/s, load 10 N."""
-    from simulation.traction import dry_friction
+    from cageless.simulation.traction import dry_friction
 
     q, mu_c, mu_s, v_s, v_reg = 10.0, 0.1, 0.15, 0.01, 1e-3
     assert dry_friction(1.0, q, mu_c, v_reg, mu_s, v_s) == pytest.approx(1.0, rel=1e-12)  # far past v_s: Coulomb
@@ -89,9 +89,9 @@ def test_ensemble_on_a_local_cluster_matches_the_local_run(tmp_path):
     """One Dask task per seed gives the same traces as the local processes (the run is deterministic)."""
     distributed = pytest.importorskip("distributed", reason="dask[distributed] (the test extra) is not installed")
     from cageless.conditions import OperatingConditions
-    from simulation.ensemble import run_ensemble
-    from simulation.scene import Scene
-    from simulation.simulation import Simulation
+    from cageless.simulation.ensemble import run_ensemble
+    from cageless.simulation.scene import Scene
+    from cageless.simulation.simulation import Simulation
 
     sim = Simulation(Scene(conditions=OperatingConditions(6000.0, 500.0), duration_s=0.002))
     local = run_ensemble(sim, 2, tmp_path / "local.trace.h5", progress=False)

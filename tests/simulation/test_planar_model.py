@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from cageless.bearing import default_bearing
-from simulation.models.planar import PlanarLayout, packed_start, planar_energy, planar_problem
-from simulation.quasistatic import radial_load_distribution
-from simulation.solve import solve
+from cageless.simulation.models.planar import PlanarLayout, packed_start, planar_energy, planar_problem
+from cageless.simulation.quasistatic import radial_load_distribution
+from cageless.simulation.solve import solve
 
 B = default_bearing()
 G = B.geometry
@@ -91,7 +91,7 @@ ALL_ON = _on(race_traction=True, ehl_film=True, ball_ball_film=True, drag=True)
 @pytest.mark.parametrize("effects", [CORE, ALL_ON], ids=["core", "all-effects"])
 def test_compiled_and_numpy_right_hand_sides_agree(effects):
     """The compiled RHS against the plain-numpy reference, on perturbed states with contacts and motion."""
-    from simulation.models.planar_reference import reference_rhs
+    from cageless.simulation.models.planar_reference import reference_rhs
 
     rng = np.random.default_rng(5)
     th = packed_start(B, seed=2, spread=0.0)  # neighbours exactly touching
@@ -122,8 +122,8 @@ def test_dry_stribeck_right_hand_sides_agree():
     RHS against the plain-numpy reference on states whose contacts slide slower and faster than v_s."""
     from dataclasses import replace
 
-    from simulation.models.planar_reference import reference_rhs
-    from simulation.parameters import ModelParameters
+    from cageless.simulation.models.planar_reference import reference_rhs
+    from cageless.simulation.parameters import ModelParameters
 
     rng = np.random.default_rng(7)
     dry = replace(B, lubricant=None)
@@ -159,7 +159,7 @@ def _coasting_ball(v: float, **kw):
 def test_contact_episodes_are_logged_and_classified():
     """One ball sent at 0.3 m/s into its resting neighbour: the first logged episode is an impact on that pair,
     lasting about the Hertz impact duration (Johnson 1985, sect. 11.4) at that approach speed."""
-    from simulation.models.planar import contact_events
+    from cageless.simulation.models.planar import contact_events
 
     v = 0.3
     pr, t_end = _coasting_ball(v, restitution=0.9, effects=_on(lubricant_damping=False))
@@ -179,7 +179,7 @@ def test_contact_episodes_are_logged_and_classified():
 
 def test_sustained_contact_is_rubbing():
     """Balls packed in contact under gravity and a radial load press on each other for the whole run."""
-    from simulation.models.planar import contact_events
+    from cageless.simulation.models.planar import contact_events
 
     th = packed_start(B, seed=1, spread=0.0)
     pr = planar_problem(B, th, np.full(G.n_balls, 0.5 * G.pitch_diameter_m), (0.0, -2e-6), 500.0,
@@ -196,7 +196,7 @@ def test_contact_onset_is_not_stepped_over():
     (elastic Hertz peak k (5 m v^2 / 4k)^0.6, Johnson 1985 sect. 11.4, with m the reduced mass)."""
     from dataclasses import replace
 
-    from simulation.models.planar import contact_events
+    from cageless.simulation.models.planar import contact_events
 
     v = 0.3
     pr, t_end = _coasting_ball(v, restitution=1.0, effects=_on(lubricant_damping=False, race_contact=False))

@@ -18,8 +18,8 @@ import sys
 
 _SCRIPT = r"""
 import json, numba, numpy as np
-from simulation.effects import EffectSpec
-from simulation.models import race_laws
+from cageless.simulation.effects import EffectSpec
+from cageless.simulation.models import race_laws
 
 K_X = 2.0e6  # N/m: the example law's parameter
 SLOT = -1  # its slot in the parameter vector, known once the layout is generated (below); read at compile time
@@ -32,12 +32,12 @@ spec = EffectSpec("race_spring", "a linear spring k_x delta at the race contacts
                   lambda s: (True, "example law"), flag="F_SPRING", slots=("K_X",),
                   fill=lambda par: {"K_X": K_X})
 race_laws.register_race_law(spec, linear_spring)
-from simulation.models.base import LAYOUT
+from cageless.simulation.models.base import LAYOUT
 SLOT = LAYOUT.index("K_X")
 
 from cageless.conditions import OperatingConditions
-from simulation.scene import Scene
-from simulation.simulation import Choices, Simulation
+from cageless.simulation.scene import Scene
+from cageless.simulation.simulation import Choices, Simulation
 
 scene = Scene(conditions=OperatingConditions(3000.0, 500.0), duration_s=1e-3)
 on = Simulation(scene)

@@ -7,13 +7,13 @@ import json
 import numpy as np
 import pytest
 
-from cageless.cli import main
+from cageless.app.cli import main
 from cageless.conditions import OperatingConditions
 from cageless.errors import UsageError
 from cageless.trace import read_trace
-from simulation.effects import choose_model
-from simulation.run import initial_state, simulate
-from simulation.scene import Scene
+from cageless.simulation.effects import choose_model
+from cageless.simulation.run import initial_state, simulate
+from cageless.simulation.scene import Scene
 
 FORCE_OFF = ["--effect", "race_traction=off", "--effect", "ehl_film=off", "--effect", "ball_ball_film=off", "--force"]
 
@@ -91,10 +91,10 @@ def test_solver_failure_is_an_incomplete_trace(tmp_path):
 def test_ball_ball_friction_is_in_the_trace(axial):
     """Ball-ball friction (magnitude, N) where neighbours touch: zero where apart, never above the peak of the
     traction curve times the normal force (simulation.parameters: peak 0.06), and present in the packed start."""
-    from simulation.effects import choose_model
-    from simulation.parameters import ModelParameters
-    from simulation.run import simulate
-    from simulation.scene import Scene
+    from cageless.simulation.effects import choose_model
+    from cageless.simulation.parameters import ModelParameters
+    from cageless.simulation.run import simulate
+    from cageless.simulation.scene import Scene
     from cageless.conditions import OperatingConditions
 
     scene = Scene(conditions=OperatingConditions(3000.0, 500.0, axial), duration_s=0.01, initial_gap_fraction=0.0)
@@ -109,8 +109,8 @@ def test_one_run_object_sets_up_every_run():
     """Simulation(scene, parameters, choices).run() gives the trace simulate() gives (the same run, set up once),
     refuses bad settings when it is made, and an ensemble member differs only in its seed."""
     from cageless.errors import ParameterError
-    from simulation.parameters import ModelParameters
-    from simulation.simulation import Choices, Simulation
+    from cageless.simulation.parameters import ModelParameters
+    from cageless.simulation.simulation import Choices, Simulation
 
     scene = Scene(conditions=OperatingConditions(3000.0, 500.0), duration_s=5e-4)
     sim = Simulation(scene, ModelParameters(restitution=0.6), Choices(method="dp5", sample_rate_hz=20_000.0))

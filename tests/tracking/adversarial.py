@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from tracking.synthetic.render import Renderer, _Spot
+from cageless.tracking.synthetic.render import Renderer, _Spot
 
 __all__ = ["BrightBandRenderer"]
 

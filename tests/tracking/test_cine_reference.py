@@ -13,8 +13,8 @@ import json
 import numpy as np
 import pytest
 
-from tracking.io import open_video
-from tracking.io.cine import CineReader
+from cageless.tracking.io import open_video
+from cageless.tracking.io.cine import CineReader
 
 FILES = ("cine_781.cine", "cine_legacy.cine")
 

@@ -21,9 +21,9 @@ from pathlib import Path
 
 import pytest
 
-from tracking.synthetic.matrix import HOLDOUT, TUNING
-from tracking.synthetic.runner import run_seeds
-from tracking.synthetic.score import BARS
+from cageless.tracking.synthetic.matrix import HOLDOUT, TUNING
+from cageless.tracking.synthetic.runner import run_seeds
+from cageless.tracking.synthetic.score import BARS
 
 CI_SEEDS = (*TUNING[:8], *HOLDOUT[:8])
 ALL = [("TUNING", s) for s in TUNING] + [("HOLDOUT", s) for s in HOLDOUT]

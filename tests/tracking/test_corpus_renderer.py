@@ -18,12 +18,12 @@ import pytest
 from cageless.kinematics import theoretical_cage_speed
 from cageless.trace import Trace
 from cageless.units import rpm_to_rad_s
-from tracking.io import open_video
-from tracking.synthetic.appearance import draw_params
-from tracking.synthetic.corpus import clip_truth, render_clip, simulate_motion
-from tracking.synthetic.matrix import HOLDOUT, SETS, TUNING, coverage
-from tracking.synthetic.scene3d import FrameState, SceneRenderer
-from tracking.synthetic.score import BARS, ideal_trace, score_trace, truth_arrays
+from cageless.tracking.io import open_video
+from cageless.tracking.synthetic.appearance import draw_params
+from cageless.tracking.synthetic.corpus import clip_truth, render_clip, simulate_motion
+from cageless.tracking.synthetic.matrix import HOLDOUT, SETS, TUNING, coverage
+from cageless.tracking.synthetic.scene3d import FrameState, SceneRenderer
+from cageless.tracking.synthetic.score import BARS, ideal_trace, score_trace, truth_arrays
 
 SMALL = next(s for s in TUNING if (draw_params(s).width, draw_params(s).height) == (640, 480))
 
@@ -143,7 +143,7 @@ def test_sets_are_disjoint():
 
 # -- the scorer ------------------------------------------------------------------------------------------
 def _truth_trace(params, truth, omega_c, angle=None, window=21) -> Trace:
-    from tracking.kinematics import revolution_speed
+    from cageless.tracking.kinematics import revolution_speed
     tr = truth_arrays(truth)
     a = tr["angle"] if angle is None else angle
     speed = revolution_speed(tr["time"], a, window, 2)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from cageless.errors import VideoError
-from tracking.io import open_video, write_cine
+from cageless.tracking.io import open_video, write_cine
 
 
 @pytest.fixture()
@@ -25,7 +25,7 @@ def test_truncated_cine(tmp_path, good_cine):
     with pytest.raises(VideoError, match=r"cut.cine: is truncated: frame 4 of 5.*byte offset \d+") as err:
         open_video(cut)
     assert err.value.offset is not None and err.value.offset < len(raw)
-    from tracking.io.cine import CineReader
+    from cageless.tracking.io.cine import CineReader
 
     with CineReader(cut, allow_truncated=True) as video:
         assert len(video) == 4
@@ -75,7 +75,7 @@ def test_colour_cine_is_refused(tmp_path, good_cine):
 
 def test_corrupt_image_size(tmp_path, good_cine):
     path, _ = good_cine
-    from tracking.io.cine import CineReader
+    from cageless.tracking.io.cine import CineReader
 
     with CineReader(path) as video:
         first = int(video._data_start[0])
@@ -107,7 +107,7 @@ def test_unknown_suffix_missing_and_empty_folder(tmp_path):
 
 
 def test_image_sequence_without_timing(tmp_path):
-    from tracking.io import write_image_sequence
+    from cageless.tracking.io import write_image_sequence
 
     folder = write_image_sequence(tmp_path / "seq", np.zeros((2, 4, 4), np.uint8))
     with open_video(folder) as video:
@@ -116,7 +116,7 @@ def test_image_sequence_without_timing(tmp_path):
 
 
 def test_damaged_image_in_sequence(tmp_path):
-    from tracking.io import write_image_sequence
+    from cageless.tracking.io import write_image_sequence
 
     folder = write_image_sequence(tmp_path / "seq", np.zeros((3, 4, 4), np.uint8), suffix=".png")
     (folder / "frame_000001.png").write_bytes(b"not a png")

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tracking.io import open_video, write_cine, write_ffv1, write_image_sequence
-from tracking.io.packing import pack10, pack12, unpack10, unpack12
+from cageless.tracking.io import open_video, write_cine, write_ffv1, write_image_sequence
+from cageless.tracking.io.packing import pack10, pack12, unpack10, unpack12
 
 
 def frames(n: int, h: int, w: int, bits: int, seed: int = 0) -> np.ndarray:

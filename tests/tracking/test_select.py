@@ -20,18 +20,18 @@ import pandas as pd
 import pytest
 
 from cageless.bearing import default_bearing
-from cageless.cli import main
+from cageless.app.cli import main
 from cageless.conditions import OperatingConditions
 from cageless.errors import TrackingError
 from cageless.kinematics import theoretical_cage_speed
 from cageless.profiles import angle_profile
-from tracking.candidates import Candidates, link_tracklets
-from tracking.kinematics import DEFAULT_WINDOW, revolution_speed
-from tracking.pipeline import track_video
-from tracking.select import cyclic_select
-from tracking.synthetic.camera import Appearance, Camera
-from tracking.synthetic.clip import frames_for_revolutions, render_clip
-from tracking.synthetic.motion import KinematicLaw
+from cageless.tracking.candidates import Candidates, link_tracklets
+from cageless.tracking.kinematics import DEFAULT_WINDOW, revolution_speed
+from cageless.tracking.pipeline import track_video
+from cageless.tracking.select import cyclic_select
+from cageless.tracking.synthetic.camera import Appearance, Camera
+from cageless.tracking.synthetic.clip import frames_for_revolutions, render_clip
+from cageless.tracking.synthetic.motion import KinematicLaw
 
 sys.path.insert(0, str(Path(__file__).parent))
 from adversarial import BrightBandRenderer  # noqa: E402
@@ -141,7 +141,7 @@ def test_a_clip_without_balls_is_refused(tmp_path):
     clip = render_clip(tmp_path / "still.cine", r, 40, law=law, fmt="cine-16")
     video = clip["video"]
     still = tmp_path / "still2.cine"
-    from tracking.io import open_video, write_cine
+    from cageless.tracking.io import open_video, write_cine
 
     with open_video(video) as v:
         frame = v[0]
@@ -157,7 +157,7 @@ def test_a_clip_without_balls_is_refused(tmp_path):
 def test_dark_ring_faces_are_located_by_motion(tmp_path):
     """Dark ring faces frame no dark band: the ball band is found from what moves, and the ball
     circle is chosen by its support (the annulus middle is not the pitch circle)."""
-    from tracking.synthetic.render import Renderer
+    from cageless.tracking.synthetic.render import Renderer
 
     look = Appearance(highlight_peak=0.85, ring_level=0.05, cavity_level=0.12, n_static_glints=8, glint_peak=1.2)
     clip = render_clip(tmp_path / "dark.cine", Renderer(G, CAM, look, seed=21),

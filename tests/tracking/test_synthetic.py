@@ -12,11 +12,11 @@ from cageless.errors import ParameterError
 from cageless.kinematics import theoretical_cage_speed
 from cageless.parameter_sets import wang2026
 from cageless.units import rpm_to_rad_s
-from tracking.io import open_video
-from tracking.synthetic.camera import Appearance, Camera
-from tracking.synthetic.clip import render_clip
-from tracking.synthetic.motion import KinematicLaw, paper_slip_peak
-from tracking.synthetic.render import Renderer
+from cageless.tracking.io import open_video
+from cageless.tracking.synthetic.camera import Appearance, Camera
+from cageless.tracking.synthetic.clip import render_clip
+from cageless.tracking.synthetic.motion import KinematicLaw, paper_slip_peak
+from cageless.tracking.synthetic.render import Renderer
 
 G = wang2026.geometry()
 PHI_MIN = 2 * math.asin(G.ball_diameter_m / G.pitch_diameter_m)  # smallest centre angle between touching balls
@@ -180,7 +180,7 @@ def test_parallel_rendering_is_identical(tmp_path):
 
 
 def test_full_preset_renders_the_papers_camera(tmp_path):
-    from tracking.synthetic.lab import make_lab
+    from cageless.tracking.synthetic.lab import make_lab
 
     results = make_lab(tmp_path, preset="full", revolutions=0.005, progress=False)
     with open_video(results[0]["video"]) as video:

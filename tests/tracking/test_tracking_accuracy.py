@@ -19,13 +19,13 @@ from cageless.bearing import default_bearing
 from cageless.conditions import OperatingConditions
 from cageless.kinematics import theoretical_cage_speed
 from cageless.profiles import angle_profile
-from tracking.kinematics import DEFAULT_WINDOW, revolution_speed
-from tracking.pipeline import track_video
-from tracking.synthetic.camera import Appearance, Camera
-from tracking.synthetic.clip import frames_for_revolutions, render_clip
-from tracking.synthetic.crb import position_crb
-from tracking.synthetic.motion import KinematicLaw
-from tracking.synthetic.render import Renderer
+from cageless.tracking.kinematics import DEFAULT_WINDOW, revolution_speed
+from cageless.tracking.pipeline import track_video
+from cageless.tracking.synthetic.camera import Appearance, Camera
+from cageless.tracking.synthetic.clip import frames_for_revolutions, render_clip
+from cageless.tracking.synthetic.crb import position_crb
+from cageless.tracking.synthetic.motion import KinematicLaw
+from cageless.tracking.synthetic.render import Renderer
 
 B = default_bearing()
 G = B.geometry

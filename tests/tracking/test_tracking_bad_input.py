@@ -10,16 +10,16 @@ import pandas as pd
 import pytest
 
 from cageless.bearing import default_bearing
-from cageless.cli import main
+from cageless.app.cli import main
 from cageless.conditions import OperatingConditions
 from cageless.errors import TrackingError, VideoError
 from cageless.trace import read_trace
-from tracking.io import write_cine
-from tracking.pipeline import track_video
-from tracking.synthetic.camera import Appearance, Camera
-from tracking.synthetic.clip import render_clip
-from tracking.synthetic.motion import KinematicLaw
-from tracking.synthetic.render import Renderer
+from cageless.tracking.io import write_cine
+from cageless.tracking.pipeline import track_video
+from cageless.tracking.synthetic.camera import Appearance, Camera
+from cageless.tracking.synthetic.clip import render_clip
+from cageless.tracking.synthetic.motion import KinematicLaw
+from cageless.tracking.synthetic.render import Renderer
 
 B = default_bearing()
 SMALL = Camera(width=320, height=200, px_per_mm=3.125, bit_depth=8)

@@ -10,7 +10,7 @@ Every case asserts:
 * finite states to the end;
 * no interpenetration beyond a few times the static Hertz deflection: every overlap stays below
   ``OVERLAP_FACTOR`` times the deflection of the most loaded outer contact under the static radial load
-  (Stribeck/Sjovall distribution, :func:`simulation.quasistatic.radial_load_distribution`) plus the
+  (Stribeck/Sjovall distribution, :func:`cageless.simulation.quasistatic.radial_load_distribution`) plus the
   centrifugal force m (d_m/2) omega_c^2 (Harris & Kotzalas, *Essential Concepts*, 5th ed., sect. 10.2),
   and never below 2 um. Measured: 1.1-7.1 times; the largest are ball-ball impacts right after the
   instantaneous start (22 um at R = 0.95, the Hertz overlap of a ~1 m/s impact);
@@ -34,12 +34,12 @@ from cageless.bearing import default_bearing
 from cageless.conditions import OperatingConditions
 from cageless.kinematics import startup_duration, theoretical_cage_speed
 from cageless.profiles import angle_profile
-from simulation.effects import choose_model
-from simulation.hertz import compliance, hertz_contact, race_curvatures
-from simulation.parameters import ModelParameters
-from simulation.quasistatic import radial_load_distribution
-from simulation.run import energy_balance, peak_unloaded_slip, simulate
-from simulation.scene import Scene
+from cageless.simulation.effects import choose_model
+from cageless.simulation.hertz import compliance, hertz_contact, race_curvatures
+from cageless.simulation.parameters import ModelParameters
+from cageless.simulation.quasistatic import radial_load_distribution
+from cageless.simulation.run import energy_balance, peak_unloaded_slip, simulate
+from cageless.simulation.scene import Scene
 
 #: "a few times the static Hertz deflection"
 OVERLAP_FACTOR = 8.0

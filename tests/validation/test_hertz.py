@@ -13,7 +13,7 @@ import pytest
 from scipy import special
 
 from cageless.parameter_sets import wang2026
-from simulation.hertz import ball_ball_contact, compliance, hamrock_brewe, hertz_contact, race_curvatures
+from cageless.simulation.hertz import ball_ball_contact, compliance, hamrock_brewe, hertz_contact, race_curvatures
 
 G, M = wang2026.geometry(), wang2026.material()
 

@@ -25,8 +25,8 @@ import math
 
 import pytest
 
-from simulation.film import hamrock_dowson
-from simulation.physics import drag, film_traction as ft, rolling_force as rf, viscosity as vis
+from cageless.simulation.film import hamrock_dowson
+from cageless.simulation.physics import drag, film_traction as ft, rolling_force as rf, viscosity as vis
 
 D = 9.525e-3
 RX = 0.5 * D * (46.005e-3 + D) / 46.005e-3

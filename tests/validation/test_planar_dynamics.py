@@ -13,7 +13,7 @@ References
   the largest step halved; the paper's own check moved 7.8 % -> 7.2 %).
 
 The absolute slip levels depend on the traction curve, whose default is representative rather than the
-paper's (see :mod:`simulation.parameters`); the tests assert the trends and the physics, not the levels.
+paper's (see :mod:`cageless.simulation.parameters`); the tests assert the trends and the physics, not the levels.
 """
 
 from __future__ import annotations
@@ -25,11 +25,11 @@ from cageless.bearing import default_bearing
 from cageless.conditions import OperatingConditions
 from cageless.kinematics import startup_duration, theoretical_cage_speed
 from cageless.profiles import angle_profile
-from simulation.effects import choose_model
-from simulation.models.planar import planar_problem
-from simulation.run import energy_balance, initial_state, peak_unloaded_slip, simulate
-from simulation.scene import Scene
-from simulation.solve import solve
+from cageless.simulation.effects import choose_model
+from cageless.simulation.models.planar import planar_problem
+from cageless.simulation.run import energy_balance, initial_state, peak_unloaded_slip, simulate
+from cageless.simulation.scene import Scene
+from cageless.simulation.solve import solve
 
 def settle(rpm: float) -> float:
     """The start-up left out of every profile: acceleration from rest, then the packed balls spread (three cage

@@ -15,13 +15,13 @@ import pytest
 
 from cageless.conditions import OperatingConditions
 from cageless.profiles import angle_profile
-from simulation.effects import choose_model
-from simulation.models import planar as P
-from simulation.models import spatial as S
-from simulation.run import build_problem, energy_balance, initial_state, peak_unloaded_slip, simulate
-from simulation.parameters import ModelParameters
-from simulation.scene import Scene
-from simulation.solve import solve
+from cageless.simulation.effects import choose_model
+from cageless.simulation.models import planar as P
+from cageless.simulation.models import spatial as S
+from cageless.simulation.run import build_problem, energy_balance, initial_state, peak_unloaded_slip, simulate
+from cageless.simulation.parameters import ModelParameters
+from cageless.simulation.scene import Scene
+from cageless.simulation.solve import solve
 
 SETTLE_S = 0.04
 #: The start-up of a pure radial run at 3000 rpm (cageless.kinematics.startup_duration: three cage revolutions).

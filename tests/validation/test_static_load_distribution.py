@@ -15,7 +15,7 @@ import pytest
 
 from cageless.errors import ParameterError
 from cageless.parameter_sets import wang2026
-from simulation.quasistatic import radial_load_distribution
+from cageless.simulation.quasistatic import radial_load_distribution
 
 G, M = wang2026.geometry(), wang2026.material()
 

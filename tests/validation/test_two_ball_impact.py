@@ -18,9 +18,9 @@ import pytest
 from scipy.integrate import quad
 
 from cageless.parameter_sets import wang2026
-from simulation.hertz import ball_ball_contact
-from simulation.models.two_balls import two_ball_problem
-from simulation.solve import solve
+from cageless.simulation.hertz import ball_ball_contact
+from cageless.simulation.models.two_balls import two_ball_problem
+from cageless.simulation.solve import solve
 
 G, MAT, MASS = wang2026.geometry(), wang2026.material(), wang2026.masses().ball_mass_kg
 K = ball_ball_contact(G, MAT).stiffness

@@ -27,7 +27,7 @@ after the start: measured peak slips were then 3.37 / 1.20 / 0.33 %, *below* the
 vibration energy feeds the balls. So switching it off is not possible here.
 
 **What is compared.** The quantity compared is the peak of the mean slip profile in the unloaded zone
-(:func:`simulation.run.peak_unloaded_slip`), over 0.1 s after the start-up. That is 1.2 / 2.0 / 4.0 cage
+(:func:`cageless.simulation.run.peak_unloaded_slip`), over 0.1 s after the start-up. That is 1.2 / 2.0 / 4.0 cage
 revolutions at the three speeds. With 0.05 s the 1800 rpm peak moved to 6.01 % (+0.40 pp), less than one
 revolution being covered. The remaining excess, 0.1-0.2 pp, comes from the ball-ball impacts of the full
 complement.
@@ -44,9 +44,9 @@ import pytest
 from cageless.bearing import default_bearing
 from cageless.conditions import OperatingConditions
 from cageless.kinematics import startup_duration, theoretical_cage_speed
-from simulation.effects import choose_model
-from simulation.run import peak_unloaded_slip, simulate
-from simulation.scene import Scene
+from cageless.simulation.effects import choose_model
+from cageless.simulation.run import peak_unloaded_slip, simulate
+from cageless.simulation.scene import Scene
 
 G = 9.81
 WINDOW_S = 0.1

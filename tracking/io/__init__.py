@@ -1,6 +1,6 @@
 """Frame sources: one lazy, random-access interface for every kind of video.
 
->>> from tracking.io import open_video
+>>> from cageless.tracking.io import open_video
 >>> with open_video("n3000_Fr500_Fa0.cine") as video:          # doctest: +SKIP
 ...     print(len(video), video.frame_shape, video.metadata.time_source)
 ...     for first, frames in video.iter_chunks(256):
@@ -15,11 +15,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from cageless.errors import VideoError
-from tracking.io.base import FrameSource, VideoMetadata
-from tracking.io.cine import CineReader
-from tracking.io.cine_write import CINE_FORMATS, write_cine
-from tracking.io.images import ImageSequenceReader, write_image_sequence
-from tracking.io.opencv import OpenCVReader, write_ffv1
+from cageless.tracking.io.base import FrameSource, VideoMetadata
+from cageless.tracking.io.cine import CineReader
+from cageless.tracking.io.cine_write import CINE_FORMATS, write_cine
+from cageless.tracking.io.images import ImageSequenceReader, write_image_sequence
+from cageless.tracking.io.opencv import OpenCVReader, write_ffv1
 
 __all__ = [
     "open_video", "FrameSource", "VideoMetadata", "CineReader", "OpenCVReader", "ImageSequenceReader",

@@ -34,8 +34,8 @@ import numpy as np
 import numpy.typing as npt
 
 from cageless.errors import VideoError
-from tracking.io.base import FrameSource, VideoMetadata
-from tracking.io.cine_layout import (
+from cageless.tracking.io.base import FrameSource, VideoMetadata
+from cageless.tracking.io.cine_layout import (
     BITMAPINFO,
     BITMAPINFO_FIELDS,
     BLOCK_HEADER,
@@ -48,7 +48,7 @@ from tracking.io.cine_layout import (
     TAG_TIME_ONLY,
     TIME64_FRACTION,
 )
-from tracking.io.packing import PACKED_BITS, unpack10, unpack12, unpack_frames_into
+from cageless.tracking.io.packing import PACKED_BITS, unpack10, unpack12, unpack_frames_into
 
 __all__ = ["CineReader"]
 

@@ -1,8 +1,8 @@
 """Write Phantom ``.cine`` files: 8-bit, 16-bit, packed 10-bit and packed 12-bit.
 
-Files are laid out as :mod:`tracking.io.cine_layout` describes, with a
+Files are laid out as :mod:`cageless.tracking.io.cine_layout` describes, with a
 time-stamp block (so dropped frames show as gaps) and an exposure block, and
-are written atomically. :class:`~tracking.io.cine.CineReader` reads back
+are written atomically. :class:`~cageless.tracking.io.cine.CineReader` reads back
 exactly what this writer wrote.
 """
 
@@ -20,7 +20,7 @@ import numpy.typing as npt
 from cageless._version import __version__
 from cageless.atomic import atomic_path
 from cageless.errors import ParameterError
-from tracking.io.cine_layout import (
+from cageless.tracking.io.cine_layout import (
     BITMAPINFO,
     BLOCK_HEADER,
     HEADER,
@@ -31,7 +31,7 @@ from tracking.io.cine_layout import (
     TAG_TIME_ONLY,
     TIME64_FRACTION,
 )
-from tracking.io.packing import pack10, pack12
+from cageless.tracking.io.packing import pack10, pack12
 
 __all__ = ["CineFormat", "write_cine", "CINE_FORMATS"]
 

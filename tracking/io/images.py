@@ -20,7 +20,7 @@ import numpy.typing as npt
 from cageless.atomic import atomic_path, atomic_write_text
 from cageless.conditions import IMAGE_SUFFIXES
 from cageless.errors import ParameterError, VideoError
-from tracking.io.base import FrameSource, VideoMetadata
+from cageless.tracking.io.base import FrameSource, VideoMetadata
 
 __all__ = ["ImageSequenceReader", "write_image_sequence", "list_images"]
 

@@ -4,7 +4,7 @@ Frames come back as 8-bit luminance (the first channel of OpenCV's gray-as-BGR
 decode). Random access seeks by ``CAP_PROP_POS_FRAMES`` in AVI, where it is
 exact; in MKV/MP4 it moves forward by grabbing frames and re-opens the file to
 go back, which is always exact but slow, so read those sequentially
-(:meth:`~tracking.io.base.FrameSource.iter_chunks`).
+(:meth:`~cageless.tracking.io.base.FrameSource.iter_chunks`).
 
 Containers store their frame rate as a rational that may be rounded, so give
 the true rate with ``fps`` (the conditions' ``fps`` key or ``--fps``) where it
@@ -27,7 +27,7 @@ import numpy.typing as npt
 
 from cageless.atomic import atomic_path
 from cageless.errors import ParameterError, VideoError
-from tracking.io.base import FrameSource, VideoMetadata
+from cageless.tracking.io.base import FrameSource, VideoMetadata
 
 __all__ = ["OpenCVReader", "write_ffv1"]
 

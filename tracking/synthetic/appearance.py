@@ -1,9 +1,9 @@
 """Parameters of one corpus clip, drawn from a seed: the bearing, the camera, the light and the faults.
 
 This is the parameter side of the second, independent renderer
-(:mod:`tracking.synthetic.scene3d`). :func:`draw_params` maps a seed to a
+(:mod:`cageless.tracking.synthetic.scene3d`). :func:`draw_params` maps a seed to a
 :class:`ClipParams` deterministically. Every appearance factor a lab varies is
-a field, so a matrix of seeds (:mod:`tracking.synthetic.matrix`) can mix them.
+a field, so a matrix of seeds (:mod:`cageless.tracking.synthetic.matrix`) can mix them.
 
 How a seed becomes a draw
 -------------------------

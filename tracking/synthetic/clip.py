@@ -27,9 +27,9 @@ from cageless.balls import ball_order, normalise_unwrapped
 from cageless.errors import ParameterError
 from cageless.kinematics import theoretical_cage_speed
 from cageless.units import rpm_to_rad_s
-from tracking.io import write_cine, write_ffv1, write_image_sequence
-from tracking.synthetic.motion import BallMotion, KinematicLaw
-from tracking.synthetic.render import TRUTH_COLUMNS, Renderer
+from cageless.tracking.io import write_cine, write_ffv1, write_image_sequence
+from cageless.tracking.synthetic.motion import BallMotion, KinematicLaw
+from cageless.tracking.synthetic.render import TRUTH_COLUMNS, Renderer
 
 __all__ = ["render_clip", "ClipResult"]
 

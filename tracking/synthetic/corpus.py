@@ -49,10 +49,10 @@ from cageless.conditions import OperatingConditions
 from cageless.errors import VideoError
 from cageless.kinematics import theoretical_cage_speed
 from cageless.units import rpm_to_rad_s
-from tracking.io import write_cine
-from tracking.synthetic.appearance import ClipParams, draw_params
-from tracking.synthetic.motion import KinematicLaw
-from tracking.synthetic.scene3d import FrameState, SceneRenderer
+from cageless.tracking.io import write_cine
+from cageless.tracking.synthetic.appearance import ClipParams, draw_params
+from cageless.tracking.synthetic.motion import KinematicLaw
+from cageless.tracking.synthetic.scene3d import FrameState, SceneRenderer
 
 __all__ = ["ClipSpec", "render_clip", "load_clip", "clip_truth", "TRUTH_COLUMNS", "clip_stem", "simulate_motion",
            "conditions_of", "describe"]
@@ -157,7 +157,7 @@ def conditions_of(params: ClipParams) -> OperatingConditions:
 def simulate_motion(params: ClipParams, n_frames: int) -> dict[str, np.ndarray]:
     """Frame plan and ball motion: kept frame indices, time stamps (s), angles, speeds, ring angle, dark flags.
 
-    The ball motion is :class:`~tracking.synthetic.motion.KinematicLaw` (hard balls on the pitch circle,
+    The ball motion is :class:`~cageless.tracking.synthetic.motion.KinematicLaw` (hard balls on the pitch circle,
     slip in the unloaded zone, bunching, cyclic order kept), sampled at each time stamp and 1 us either
     side in one integration, so the speed is a central difference of the true angle.
     """
@@ -220,7 +220,7 @@ def render_clip(seed: int, folder: str | Path, long: bool = False) -> ClipSpec:
     Parameters
     ----------
     seed
-        The clip's seed (:func:`~tracking.synthetic.appearance.draw_params`).
+        The clip's seed (:func:`~cageless.tracking.synthetic.appearance.draw_params`).
     folder
         Output folder, created if needed.
     long

@@ -2,7 +2,7 @@
 
 The bound used in the accuracy tests and ``cageless bench tracking``: the
 Fisher information of a Gaussian spot sampled at pixel centres (exactly how
-:mod:`tracking.synthetic.render` draws it),
+:mod:`cageless.tracking.synthetic.render` draws it),
 
     mu_i = A exp(-|x_i - x0|^2 / (2 s^2)) + b,
 

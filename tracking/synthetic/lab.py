@@ -37,10 +37,10 @@ from cageless.atomic import atomic_write_text
 from cageless.bearing import Geometry
 from cageless.errors import ParameterError
 from cageless.parameter_sets import wang2026
-from tracking.synthetic.camera import Appearance, Camera
-from tracking.synthetic.clip import frames_for_revolutions, render_clip
-from tracking.synthetic.motion import KinematicLaw
-from tracking.synthetic.render import Renderer
+from cageless.tracking.synthetic.camera import Appearance, Camera
+from cageless.tracking.synthetic.clip import frames_for_revolutions, render_clip
+from cageless.tracking.synthetic.motion import KinematicLaw
+from cageless.tracking.synthetic.render import Renderer
 
 __all__ = ["ClipSpec", "PRESETS", "make_lab"]
 

@@ -8,7 +8,7 @@
     scores only after a change is final.
 
 Each block of 8 consecutive seeds is a Latin hypercube over every factor
-(:mod:`tracking.synthetic.appearance`), so each set reaches both ends of every
+(:mod:`cageless.tracking.synthetic.appearance`), so each set reaches both ends of every
 range and every level of every categorical factor; :func:`coverage` checks it
 and ``python benchmarks/tracking_corpus.py`` prints the table.
 """
@@ -19,7 +19,7 @@ import math
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from tracking.synthetic.appearance import CONTAINERS, RESOLUTIONS, ClipParams, draw_params
+from cageless.tracking.synthetic.appearance import CONTAINERS, RESOLUTIONS, ClipParams, draw_params
 
 __all__ = ["TUNING", "HOLDOUT", "SETS", "CHECKS", "coverage", "format_coverage"]
 

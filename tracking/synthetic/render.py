@@ -26,8 +26,8 @@ import numpy.typing as npt
 import pandas as pd
 
 from cageless.bearing import Geometry
-from tracking.synthetic.camera import Appearance, Camera, RingRadii
-from tracking.synthetic.motion import BallMotion
+from cageless.tracking.synthetic.camera import Appearance, Camera, RingRadii
+from cageless.tracking.synthetic.motion import BallMotion
 
 __all__ = ["Renderer", "TRUTH_COLUMNS"]
 

@@ -6,8 +6,8 @@ Public API::
     run_seeds(seeds, folder, workers=2, long=False, progress=True) -> list[ClipResult]
 
 Each clip is rendered into ``folder`` (or reused), tracked by
-:func:`tracking.pipeline.track_video` with the clip's bearing and conditions, and
-scored by :func:`tracking.synthetic.score.score_trace`. A tracker error (no trace)
+:func:`cageless.tracking.pipeline.track_video` with the clip's bearing and conditions, and
+scored by :func:`cageless.tracking.synthetic.score.score_trace`. A tracker error (no trace)
 is a result too: ``status = "error"`` with its message.
 """
 
@@ -31,8 +31,8 @@ import cv2
 import numpy as np
 
 from cageless.trace import Trace
-from tracking.synthetic.corpus import ClipSpec, describe, render_clip
-from tracking.synthetic.score import BARS, Score, ideal_trace, score_trace
+from cageless.tracking.synthetic.corpus import ClipSpec, describe, render_clip
+from cageless.tracking.synthetic.score import BARS, Score, ideal_trace, score_trace
 
 __all__ = ["ClipResult", "run_seed", "run_seeds", "badness", "oracle_trace"]
 
@@ -67,7 +67,7 @@ def run_seed(seed: int, folder: str | Path, long: bool = False, keep: bool = Tru
 
 
 def _track_and_score(spec: ClipSpec) -> ClipResult:
-    from tracking.pipeline import TrackOptions, track_video
+    from cageless.tracking.pipeline import TrackOptions, track_video
 
     seed = spec.seed
     factors = describe(spec.params)
@@ -134,11 +134,11 @@ def oracle_trace(spec: ClipSpec) -> Trace:
     saturated top and two half-widths beyond it, around the true highlight position (only the connected blob
     nearest it) and inside the (blurred) ball (hot pixels, bright in every one of 16 frames spread over the
     clip, masked), skips highlights the truth marks hidden (dark frames), and then does what
-    :func:`~tracking.synthetic.score.ideal_trace` does (one circle fit, angles, the tracker's speed filter).
+    :func:`~cageless.tracking.synthetic.score.ideal_trace` does (one circle fit, angles, the tracker's speed filter).
     Where it passes, the pixels (noise, saturation, JPEG, blur, glints and dust included), not only the
     geometry, support the bars; where it fails, a detector must do better than a plain centroid.
     """
-    from tracking.io import open_video
+    from cageless.tracking.io import open_video
 
     p = spec.params
     t = spec.truth.sort_values(["frame", "ball"], kind="stable")

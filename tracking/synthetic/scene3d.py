@@ -1,7 +1,7 @@
 """A second, independent renderer of bearing end-face video: shaded spheres, textured rings, a real camera.
 
-It shares no drawing code with :mod:`tracking.synthetic.render` and does not
-look like it. What it draws, from a :class:`~tracking.synthetic.appearance.ClipParams`:
+It shares no drawing code with :mod:`cageless.tracking.synthetic.render` and does not
+look like it. What it draws, from a :class:`~cageless.tracking.synthetic.appearance.ClipParams`:
 
 * **balls** as black-coated spheres under one or two distant lights, shaded per
   pixel from the sphere normal ``n``: a weak Lambert term, a Fresnel-like rim
@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from tracking.synthetic.appearance import ClipParams, _outer_radius_factor
+from cageless.tracking.synthetic.appearance import ClipParams, _outer_radius_factor
 
 __all__ = ["SceneRenderer", "FrameState"]
 

@@ -46,7 +46,7 @@ from cageless.kinematics import slip_rate, theoretical_cage_speed
 from cageless.profiles import angle_profile
 from cageless.trace import Trace, VideoInfo
 from cageless.units import rpm_to_rad_s
-from tracking.kinematics import DEFAULT_WINDOW, revolution_speed
+from cageless.tracking.kinematics import DEFAULT_WINDOW, revolution_speed
 
 __all__ = ["Score", "BARS", "score_trace", "ideal_trace", "truth_arrays", "wrap"]
 

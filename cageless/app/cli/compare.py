@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from cageless.cli.common import finite_float
+from cageless.app.cli.common import finite_float
 
 __all__ = ["register", "run"]
 
@@ -41,10 +41,10 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     from cageless.atomic import atomic_write_text
     from cageless.errors import UsageError
     from cageless.trace import read_trace
-    from comparison.align import align_time
-    from comparison.compare import compare
-    from comparison.report import describe_condition, figures
-    from comparison.table import table_frame, to_markdown
+    from cageless.comparison.align import align_time
+    from cageless.comparison.compare import compare
+    from cageless.comparison.report import describe_condition, figures
+    from cageless.comparison.table import table_frame, to_markdown
 
     from cageless.outputs import check_output_dir
     from cageless.validate import check_options

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from cageless.cli.common import finite_float
+from cageless.app.cli.common import finite_float
 
 __all__ = ["register", "run"]
 
@@ -46,9 +46,9 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Run the sweep and print the summary."""
     from cageless.config import bearing_from_config
     from cageless.errors import UsageError
-    from simulation.sweep import parse_vary, run_sweep, summarise, write_sweep
-    from cageless.calibrate import describe_calibration
-    from cageless.cli.common import parameter_values
+    from cageless.simulation.sweep import parse_vary, run_sweep, summarise, write_sweep
+    from cageless.app.calibrate import describe_calibration
+    from cageless.app.cli.common import parameter_values
 
     if args.seeds < 1:
         raise UsageError(f"--seeds must be >= 1, got {args.seeds}")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from cageless.cli.common import finite_float
+from cageless.app.cli.common import finite_float
 
 __all__ = ["register", "run"]
 
@@ -54,7 +54,7 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
 
 
 def _target(args: argparse.Namespace) -> Any:
-    from cageless.calibrate import target_from_peak, target_from_trace
+    from cageless.app.calibrate import target_from_peak, target_from_trace
     from cageless.errors import UsageError
 
     given = [f for f in ("speed_rpm", "radial_load_n", "axial_load_n") if getattr(args, f) is not None]
@@ -72,15 +72,15 @@ def _target(args: argparse.Namespace) -> Any:
 
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Calibrate and write the parameter file."""
-    from cageless.calibrate import (calibrate, calibration_document, default_out_name, parse_bounds,
+    from cageless.app.calibrate import (calibrate, calibration_document, default_out_name, parse_bounds,
                                     write_calibration)
-    from cageless.cli.common import parameter_values
+    from cageless.app.cli.common import parameter_values
     from cageless.config import bearing_from_config
     from cageless.errors import UsageError
 
     bearing = bearing_from_config(config)
     bounds = parse_bounds(args.vary, bearing)
-    from simulation.parameters import parse_set_overrides
+    from cageless.simulation.parameters import parse_set_overrides
 
     clash = [b.name for b in bounds if b.name in parse_set_overrides(args.set_values)]
     if clash:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from cageless.cli.common import finite_float
+from cageless.app.cli.common import finite_float
 from cageless.config import bearing_from_config
 
 __all__ = ["register", "run"]
@@ -41,7 +41,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Render the folder and print one line per clip; return the exit code."""
     from cageless.outputs import check_output_dir, output_lock
     from cageless.validate import check_options
-    from tracking.synthetic.lab import PRESETS, make_lab
+    from cageless.tracking.synthetic.lab import PRESETS, make_lab
 
     check_options(args, ("seed", "revolutions", "workers"), force=False)
     out = check_output_dir(args.out, "DIR")

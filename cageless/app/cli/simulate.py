@@ -4,7 +4,7 @@
 writes a ``cageless-trace/1`` simulation file and prints a summary. This release
 runs the planar level (pure radial load on an aligned bearing); a scene that
 needs the spatial level is refused with the flags that force it. ``--set``
-changes an open model parameter (:class:`simulation.parameters.ModelParameters`),
+changes an open model parameter (:class:`cageless.simulation.parameters.ModelParameters`),
 ``--ensemble N`` runs seeds 0..N-1 on both cores.
 """
 
@@ -13,7 +13,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from cageless.cli.common import finite_float
+from cageless.app.cli.common import finite_float
 from cageless.config import bearing_from_config
 
 __all__ = ["register", "run"]
@@ -84,8 +84,8 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     import dataclasses
 
     from cageless.conditions import OperatingConditions
-    from simulation.effects import choose_model, parse_effect_overrides
-    from simulation.scene import Scene
+    from cageless.simulation.effects import choose_model, parse_effect_overrides
+    from cageless.simulation.scene import Scene
 
     bearing = bearing_from_config(config)
     _validate(args, bearing)
@@ -128,8 +128,8 @@ def _validate(args: argparse.Namespace, bearing: Any) -> None:
 
 
 def _parameters(args: argparse.Namespace, config: dict[str, Any]) -> Any:
-    from cageless.cli.common import parameter_values
-    from simulation.parameters import ModelParameters
+    from cageless.app.cli.common import parameter_values
+    from cageless.simulation.parameters import ModelParameters
 
     values = parameter_values(args, config)  # [parameters] of --config, then --set
     if args.restitution is not None:
@@ -139,18 +139,18 @@ def _parameters(args: argparse.Namespace, config: dict[str, Any]) -> Any:
 
 def _run(args: argparse.Namespace, scene: Any, choice: Any, config: dict[str, Any]) -> int:
     from cageless.errors import UsageError
-    from simulation.run import check_supported
+    from cageless.simulation.run import check_supported
 
     check_supported(scene, choice)
     par = _parameters(args, config)  # validated before anything compiles
     if args.ensemble < 1:
         raise UsageError(f"--ensemble must be >= 1, got {args.ensemble}")
     out = args.out or f"sim_{args.speed_rpm:g}rpm_Fr{args.radial_load_n:g}.trace.h5"
-    from simulation.simulation import Choices, Simulation
+    from cageless.simulation.simulation import Choices, Simulation
 
     sim = Simulation(scene, par, Choices(method=args.solver, rtol=args.rtol, max_step=args.max_step,
                                          sample_rate_hz=args.sample_rate), model=choice)
-    from cageless.calibrate import describe_calibration
+    from cageless.app.calibrate import describe_calibration
 
     note = describe_calibration(config.get("calibration"))
     config = {"command": "simulate", "set": args.set_values, **({"calibration": note} if note else {})}
@@ -163,7 +163,7 @@ def _run(args: argparse.Namespace, scene: Any, choice: Any, config: dict[str, An
         print(f"effects: {', '.join(choice.active)}")
         print(_summary_line(trace, sim.solution, out))
         return 0 if sim.solution.success else 1
-    from simulation.ensemble import run_ensemble
+    from cageless.simulation.ensemble import run_ensemble
 
     rows = run_ensemble(sim, args.ensemble, out, progress=not args.quiet, scheduler=args.scheduler, config=config)
     print(f"effects: {', '.join(choice.active)}")
@@ -173,7 +173,7 @@ def _run(args: argparse.Namespace, scene: Any, choice: Any, config: dict[str, An
 
 
 def _summary_line(trace: Any, sol: Any, out: str) -> str:
-    from simulation.run import peak_unloaded_slip
+    from cageless.simulation.run import peak_unloaded_slip
 
     ev = trace.events
     from cageless.kinematics import startup_duration

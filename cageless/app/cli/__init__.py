@@ -20,7 +20,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from cageless._version import __version__
-from cageless.cli.common import ArgumentParser, apply_config_defaults, common_options, setup_logging
+from cageless.app.cli.common import ArgumentParser, apply_config_defaults, common_options, setup_logging
 from cageless.errors import CagelessError, ParameterError, UsageError
 
 __all__ = ["main", "entry_point", "build_parser", "SUBCOMMANDS"]
@@ -77,7 +77,7 @@ def build_parser(command: str | None = None) -> ArgumentParser:
     parent = common_options()
     for name in SUBCOMMANDS:
         if command is None or name == command:
-            importlib.import_module(f"cageless.cli.{name}").register(subparsers, parent)
+            importlib.import_module(f"cageless.app.cli.{name}").register(subparsers, parent)
         else:
             subparsers.add_parser(name, help=SUMMARIES[name], add_help=False)
     return parser
@@ -113,7 +113,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             return EXIT_USAGE
         args, config = apply_config_defaults(parser, args.command, argv, args)
         setup_logging(args.quiet, args.verbose)
-        module = importlib.import_module(f"cageless.cli.{args.command}")
+        module = importlib.import_module(f"cageless.app.cli.{args.command}")
         return int(module.run(args, config))
     except SystemExit as exc:  # --help and --version exit through argparse
         return int(exc.code or 0) if isinstance(exc.code, int | None) else EXIT_USAGE

@@ -8,7 +8,7 @@ import math
 from typing import Any
 
 from cageless.bearing import Bearing
-from cageless.cli.common import finite_float
+from cageless.app.cli.common import finite_float
 from cageless.config import bearing_from_config
 from cageless.errors import CagelessError
 from cageless.kinematics import (
@@ -113,7 +113,7 @@ def _format_text(d: dict[str, Any]) -> str:
 
 def describe_video(path: str, fps: float | None = None) -> dict[str, Any]:
     """Return what the reader sees in a video, JSON-ready."""
-    from tracking.io import open_video
+    from cageless.tracking.io import open_video
 
     with open_video(path, fps=fps) as video:
         meta = video.metadata.to_dict()

@@ -45,12 +45,12 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Run the study and print its tables."""
     if args.study == "effects":
-        from simulation.bench import effects_study, format_effects
+        from cageless.simulation.bench import effects_study, format_effects
 
         result = effects_study(args.speed_rpm, args.radial_load_n, args.axial_load_n)
         print(format_effects(result))
     elif args.study == "accuracy":
-        from simulation.bench import accuracy_study, format_accuracy, format_models, model_study, plot_accuracy
+        from cageless.simulation.bench import accuracy_study, format_accuracy, format_models, model_study, plot_accuracy
 
         result = accuracy_study(window_s=args.window, repeats=args.repeats)
         print(format_accuracy(result))
@@ -61,7 +61,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
         if args.plot:
             plot_accuracy(result, args.plot)
     else:
-        from tracking.bench import format_tables, run_benchmark
+        from cageless.tracking.bench import format_tables, run_benchmark
 
         folder = Path(args.dir)
         folder.mkdir(parents=True, exist_ok=True)

@@ -1,7 +1,7 @@
 """Fit open model parameters to a measured slip profile or a target peak slip (``cageless calibrate``).
 
-This module is the app layer, like :mod:`cageless.lab`: it alone joins the simulation (one run per
-seed per evaluation, through :func:`simulation.sweep.simulate_point`) and the comparison metrics.
+This module is the app layer, like :mod:`cageless.app.lab`: it alone joins the simulation (one run per
+seed per evaluation, through :func:`cageless.simulation.sweep.simulate_point`) and the comparison metrics.
 
 Objective
     With a video trace: the MAE (or RMSE) in percentage points between the measured mean slip
@@ -76,7 +76,7 @@ class Bound:
 
 
 def _known_names(bearing: Bearing) -> list[str]:
-    from simulation.parameters import ModelParameters
+    from cageless.simulation.parameters import ModelParameters
 
     model = [f.name for f in dataclasses.fields(ModelParameters)]
     dotted = [f"{s}.{k}" for s, d in bearing.to_dict().items() if isinstance(d, dict) for k in d]
@@ -92,7 +92,7 @@ def parse_bounds(items: Sequence[str], bearing: Bearing | None = None) -> list[B
         For a malformed item, an unknown name (with a suggestion), a parameter without a documented
         range, LOW >= HIGH, or a range outside the documented one (named with its source).
     """
-    from simulation.ranges import DOCUMENTED_RANGES
+    from cageless.simulation.ranges import DOCUMENTED_RANGES
 
     known = _known_names(bearing or default_bearing())
     out: list[Bound] = []
@@ -142,7 +142,7 @@ def target_from_trace(path: str | Path, duration_s: float | None = None) -> Targ
     """
     from cageless.provenance import sha256_file
     from cageless.trace import read_trace
-    from comparison.align import profiles
+    from cageless.comparison.align import profiles
 
     try:
         trace = read_trace(path)
@@ -183,7 +183,7 @@ def _zone(values: np.ndarray) -> np.ndarray:
 def _evaluate_seed(point: dict[str, Any], base: dict[str, Any]) -> dict[str, Any]:
     """One simulation of an evaluation: the per-bin slip sums and counts after the start-up (a worker job)."""
     from cageless.profiles import angle_profile
-    from simulation.sweep import simulate_point
+    from cageless.simulation.sweep import simulate_point
 
     trace, sol, settle, error = simulate_point(point, base)
     if trace is None or not sol.success:
@@ -197,7 +197,7 @@ def _evaluate_seed(point: dict[str, Any], base: dict[str, Any]) -> dict[str, Any
 
 def _miss(target: Target, mean: np.ndarray, metric: str) -> tuple[float, float]:
     """(objective in pp, peak of ``mean`` in the zone in %)."""
-    from comparison.metrics import profile_errors
+    from cageless.comparison.metrics import profile_errors
 
     zone = _zone(mean)
     peak = 100 * float(np.max(mean[zone])) if zone.any() else float("nan")
@@ -317,8 +317,8 @@ def calibrate(target: Target, bounds: list[Bound], budget: int | None = None, se
     import time
 
     from cageless.parallel import job_pool
-    from simulation.parameters import ModelParameters
-    from simulation.sweep import sweep_base
+    from cageless.simulation.parameters import ModelParameters
+    from cageless.simulation.sweep import sweep_base
 
     d = len(bounds)
     budget = budget if budget is not None else (12 if d == 1 else 10 * d)
@@ -407,7 +407,7 @@ def calibration_document(result: CalibrationResult, bearing_section: Mapping[str
 def write_calibration(path: str | Path, doc: Mapping[str, Any]) -> Path:
     """Write the parameter file atomically (TOML)."""
     from cageless.atomic import atomic_write_text
-    from cageless.tomlwrite import dumps
+    from cageless.app.tomlwrite import dumps
 
     header = ("# cageless parameter set from `cageless calibrate`. Use it with --config FILE.toml in\n"
               "# cageless simulate, sweep or report; --set on the command line wins over [parameters].\n")

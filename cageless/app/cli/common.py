@@ -19,7 +19,7 @@ __all__ = [
 class ArgumentParser(argparse.ArgumentParser):
     """An argparse parser that raises :class:`UsageError` instead of exiting.
 
-    This keeps :func:`cageless.cli.main` testable in-process and lets the error
+    This keeps :func:`cageless.app.cli.main` testable in-process and lets the error
     carry a suggestion for a misspelled subcommand or option.
     """
 
@@ -93,7 +93,7 @@ def parameter_values(args: argparse.Namespace, config: dict[str, Any]) -> dict[s
     written by ``cageless calibrate``), then ``--set`` on the command line, which wins. Checked by name
     and value; a bad file entry names the file."""
     from cageless.errors import CagelessError
-    from simulation.parameters import ModelParameters, parse_set_overrides
+    from cageless.simulation.parameters import ModelParameters, parse_set_overrides
 
     table = config.get("parameters", {})
     if not isinstance(table, dict) or any(isinstance(v, bool) or not isinstance(v, int | float)

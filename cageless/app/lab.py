@@ -94,7 +94,7 @@ class LabResult:
 
 def _track_job(video: str, conditions: OperatingConditions, bearing: Bearing, out_dir: str,
                n_balls: int | None = None) -> tuple[str, str]:
-    from tracking.pipeline import TrackOptions, track_video
+    from cageless.tracking.pipeline import TrackOptions, track_video
 
     try:
         res = track_video(video, conditions, bearing, TrackOptions(n_balls=n_balls), out_dir=out_dir, progress=False,
@@ -118,9 +118,9 @@ def _qc_files(trace_path: Path) -> list[Path]:
 
 def _simulate_job(conditions: OperatingConditions, bearing: Bearing, duration_s: float, parameters: dict[str, float],
                   rtol: float, out: str) -> tuple[str, str]:
-    from simulation.parameters import ModelParameters
-    from simulation.scene import Scene
-    from simulation.simulation import Choices, Simulation
+    from cageless.simulation.parameters import ModelParameters
+    from cageless.simulation.scene import Scene
+    from cageless.simulation.simulation import Choices, Simulation
 
     try:
         scene = Scene(conditions=OperatingConditions(conditions.speed_rpm, conditions.radial_load_n,
@@ -246,9 +246,9 @@ def run_lab(folder: str | Path, out: str | Path, options: LabOptions | None = No
 
 def _run_lab(folder: str | Path, out: Path, options: LabOptions | None, bearing: Bearing | None,
              progress: bool) -> LabResult:
-    from comparison.compare import ComparisonRow, compare
-    from comparison.report import build_report, describe_condition, write_report
-    from comparison.table import write_tables
+    from cageless.comparison.compare import ComparisonRow, compare
+    from cageless.comparison.report import build_report, describe_condition, write_report
+    from cageless.comparison.table import write_tables
 
     options = options or LabOptions()
     bearing = bearing or default_bearing()
@@ -303,7 +303,7 @@ def _run_lab(folder: str | Path, out: Path, options: LabOptions | None, bearing:
 
 
 def _failed_row(label: str, c: OperatingConditions | None, message: str) -> Any:
-    from comparison.compare import ComparisonRow
+    from cageless.comparison.compare import ComparisonRow
 
     nan = float("nan")
     speed, fr, fa = _condition_key(c) if c is not None else (nan, nan, nan)

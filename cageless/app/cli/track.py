@@ -12,7 +12,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from cageless.bearing import Bearing
-from cageless.cli.common import finite_float
+from cageless.app.cli.common import finite_float
 from cageless.conditions import (
     IMAGE_SUFFIXES,
     LabEntry,
@@ -40,8 +40,8 @@ examples:
 
 def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     """Add the ``track`` subcommand."""
-    from tracking.detect import DETECTORS
-    from tracking.kinematics import DEFAULT_WINDOW
+    from cageless.tracking.detect import DETECTORS
+    from cageless.tracking.kinematics import DEFAULT_WINDOW
 
     p = subparsers.add_parser(
         "track", parents=[parent], help="track the balls in videos and write trace files",
@@ -100,7 +100,7 @@ def _with_speed(entry: LabEntry, speed_rpm: float | None) -> LabEntry:
 
 
 def _track_one(job: tuple[Path, OperatingConditions, Bearing, Any, Path]) -> tuple[str, dict[str, Any] | str]:
-    from tracking.pipeline import track_video
+    from cageless.tracking.pipeline import track_video
 
     video, conditions, bearing, options, out = job
     try:
@@ -127,8 +127,8 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     bearing = bearing_from_config(config)
     entries = [plausible_entry(e, args.force) for e in collect_inputs(args.inputs, args.speed_rpm)]
     _prefetch_first_hash(entries, args.workers)
-    from tracking.detect import DetectorParams  # these imports take a second: the hash runs meanwhile
-    from tracking.pipeline import TrackOptions
+    from cageless.tracking.detect import DetectorParams  # these imports take a second: the hash runs meanwhile
+    from cageless.tracking.pipeline import TrackOptions
 
     options = TrackOptions(detector=replace(DetectorParams(), method=args.detector), window=args.window,
                            strict=args.strict, fps=args.fps, allow_truncated=args.allow_truncated,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from cageless.cli.common import finite_float
+from cageless.app.cli.common import finite_float
 
 __all__ = ["register", "run"]
 
@@ -50,11 +50,11 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Run the workflow and print where the report is."""
     from cageless.config import bearing_from_config
     from cageless.errors import UsageError
-    from cageless.lab import LabOptions, run_lab
-    from cageless.calibrate import describe_calibration
-    from cageless.cli.common import parameter_values
+    from cageless.app.lab import LabOptions, run_lab
+    from cageless.app.calibrate import describe_calibration
+    from cageless.app.cli.common import parameter_values
 
-    from cageless.lab import CACHE_NAME, REPORT_PRODUCTS
+    from cageless.app.lab import CACHE_NAME, REPORT_PRODUCTS
     from cageless.outputs import check_output_dir, check_products
     from cageless.validate import check_options
 
