@@ -36,6 +36,8 @@ __all__ = [
     "STARTUP_REVOLUTIONS",
     "slip_rate",
     "rereference_slip",
+    "loaded_zone_speed",
+    "LOADED_ZONE_HALF_WIDTH_DEG",
     "centrifugal_force",
 ]
 
@@ -212,6 +214,42 @@ def rereference_slip(slip: npt.ArrayLike, ball_diameter_m: float, pitch_diameter
     gamma = ball_diameter_m / pitch_diameter_m
     ratio = (1.0 - gamma * math.cos(from_angle_rad)) / (1.0 - gamma * math.cos(to_angle_rad))
     return 1.0 - (1.0 - np.asarray(slip, dtype=np.float64)) * ratio
+
+
+#: Half-width of the window about the loaded-zone centre (270 deg) whose balls set the loaded-zone speed.
+LOADED_ZONE_HALF_WIDTH_DEG = 45.0
+
+
+def loaded_zone_speed(angle: npt.ArrayLike, speed: npt.ArrayLike, valid: npt.ArrayLike | None = None,
+                      min_samples: int = 10) -> float | None:
+    """Median orbit speed (rad/s) of the balls within 45 deg of the loaded-zone centre, 270 deg.
+
+    There the inner ring drives the balls under load and they roll nearly purely (their slip is about
+    0-2 %: Wang et al. 2026, figure 18), so this speed is the cage speed the trace itself shows.
+
+    Parameters
+    ----------
+    angle, speed
+        Orbital angles (rad) and orbit speeds (rad/s), same shape ((T, Z) for a trace).
+    valid
+        Which samples to use (default all); non-finite speeds are left out too.
+    min_samples
+        Fewest samples in the window for an answer.
+
+    Returns
+    -------
+    float or None
+        The median speed, or None when fewer than ``min_samples`` samples fall in the window.
+    """
+    a = np.asarray(angle, dtype=np.float64)
+    v = np.asarray(speed, dtype=np.float64)
+    keep = np.sin(a) < -math.cos(math.radians(LOADED_ZONE_HALF_WIDTH_DEG))
+    keep &= np.isfinite(v)
+    if valid is not None:
+        keep &= np.asarray(valid, dtype=bool)
+    if int(keep.sum()) < min_samples:
+        return None
+    return float(np.median(v[keep]))
 
 
 def centrifugal_force(masses: Masses, geometry: Geometry, cage_speed_rad_s: float) -> float:

@@ -22,14 +22,15 @@ import numpy as np
 import pandas as pd
 
 from cageless.atomic import atomic_path, atomic_write_text
+from cageless.kinematics import loaded_zone_speed
 from cageless.profiles import angle_profile
 from cageless.trace import Trace
 from cageless.tracking.geometry import Orbit
 from cageless.tracking.io import open_video
 from cageless.tracking.locate import BearingLocation
 
-__all__ = ["QC_LIMITS", "QCReport", "build_qc", "write_qc", "slip_warnings", "write_selection_qc",
-           "REASON_COLOURS"]
+__all__ = ["QC_LIMITS", "QCReport", "build_qc", "write_qc", "slip_warnings", "loaded_zone_speed_ratio",
+           "write_selection_qc", "REASON_COLOURS"]
 
 log = logging.getLogger(__name__)
 
@@ -38,9 +39,16 @@ QC_LIMITS = {
     "min_detection_rate": 0.90,  # per ball
     "max_interpolated_share": 0.10,  # over all samples
     "max_residual_fraction": 0.005,  # orbit fit residual / orbit radius
-    # Balls in the loaded zone roll nearly purely (their slip there is ~0-2 %, paper figure 18), so their
-    # orbit speed measures the cage speed of the stated shaft speed; a larger gap means a wrong speed_rpm.
-    "max_speed_mismatch": 0.08,
+    # Stated speed against the video: loaded-zone orbit speed / pure-rolling cage speed - 1 must lie in
+    # [-max_speed_shortfall, +max_speed_mismatch]. Measured where the stated speed is right
+    # (benchmarks/speed_crosscheck.py): the simulator's loaded zone -0.01 % at 1800/3000/6000 r/min; the
+    # renderer's ball-motion law 0 to +6.23 % for 0-25 % unloaded-zone slip (+0.25 x the slip, as the paper's
+    # own model has the loaded zone 6 / 0.5 / 0.1 % *faster* than pure rolling at 1800 / 3000 / 6000 r/min:
+    # Wang et al. 2026, section 4, after figure 4); rendered and tracked +0.03 to +6.26 %; the bundled
+    # sample +0.22 to +5.70 %. So balls may overrun the cage speed by up to ~6.3 % (limit 7 %), but no source
+    # has them orbit slower than it (limit 3 %: tracking error on real footage, a lightly loaded zone).
+    "max_speed_mismatch": 0.07,
+    "max_speed_shortfall": 0.03,
     "min_slip": -0.01,  # a ball cannot orbit faster than pure rolling allows by more than the noise
 }
 
@@ -100,6 +108,19 @@ def build_qc(table: pd.DataFrame, order: np.ndarray, valid: np.ndarray, orbit: O
     return report
 
 
+def loaded_zone_speed_ratio(angle: np.ndarray, speed: np.ndarray, valid: np.ndarray, omega_c: float) -> float | None:
+    """The balls' loaded-zone orbit speed (:func:`cageless.kinematics.loaded_zone_speed`) over ``omega_c``.
+
+    Returns ``None`` when fewer than 10 valid samples fall there or ``omega_c`` is not positive. This is
+    the quantity that :data:`QC_LIMITS` ``["max_speed_mismatch"]`` (above 1) and ``["max_speed_shortfall"]``
+    (below 1) bound.
+    """
+    lz = loaded_zone_speed(angle, speed, valid)
+    if lz is None or not omega_c > 0:
+        return None
+    return lz / omega_c
+
+
 def slip_warnings(angle: np.ndarray, speed: np.ndarray, slip: np.ndarray, valid: np.ndarray, omega_c: float,
                   speed_rpm: float) -> list[str]:
     """Cross-check the stated speed against the balls' loaded-zone orbit speed, and flag negative slip.
@@ -119,10 +140,9 @@ def slip_warnings(angle: np.ndarray, speed: np.ndarray, slip: np.ndarray, valid:
         The warnings (empty when both checks pass).
     """
     out: list[str] = []
-    loaded = (np.sin(angle) < -math.sqrt(0.5)) & valid & np.isfinite(speed)  # within 45 deg of 270 deg
-    if loaded.sum() >= 10 and omega_c > 0:
-        ratio = float(np.median(speed[loaded])) / omega_c
-        if abs(ratio - 1.0) > QC_LIMITS["max_speed_mismatch"]:
+    ratio = loaded_zone_speed_ratio(angle, speed, valid, omega_c)
+    if ratio is not None:
+        if not -QC_LIMITS["max_speed_shortfall"] <= ratio - 1.0 <= QC_LIMITS["max_speed_mismatch"]:
             out.append(f"the stated speed {speed_rpm:g} r/min disagrees with the video: balls in the loaded zone "
                        f"orbit {100 * (ratio - 1):+.1f} % off its pure-rolling cage speed (the video looks like "
                        f"about {speed_rpm * ratio:.0f} r/min); check speed_rpm")
