@@ -396,6 +396,7 @@ def bearing_with_keys(bearing: Bearing, resolved: ResolvedConditions) -> Bearing
 
     The diametral clearance and the groove curvature factors are kept: the races sit at
     ``d_m -/+ (D + P_d / 2)`` (Harris & Kotzalas, *Rolling Bearing Analysis*, 5th ed., vol. 1, ch. 2).
+    A ball of another diameter keeps the material: its mass scales as ``D^3`` (a homogeneous sphere).
 
     Raises
     ------
@@ -418,7 +419,10 @@ def bearing_with_keys(bearing: Bearing, resolved: ResolvedConditions) -> Bearing
         raise ConditionsError(resolved.video, f"the bearing keys ({', '.join(sorted(keys))}) give an impossible "
                               f"bearing: {exc}") from exc
     label = ", ".join(f"{k} = {v:g}" for k, v in sorted(keys.items()))
-    return dataclasses.replace(bearing, geometry=geometry, name=f"{bearing.name} ({label})")
+    # a ball of another diameter, of the same steel, has the mass of a homogeneous sphere scaled by (D/D0)^3
+    masses = dataclasses.replace(bearing.masses,
+                                 ball_mass_kg=bearing.masses.ball_mass_kg * (d / g.ball_diameter_m) ** 3)
+    return dataclasses.replace(bearing, geometry=geometry, masses=masses, name=f"{bearing.name} ({label})")
 
 
 def _is_image_sequence(folder: Path) -> bool:

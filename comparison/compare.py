@@ -6,12 +6,22 @@ import math
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
-from cageless.kinematics import rereference_slip
+from cageless.errors import CagelessError, ParameterError
+from cageless.kinematics import LOADED_ZONE_HALF_WIDTH_DEG, loaded_zone_speed, rereference_slip
 from cageless.trace import Trace
 from cageless.comparison.align import MismatchError, Profiles, check_compatible, profiles, simulation_settle_s
 from cageless.comparison.metrics import profile_errors, unloaded_peak
 
-__all__ = ["ComparisonRow", "Comparison", "compare", "match_contact_angle", "slip_contact_angle"]
+__all__ = ["ComparisonRow", "Comparison", "compare", "match_contact_angle", "slip_contact_angle", "SLIP_REFERENCES",
+           "refer_to_loaded_zone"]
+
+#: What a comparison's slip rates are referred to, by name (the table and the report print the text).
+SLIP_REFERENCES = {
+    "cage": "the pure-rolling cage speed of the stated shaft speed",
+    "loaded-zone": (f"each trace's own loaded-zone speed (the median orbit speed of the balls within "
+                    f"{LOADED_ZONE_HALF_WIDTH_DEG:g} deg of 270 deg), which removes a flat bias such as a "
+                    "stated speed, scale or clearance slightly off"),
+}
 
 
 @dataclass(frozen=True)
@@ -29,6 +39,7 @@ class ComparisonRow:
     label: str = ""
     status: str = "ok"
     message: str = ""
+    slip_reference: str = "cage"
 
     def to_dict(self) -> dict[str, Any]:
         """Plain values."""
@@ -47,17 +58,21 @@ class Comparison:
 
 
 def compare(measured: Trace, simulated: Trace, bin_deg: float = 1.0, settle_s: float | None = None,
-            force: bool = False, label: str = "") -> Comparison:
+            force: bool = False, label: str = "", slip_reference: str = "cage") -> Comparison:
     """Align the traces and compute the row.
 
     ``settle_s`` is the simulated start-up left out of the simulation's profiles; by default three cage
-    revolutions (:func:`~cageless.comparison.align.simulation_settle_s`).
+    revolutions (:func:`~cageless.comparison.align.simulation_settle_s`). ``slip_reference`` is a key of
+    :data:`SLIP_REFERENCES`: ``"cage"`` (the pure-rolling cage speed, the paper's definition) or
+    ``"loaded-zone"`` (each trace's slip against its own loaded-zone speed, :func:`refer_to_loaded_zone`).
 
     Raises
     ------
     MismatchError
         When conditions or bearing differ and ``force`` is False (the message lists the differences).
     """
+    if slip_reference not in SLIP_REFERENCES:
+        raise ParameterError("slip_reference", f"must be one of {', '.join(SLIP_REFERENCES)}", slip_reference)
     mismatches = check_compatible(measured, simulated)
     if mismatches and not force:
         raise MismatchError("the traces differ: " + "; ".join(mismatches)
@@ -65,7 +80,12 @@ def compare(measured: Trace, simulated: Trace, bin_deg: float = 1.0, settle_s: f
                             "(the report then shows the mismatch).")
     if settle_s is None:
         settle_s = simulation_settle_s(simulated)
-    measured, note = match_contact_angle(measured, simulated)
+    if slip_reference == "loaded-zone":
+        measured, note = refer_to_loaded_zone(measured)
+        simulated, note_sim = refer_to_loaded_zone(simulated, settle_s)
+        note = f"{note}; {note_sim}"
+    else:
+        measured, note = match_contact_angle(measured, simulated)
     pm = profiles(measured, bin_deg)
     ps = profiles(simulated, bin_deg, settle_s=settle_s)
     err = profile_errors(pm.slip["mean"].to_numpy(), ps.slip["mean"].to_numpy())
@@ -73,8 +93,35 @@ def compare(measured: Trace, simulated: Trace, bin_deg: float = 1.0, settle_s: f
         speed_rpm=measured.speed_rpm, radial_load_n=measured.radial_load_n, axial_load_n=measured.axial_load_n,
         theoretical_slip_pct=100 * unloaded_peak(ps.slip), experimental_slip_pct=100 * unloaded_peak(pm.slip),
         mae_pp=err.mae_pp, rmse_pp=err.rmse_pp, max_error_pp=err.max_pp, label=label,
-        status="mismatch" if mismatches else "ok", message="; ".join(mismatches + ([note] if note else [])))
+        status="mismatch" if mismatches else "ok", message="; ".join(mismatches + ([note] if note else [])),
+        slip_reference=slip_reference)
     return Comparison(row=row, measured=pm, simulated=ps, mismatches=mismatches, settle_s=settle_s)
+
+
+def refer_to_loaded_zone(trace: Trace, settle_s: float = 0.0) -> tuple[Trace, str]:
+    """``trace`` with its slip referred to its own loaded-zone speed, and a note giving that speed.
+
+    The reference is :func:`cageless.kinematics.loaded_zone_speed` of the valid samples after ``settle_s``;
+    the slip becomes ``1 - theta_dot / omega_lz``. A flat error in the stated speed (or an effective
+    rolling radius off by scale or clearance) moves ``omega_c`` and ``omega_lz`` alike, so it drops out.
+
+    Raises
+    ------
+    CagelessError
+        When fewer than 10 valid samples lie in the loaded zone (the trace then cannot give its reference).
+    """
+    keep = (trace.time >= trace.time[0] + settle_s)[:, None] & trace.valid
+    omega_lz = loaded_zone_speed(trace.angle, trace.speed, keep)
+    if omega_lz is None or not omega_lz > 0:
+        raise CagelessError(f"the {trace.source} trace has too few samples in the loaded zone (within "
+                            f"{LOADED_ZONE_HALF_WIDTH_DEG:g} deg of 270 deg) to give its own slip reference: "
+                            "use a longer trace or the cage-speed reference.")
+    omega_c = trace.speed_rpm * math.pi / 30.0 * 0.5 * (
+        1.0 - trace.ball_diameter_m * math.cos(slip_contact_angle(trace)) / trace.pitch_diameter_m)
+    config = {**trace.config, "slip_reference": "loaded-zone", "slip_reference_speed_rad_s": omega_lz}
+    note = (f"{trace.source} slip referred to its loaded-zone speed {omega_lz:.4g} rad/s "
+            f"({100 * (omega_lz / omega_c - 1):+.2f} % from the cage speed)")
+    return replace(trace, slip=1.0 - trace.speed / omega_lz, config=config), note
 
 
 def slip_contact_angle(trace: Trace) -> float:

@@ -14,10 +14,11 @@ from pathlib import Path
 import pandas as pd
 
 from cageless.atomic import atomic_write_text
-from cageless.comparison.compare import ComparisonRow
+from cageless.comparison.compare import SLIP_REFERENCES, ComparisonRow
 from cageless.comparison.metrics import SLIP_RATE_DEFINITION
 
-__all__ = ["table_frame", "to_csv", "to_markdown", "to_latex", "to_html", "write_tables", "HEADERS"]
+__all__ = ["table_frame", "slip_reference_note", "to_csv", "to_markdown", "to_latex", "to_html", "write_tables",
+           "HEADERS"]
 
 HEADERS = {
     "speed_rpm": "Speed (r/min)", "radial_load_n": "Radial load (N)", "axial_load_n": "Axial load (N)",
@@ -27,8 +28,10 @@ HEADERS = {
 
 
 def table_frame(rows: Sequence[ComparisonRow]) -> pd.DataFrame:
-    """The rows as a frame, sorted by speed then loads; ``label``, ``status`` and ``message`` kept."""
-    frame = pd.DataFrame([r.to_dict() for r in rows], columns=[*HEADERS, "label", "status", "message"])
+    """The rows as a frame, sorted by speed then loads; ``label``, ``status``, ``message`` and
+    ``slip_reference`` (a key of :data:`~cageless.comparison.compare.SLIP_REFERENCES`) kept."""
+    frame = pd.DataFrame([r.to_dict() for r in rows],
+                         columns=[*HEADERS, "label", "status", "message", "slip_reference"])
     return frame.sort_values(["speed_rpm", "radial_load_n", "axial_load_n", "label"], kind="stable").reset_index(
         drop=True)
 
@@ -46,12 +49,21 @@ def _cells(frame: pd.DataFrame) -> list[list[str]]:
 
 
 def _notes(frame: pd.DataFrame) -> list[str]:
-    notes = [SLIP_RATE_DEFINITION]
+    notes = [SLIP_RATE_DEFINITION, slip_reference_note(frame)]
     for _, r in frame.iterrows():
         if r["status"] != "ok":
             notes.append(f"{r['label'] or 'condition'} ({r['speed_rpm']:g} r/min, {r['radial_load_n']:g} N): "
                          f"{r['status']}: {r['message']}")
     return notes
+
+
+def slip_reference_note(frame: pd.DataFrame) -> str:
+    """One sentence naming what the rows' slip rates are referred to (per row when they differ)."""
+    refs = frame.loc[frame["status"] != "failed", "slip_reference"].dropna().unique().tolist() or ["cage"]
+    if len(refs) == 1:
+        return f"Slip reference: {SLIP_REFERENCES.get(refs[0], refs[0])}."
+    return "Slip reference per row (column slip_reference): " + "; ".join(
+        f"{k}: {SLIP_REFERENCES.get(k, k)}" for k in refs) + "."
 
 
 def to_csv(frame: pd.DataFrame) -> str:

@@ -4,8 +4,10 @@
 2. Track each video (``OUT/traces/<video>.trace.h5`` and ``OUT/traces/qc/``).
 3. Simulate the matching scene once per distinct condition (``OUT/simulations/``). The simulated time
    is the start-up that the comparison leaves out (three cage revolutions, at least 40 ms, unless
-   ``settle_s`` is given) plus the longest video of the condition and at least one cage revolution,
-   unless ``duration_s`` is given.
+   ``settle_s`` is given) plus the longest video of the condition and at least
+   :data:`REPORT_REVOLUTIONS` (20) cage revolutions, unless ``duration_s`` is given. Twenty
+   revolutions put every ball through every 1 deg bin twenty times, give the Poincare section about 48
+   points (one per shaft revolution) and let the spread come from many passes.
 4. Compare each video with its condition's simulation.
 5. Write ``OUT/report.html`` and ``OUT/slip_table.{csv,md,tex,html}``.
 
@@ -37,7 +39,7 @@ from tqdm.auto import tqdm
 from cageless import __version__
 from cageless.atomic import atomic_write_text
 from cageless.bearing import Bearing, default_bearing
-from cageless.conditions import LabEntry, OperatingConditions, discover_lab
+from cageless.conditions import LabEntry, OperatingConditions, bearing_with_keys, discover_lab
 from cageless.errors import CagelessError
 from cageless.kinematics import startup_duration, theoretical_cage_speed
 from cageless.outputs import clean_stale_parts, output_lock
@@ -46,9 +48,11 @@ from cageless.provenance import hash_file, sha256_file
 from cageless.trace import read_trace
 from cageless.validate import plausible_entry
 
-__all__ = ["LabOptions", "LabResult", "run_lab"]
+__all__ = ["LabOptions", "LabResult", "run_lab", "REPORT_REVOLUTIONS"]
 
 CACHE_NAME = ".cageless-cache.json"
+#: Cage revolutions a report simulates after the start-up by default (at least; longer videos get longer).
+REPORT_REVOLUTIONS = 20.0
 #: The files a report writes directly in its output folder.
 REPORT_PRODUCTS = ("report.html", "slip_table.csv", "slip_table.md", "slip_table.tex", "slip_table.html")
 
@@ -61,6 +65,8 @@ class LabOptions:
 
     duration_s: float | None = None
     settle_s: float | None = None
+    #: Cage revolutions simulated after the start-up, at least (when ``duration_s`` is None).
+    revolutions: float = REPORT_REVOLUTIONS
     bin_deg: float = 1.0
     rtol: float = 1e-6
     workers: int = 2
@@ -70,11 +76,15 @@ class LabOptions:
     #: Where the parameters came from when a calibration file gave them (one line), or None.
     calibration: str | None = None
     n_balls: int | None = None
+    #: What slip is referred to in the comparison (a key of ``cageless.comparison.compare.SLIP_REFERENCES``).
+    slip_reference: str = "cage"
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready, without the scheduler address (it does not change results)."""
-        return {"duration_s": self.duration_s, "settle_s": self.settle_s, "bin_deg": self.bin_deg, "rtol": self.rtol,
+        return {"duration_s": self.duration_s, "settle_s": self.settle_s, "revolutions": self.revolutions,
+                "bin_deg": self.bin_deg, "rtol": self.rtol,
                 "force": self.force, "parameters": dict(self.parameters), "n_balls": self.n_balls,
+                "slip_reference": self.slip_reference,
                 **({"calibration": self.calibration} if self.calibration else {})}
 
 
@@ -212,8 +222,37 @@ def _condition_key(c: OperatingConditions) -> tuple[float, float, float]:
     return (c.speed_rpm, c.radial_load_n, c.axial_load_n)
 
 
-def _sim_name(key: tuple[float, float, float]) -> str:
-    return f"n{key[0]:g}_Fr{key[1]:g}_Fa{key[2]:g}.sim.trace.h5"
+#: A simulation's identity in a lab run: speed, radial and axial load, and the bearing label ("" for the
+#: configured bearing, else its ball count and diameters).
+SimKey = tuple[float, float, float, str]
+
+
+def _bearing_label(bearing: Bearing, base: Bearing) -> str:
+    if bearing.to_dict() == base.to_dict():
+        return ""
+    g = bearing.geometry
+    return f"Z{g.n_balls}_D{g.ball_diameter_m * 1e3:g}_dm{g.pitch_diameter_m * 1e3:g}"
+
+
+def _sim_key(e: LabEntry, bearing: Bearing, base: Bearing) -> SimKey:
+    return (*_condition_key(e.resolved.conditions), _bearing_label(bearing, base))
+
+
+def _sim_name(key: SimKey) -> str:
+    return f"n{key[0]:g}_Fr{key[1]:g}_Fa{key[2]:g}{'_' + key[3] if key[3] else ''}.sim.trace.h5"
+
+
+def _entry_bearings(entries: list[LabEntry], bearing: Bearing) -> tuple[dict[Path, Bearing], list[Any]]:
+    """Each video's bearing: the configured one with the ball count and diameters its sidecar or
+    ``conditions.csv`` gives (``n_balls``, ``ball_diameter_mm``, ``pitch_diameter_mm``); an impossible
+    bearing fails that video only."""
+    bearings, failed = {}, []
+    for e in entries:
+        try:
+            bearings[e.video] = bearing_with_keys(bearing, e.resolved)
+        except CagelessError as exc:
+            failed.append(_failed_row(e.video.name, e.resolved.conditions, str(exc)))
+    return bearings, failed
 
 
 def _settle(speed_rpm: float, bearing: Bearing, options: LabOptions) -> float:
@@ -228,7 +267,7 @@ def _duration(key: tuple[float, float, float], video_s: Iterable[float], bearing
     if options.duration_s is not None:
         return settle + options.duration_s
     cage = theoretical_cage_speed(bearing.geometry, key[0] * math.pi / 30.0)
-    return settle + max([*video_s, 2 * math.pi / cage])
+    return settle + max([*video_s, options.revolutions * 2 * math.pi / cage])
 
 
 def run_lab(folder: str | Path, out: str | Path, options: LabOptions | None = None, bearing: Bearing | None = None,
@@ -246,8 +285,8 @@ def run_lab(folder: str | Path, out: str | Path, options: LabOptions | None = No
 
 def _run_lab(folder: str | Path, out: Path, options: LabOptions | None, bearing: Bearing | None,
              progress: bool) -> LabResult:
-    from cageless.comparison.compare import ComparisonRow, compare
-    from cageless.comparison.report import build_report, describe_condition, write_report
+    from cageless.comparison.compare import ComparisonRow
+    from cageless.comparison.report import build_report, write_report
     from cageless.comparison.table import write_tables
 
     options = options or LabOptions()
@@ -261,45 +300,61 @@ def _run_lab(folder: str | Path, out: Path, options: LabOptions | None, bearing:
     (out / "simulations").mkdir(parents=True, exist_ok=True)
     cache, timings, skipped = _Cache(out), {}, 0
     failed: list[ComparisonRow] = [_failed_row(e.video.name, None, str(e.error)) for e in entries if not e.ok]
-    good = [e for e in entries if e.ok]
+    bearings, bad = _entry_bearings([e for e in entries if e.ok], bearing)
+    failed += bad
+    good = [e for e in entries if e.ok and e.video in bearings]
     with job_pool(options.workers, options.scheduler) as pool:
         t0 = time.perf_counter()
-        traces, n_skip = _track_all(pool, good, bearing, out, cache, progress, options.n_balls)
+        traces, n_skip = _track_all(pool, good, bearings, out, cache, progress, options.n_balls)
         skipped += n_skip
         timings["tracking"] = time.perf_counter() - t0
         for e in good:
             if isinstance(traces[e.video], CagelessError):
                 failed.append(_failed_row(e.video.name, e.resolved.conditions, str(traces[e.video])))
         t0 = time.perf_counter()
-        sims, n_skip = _simulate_all(pool, good, traces, bearing, out, cache, options, progress)
+        sims, n_skip = _simulate_all(pool, good, traces, bearings, bearing, out, cache, options, progress)
         skipped += n_skip
         timings["simulation"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    descriptions = []
-    for e in good:
-        tr = traces[e.video]
-        if isinstance(tr, CagelessError):
-            continue
-        sim = sims[_condition_key(e.resolved.conditions)]
-        if isinstance(sim, CagelessError):
-            failed.append(_failed_row(e.video.name, e.resolved.conditions, f"simulation failed: {sim}"))
-            continue
-        try:
-            measured, simulated = read_trace(tr), read_trace(sim)
-            settle = _settle(e.resolved.conditions.speed_rpm, bearing, options)
-            c = compare(measured, simulated, options.bin_deg, settle, options.force, label=e.video.name)
-            descriptions.append(describe_condition(e.video.name, c, measured, simulated))
-        except CagelessError as exc:
-            failed.append(_failed_row(e.video.name, e.resolved.conditions, str(exc)))
+    descriptions = _compare_all(good, traces, sims, bearings, bearing, options, failed)
     timings["comparison"] = time.perf_counter() - t0
     rows = [d.row for d in descriptions] + failed
     tables = write_tables(rows, out / "slip_table")
     structure = build_report(descriptions, failed, reproduction={
         "lab folder": str(folder), **({"calibration": options.calibration} if options.calibration else {}),
-        "configuration": options.to_dict(), "bearing": bearing.to_dict()}, timings=timings)
+        "configuration": options.to_dict(), "bearing": bearing.to_dict(),
+        **{f"bearing of {e.video.name}": bearings[e.video].name for e in good if _bearing_label(bearings[e.video],
+                                                                                                  bearing)}},
+        timings=timings)
     report = write_report(structure, out / "report.html")
     return LabResult(report=report, table=tables["csv"], rows=rows, n_failed=len(failed), timings=timings,
                      skipped=skipped)
+
+
+def _compare_all(good: list[LabEntry], traces: dict[Path, Any], sims: dict[SimKey, Any],
+                 bearings: dict[Path, Bearing], base: Bearing, options: LabOptions, failed: list[Any]) -> list[Any]:
+    """Compare each tracked video with its simulation; failures are appended to ``failed`` as rows."""
+    from cageless.comparison.compare import compare
+    from cageless.comparison.report import describe_condition
+
+    descriptions = []
+    for e in good:
+        tr = traces[e.video]
+        if isinstance(tr, CagelessError):
+            continue
+        sim = sims[_sim_key(e, bearings[e.video], base)]
+        if isinstance(sim, CagelessError):
+            failed.append(_failed_row(e.video.name, e.resolved.conditions, f"simulation failed: {sim}"))
+            continue
+        try:
+            measured, simulated = read_trace(tr), read_trace(sim)
+            settle = _settle(e.resolved.conditions.speed_rpm, bearings[e.video], options)
+            c = compare(measured, simulated, options.bin_deg, settle, options.force, label=e.video.name,
+                        slip_reference=options.slip_reference)
+            descriptions.append(describe_condition(e.video.name, c, measured, simulated))
+        except CagelessError as exc:
+            failed.append(_failed_row(e.video.name, e.resolved.conditions, str(exc)))
+    return descriptions
 
 
 def _failed_row(label: str, c: OperatingConditions | None, message: str) -> Any:
@@ -321,40 +376,42 @@ def _collect(results: dict[Any, Any], pending: list[Any], keys: list[str], outco
             results[item] = CagelessError(info)
 
 
-def _track_all(pool: Any, entries: list[LabEntry], bearing: Bearing, out: Path, cache: _Cache,
+def _track_all(pool: Any, entries: list[LabEntry], bearings: dict[Path, Bearing], out: Path, cache: _Cache,
                progress: bool, n_balls: int | None = None) -> tuple[dict[Path, Any], int]:
     traces: dict[Path, Any] = {}
     jobs, keys, pending = [], [], []
     for e in entries:
         key = cache.key("track", {"input": hash_file(e.video, "blake3"), "conditions": e.resolved.conditions.to_dict(),
-                                  "bearing": bearing.to_dict(), "n_balls": n_balls})
+                                  "bearing": bearings[e.video].to_dict(), "n_balls": n_balls})
         hit = cache.hit(key)
         if hit:
             traces[e.video] = hit
             continue
-        jobs.append((_track_job, (str(e.video), e.resolved.conditions, bearing, str(out / "traces"), n_balls)))
+        jobs.append((_track_job, (str(e.video), e.resolved.conditions, bearings[e.video], str(out / "traces"),
+                                  n_balls)))
         keys.append(key)
         pending.append(e.video)
     _collect(traces, pending, keys, _run_jobs(pool, jobs, "tracking", progress), cache)
     return traces, len(entries) - len(jobs)
 
 
-def _simulate_all(pool: Any, entries: list[LabEntry], traces: dict[Path, Any], bearing: Bearing, out: Path,
-                  cache: _Cache, options: LabOptions, progress: bool) -> tuple[dict[tuple[float, float, float], Any], int]:
-    lengths: dict[tuple[float, float, float], list[float]] = {}
-    conditions: dict[tuple[float, float, float], OperatingConditions] = {}
+def _simulate_all(pool: Any, entries: list[LabEntry], traces: dict[Path, Any], bearings: dict[Path, Bearing],
+                  base: Bearing, out: Path, cache: _Cache, options: LabOptions,
+                  progress: bool) -> tuple[dict[SimKey, Any], int]:
+    lengths: dict[SimKey, list[float]] = {}
+    conditions: dict[SimKey, tuple[OperatingConditions, Bearing]] = {}
     for e in entries:
-        k = _condition_key(e.resolved.conditions)
-        conditions.setdefault(k, e.resolved.conditions)
+        k = _sim_key(e, bearings[e.video], base)
+        conditions.setdefault(k, (e.resolved.conditions, bearings[e.video]))
         lengths.setdefault(k, [])
         if not isinstance(traces[e.video], CagelessError):
             tr = read_trace(traces[e.video])
             lengths[k].append(float(tr.time[-1] - tr.time[0]))
-    sims: dict[tuple[float, float, float], Any] = {}
+    sims: dict[SimKey, Any] = {}
     jobs, keys, pending = [], [], []
-    for k, c in conditions.items():
-        duration = _duration(k, lengths[k], bearing, options)
-        key = cache.key("simulate", {"conditions": list(k), "duration_s": duration, "bearing": bearing.to_dict(),
+    for k, (c, bearing) in conditions.items():
+        duration = _duration(k[:3], lengths[k], bearing, options)
+        key = cache.key("simulate", {"conditions": list(k[:3]), "duration_s": duration, "bearing": bearing.to_dict(),
                                      "parameters": options.parameters, "rtol": options.rtol})
         hit = cache.hit(key)
         if hit:

@@ -8,11 +8,11 @@ from datetime import datetime, timezone
 from typing import Any
 
 from cageless import __version__
-from cageless.comparison.compare import ComparisonRow
+from cageless.comparison.compare import SLIP_REFERENCES, ComparisonRow
 from cageless.comparison.metrics import SLIP_RATE_DEFINITION
 from cageless.comparison.report import figures
 from cageless.comparison.report.describe import ConditionDescription, tracking_verdict
-from cageless.comparison.table import table_frame, to_html
+from cageless.comparison.table import slip_reference_note, table_frame, to_html
 
 __all__ = ["build_report"]
 
@@ -51,7 +51,8 @@ def _section(d: ConditionDescription) -> dict[str, Any]:
             section["figures"].append({"caption": "Contact trajectory on the raceways (simulated, spatial model; "
                                                   "the paper's figure 13): how far the contact angle swings "
                                                   "around the orbit.", "svg": figures.contact_track_figure(d)})
-        section["facts"] += [("settling time left out of the simulation", f"{d.comparison.settle_s:g} s")]
+        section["facts"] += [("settling time left out of the simulation", f"{d.comparison.settle_s:g} s"),
+                             ("slip reference", SLIP_REFERENCES.get(r.slip_reference, r.slip_reference))]
     return section
 
 
@@ -104,7 +105,7 @@ def build_report(descriptions: Sequence[ConditionDescription], failed_rows: Sequ
         "conditions": [[f"{r.speed_rpm:g}", f"{r.radial_load_n:g}", f"{r.axial_load_n:g}", r.label, r.status]
                        for r in table_frame(rows).itertuples()],
         "table_html": to_html(frame),
-        "definition": SLIP_RATE_DEFINITION,
+        "definition": f"{SLIP_RATE_DEFINITION} {slip_reference_note(frame)}",
         "summary": [_summary(d) for d in descriptions],
         "sections": [_section(d) for d in descriptions],
         "failures": [{"title": r.label, "message": r.message} for r in failed_rows],

@@ -20,6 +20,9 @@ from cageless.app.lab import LabOptions, run_lab
 
 ROOT = Path(__file__).resolve().parents[2]
 LAB = ROOT / "sample_data" / "lab"
+#: The report's default simulates 20 cage revolutions after the start-up; these tests check the page and
+#: the scheduler, not the statistics, so they state a shorter run (one revolution, 0.1 s at 6000 r/min).
+QUICK = {"revolutions": 1.0}
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 
 
@@ -33,7 +36,7 @@ def small_lab(tmp_path_factory):
 @pytest.mark.skipif(CHROMIUM is None, reason="Chromium is not installed (.ci/run installs Debian's chromium)")
 def test_report_opens_in_headless_chromium(small_lab, tmp_path):
     sync_api = pytest.importorskip("playwright.sync_api", reason="playwright (the test extra) is not installed")
-    res = run_lab(small_lab, tmp_path / "out", LabOptions(workers=1), progress=False)
+    res = run_lab(small_lab, tmp_path / "out", LabOptions(workers=1, **QUICK), progress=False)
     errors: list[str] = []
     art = Path(os.environ.get("CAGELESS_ARTIFACT_DIR", ROOT / "artifacts"))
     art.mkdir(parents=True, exist_ok=True)
@@ -57,9 +60,9 @@ def test_report_opens_in_headless_chromium(small_lab, tmp_path):
 
 def test_dask_cluster_gives_the_same_table(small_lab, tmp_path):
     distributed = pytest.importorskip("distributed", reason="dask[distributed] (the test extra) is not installed")
-    local = run_lab(small_lab, tmp_path / "local", LabOptions(workers=2), progress=False)
+    local = run_lab(small_lab, tmp_path / "local", LabOptions(workers=2, **QUICK), progress=False)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cl:
-        remote = run_lab(small_lab, tmp_path / "dask", LabOptions(scheduler=cl.scheduler_address), progress=False)
+        remote = run_lab(small_lab, tmp_path / "dask", LabOptions(scheduler=cl.scheduler_address, **QUICK), progress=False)
     a, b = pd.read_csv(local.table), pd.read_csv(remote.table)
     pd.testing.assert_frame_equal(a, b)
     assert local.n_failed == remote.n_failed == 0

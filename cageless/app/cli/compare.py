@@ -14,6 +14,7 @@ _EXAMPLES = """\
 examples:
   cageless compare out/traces/clip_3000rpm.trace.h5 sim_3000rpm_Fr500.trace.h5
   cageless compare measured.trace.h5 simulated.trace.h5 --figures figs/ --align-ball 3
+  cageless compare measured.trace.h5 simulated.trace.h5 --slip-reference loaded-zone
 """
 
 
@@ -31,6 +32,10 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--settle", type=finite_float,
                    help="simulated start-up left out of the simulation's profile (s; default three cage "
                    "revolutions, at least 0.04)")
+    p.add_argument("--slip-reference", choices=("cage", "loaded-zone"), default="cage",
+                   help="what slip is referred to: the pure-rolling cage speed of the stated speed (default, the "
+                   "paper's definition) or each trace's own loaded-zone speed, which removes a flat bias from a "
+                   "stated speed, scale or clearance slightly off")
     p.add_argument("--force", action="store_true", help="compare traces of different conditions or bearings")
     p.add_argument("--align-ball", type=int, help="also align this ball's speed in time (cross-correlation)")
     p.add_argument("--figures", help="write the speed, slip, contact and ring figures (SVG) to this folder")
@@ -56,8 +61,11 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     if measured.source != "video" or simulated.source != "simulation":
         raise UsageError(f"give the video trace first and the simulation trace second (got {measured.source} "
                          f"and {simulated.source}).")
-    c = compare(measured, simulated, args.bin_deg, args.settle, args.force, label=Path(args.video_trace).name)
+    c = compare(measured, simulated, args.bin_deg, args.settle, args.force, label=Path(args.video_trace).name,
+                slip_reference=args.slip_reference)
     print(to_markdown(table_frame([c.row])), end="")
+    if args.slip_reference != "cage":
+        print(f"Note: {c.row.message}")
     if args.align_ball is not None:
         a = align_time(measured, simulated, args.align_ball)
         print(f"time alignment of ball {a.ball}: measured(t) ~ simulated(t {a.lag_s:+.6f} s), "

@@ -13,6 +13,7 @@ _EXAMPLES = """\
 examples:
   cageless report sample_data/lab -o report
   cageless report lab -o out --duration 0.2 --set cho_n_s_m=2500
+  cageless report sample_data/lab -o quick --revolutions 2     a quick look (2 cage revolutions simulated)
   cageless report lab -o out --config fitted.toml     parameters from `cageless calibrate`
   cageless report lab -o out --scheduler tcp://10.0.0.5:8786     the same workflow on a Dask cluster
 """
@@ -30,11 +31,17 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("lab", help="lab folder (videos with their conditions)")
     p.add_argument("-o", "--out", default="report", help="output folder (default ./report)")
     p.add_argument("--duration", type=finite_float,
-                   help="simulated time after the start-up (s; default: the longest video, at least one cage "
-                   "revolution)")
+                   help="simulated time after the start-up (s; default: the longest video, at least --revolutions "
+                   "cage revolutions)")
+    p.add_argument("--revolutions", type=finite_float, default=20.0,
+                   help="cage revolutions simulated after the start-up, at least (default 20: every 1 deg bin "
+                   "filled by every ball many times, dozens of Poincare points); --duration overrides it")
     p.add_argument("--settle", type=finite_float,
                    help="simulated start-up left out of the comparison (s; default three cage revolutions, "
                    "at least 0.04)")
+    p.add_argument("--slip-reference", choices=("cage", "loaded-zone"), default="cage",
+                   help="what slip is referred to: the pure-rolling cage speed of the stated speed (default) or "
+                   "each trace's own loaded-zone speed (removes a flat bias from scale or clearance)")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", dest="set_values",
                    help="change an open model parameter (see `cageless simulate --help`)")
     p.add_argument("--rtol", type=finite_float, default=1e-6, help="simulation tolerance (default 1e-6)")
@@ -61,13 +68,14 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     if args.n_balls is not None and args.n_balls < 3:
         raise UsageError(f"--n-balls {args.n_balls}: must be a whole number >= 3.")
     values = parameter_values(args, config)  # [parameters] of --config, then --set; before any work starts
-    check_options(args, ("duration", "settle", "rtol", "workers"))
+    check_options(args, ("duration", "settle", "revolutions", "rtol", "workers"))
     check_output_dir(args.out, "-o")
     check_products(args.out, REPORT_PRODUCTS, CACHE_NAME)
     note = describe_calibration(config.get("calibration"))
-    options = LabOptions(duration_s=args.duration, settle_s=args.settle, rtol=args.rtol, workers=args.workers,
+    options = LabOptions(duration_s=args.duration, settle_s=args.settle, revolutions=args.revolutions,
+                         rtol=args.rtol, workers=args.workers,
                          scheduler=args.scheduler, force=args.force, parameters=values, calibration=note,
-                         n_balls=args.n_balls)
+                         n_balls=args.n_balls, slip_reference=args.slip_reference)
     if note:
         print(f"parameters: {note}")
     res = run_lab(args.lab, args.out, options, bearing_from_config(config), progress=not args.quiet)
