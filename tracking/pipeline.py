@@ -134,6 +134,28 @@ class _CroppedFrames:
                 return self._stack[j, self.rows, self.cols]
             return self.video.frame_view(j)[self.rows, self.cols]
         k = i // self.chunk
+        return self._chunk(k)[i - k * self.chunk]
+
+    @property
+    def block_size(self) -> int:
+        """Frames per :meth:`block` (a memory-mapped block's pages are dropped after the next is asked for)."""
+        return _DROP_EVERY if self.zero_copy else self.chunk
+
+    def block(self, a: int, b: int) -> np.ndarray:
+        """Frames ``a..b-1`` as one ``(frames, rows, cols)`` array (a view where possible), ``a`` a multiple of
+        :attr:`block_size` and ``b - a`` at most that."""
+        if not self.zero_copy:
+            k = a // self.chunk
+            return self._chunk(k)[a - k * self.chunk:b - k * self.chunk]
+        j, last = self.offset + a, self.offset + b - 1
+        if self._span != (j, j):  # the previous block is done: unmap its pages
+            self.video.drop_pages(*self._span)  # type: ignore[attr-defined]
+        self._span = (min(j, last), max(j, last))
+        if self._stack is not None:
+            return self._stack[j:last + 1, self.rows, self.cols]
+        return np.stack([self.video.frame_view(x)[self.rows, self.cols] for x in range(j, last + 1)])
+
+    def _chunk(self, k: int) -> np.ndarray:
         block = self._cache.get(k)
         if block is None:
             a = self.offset + k * self.chunk
@@ -142,7 +164,7 @@ class _CroppedFrames:
             self._cache[k] = block
             if len(self._cache) > 2:
                 self._cache.popitem(last=False)
-        return block[i - k * self.chunk]
+        return block
 
 
 def _locate(video: FrameSource, background: np.ndarray, bearing: Bearing, path: Path) -> BearingLocation:
