@@ -36,7 +36,7 @@ from cageless.tracking.io import CineReader, FrameSource, open_video
 from cageless.tracking.kinematics import DEFAULT_WINDOW, revolution_speed
 from cageless.tracking.link import BallCountWarning, TrackSetup, track_frames
 from cageless.tracking.locate import BearingLocation, background_frame, locate_bearing
-from cageless.tracking.locate_motion import locate_by_motion, motion_map, plausible_band
+from cageless.tracking.locate_motion import holds_the_motion, locate_by_motion, motion_map, plausible_band
 from cageless.tracking.qc import QCReport, build_qc, slip_warnings, write_qc, write_selection_qc
 from cageless.tracking.select import SPEED_BAND, Selection, SelectionError, select_balls
 
@@ -146,20 +146,21 @@ class _CroppedFrames:
 
 
 def _locate(video: FrameSource, background: np.ndarray, bearing: Bearing, path: Path) -> BearingLocation:
-    """The bearing and its ball band from brightness; from motion when that fails or gives a band that
-    does not fit a ball (dark ring faces, balls over bright faces)."""
+    """The bearing and its ball band from brightness; from motion when that fails, gives a band that
+    does not fit a ball, or a band where little moves (dark ring faces, balls over bright faces)."""
     g = bearing.geometry
     ratio = g.ball_diameter_m / (0.5 * g.pitch_diameter_m)
     err: TrackingError | None = None
+    spread = motion_map(video)
     try:
         loc = locate_bearing(background, path)
-        if plausible_band(loc, ratio):
+        if plausible_band(loc, ratio) and holds_the_motion(spread, loc):
             return loc
     except TrackingError as exc:
         if "no contrast" in exc.message:
             raise
         err = exc
-    alt = locate_by_motion(motion_map(video), path, ratio)
+    alt = locate_by_motion(spread, path, ratio)
     if alt is not None:
         log.info("%s: ball band found from motion (%.0f..%.0f px)", path, alt.band_inner, alt.band_outer)
         return alt
