@@ -43,6 +43,8 @@ HERE = Path(__file__).resolve().parents[1]
 _PRELUDE = (
     "import sys, atexit; sys.meta_path[:] = [f for f in sys.meta_path if '__editable__' not in repr(f)]; "
     "sys.path.insert(0, {src!r}); "
+    # tracking/, simulation/ and comparison/ install as cageless.tracking, ... (setuptools package-dir).
+    "import cageless; cageless.__path__.append({src!r}); "
     # The peak RSS of this process since exec (VmHWM): wait4's ru_maxrss would carry the parent's peak over
     # the fork (the parent maps the clips while cutting them).
     "atexit.register(lambda: print('VMHWM_KB', open('/proc/self/status').read().split('VmHWM:')[1].split()[0], "

@@ -19,7 +19,7 @@ from __future__ import annotations
 import logging
 import math
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,6 +29,7 @@ import pandas as pd
 from cageless.errors import TrackingError
 from cageless.tracking.candidates import find_candidates
 from cageless.tracking.detect import Detections, DetectorParams, centroid_windows, detect_full
+from cageless.tracking.link_kernel import MAX_MASS_RATIO, REDETECT_AFTER, WIDEN_AFTER, run_block
 from cageless.tracking.locate import fit_circle
 from cageless.tracking.select import Anchor, BallRing, anchor_at
 
@@ -40,11 +41,13 @@ TRACK_COLUMNS = ("frame", "time_s", "ball", "u_px", "v_px", "mass", "detected")
 
 #: Consecutive misses after which a ball is looked for in a doubled window, and after which the
 #: whole frame is searched (a highlight dropout lasts a few frames; the prediction stays good).
-_WIDEN_AFTER = 3
-_REDETECT_AFTER = 12
+_WIDEN_AFTER = WIDEN_AFTER
+_REDETECT_AFTER = REDETECT_AFTER
 #: A window whose mass exceeds this multiple of the ball's usual mass has caught something brighter
 #: than a highlight (the ring face between two balls) and counts as a miss.
-_MAX_MASS_RATIO = 4.0
+_MAX_MASS_RATIO = MAX_MASS_RATIO
+#: Frames per block handed to the compiled step when the frame source cannot give blocks itself.
+_BLOCK = 32
 #: Frames scanned for a start frame with all balls in view.
 _START_SCAN = 64
 
@@ -215,6 +218,9 @@ def track_frames(frames: Callable[[int], np.ndarray], times: npt.NDArray[np.floa
         progress(1)
     for direction in (1, -1):
         state = _State(**{k: (val.copy() if isinstance(val, np.ndarray) else val) for k, val in init.__dict__.items()})
+        if s.params.method == "window":
+            _run_compiled(frames, times, state, s, centre, (u, v, mass), start, direction, progress)
+            continue
         rng = range(start + 1, n) if direction == 1 else range(start - 1, -1, -1)
         for i in rng:
             _step(frames(i), float(times[i]), state, s, centre, (u, v, mass), i)
@@ -226,6 +232,49 @@ def track_frames(frames: Callable[[int], np.ndarray], times: npt.NDArray[np.floa
         "u_px": u.ravel(), "v_px": v.ravel(), "mass": mass.ravel(), "detected": np.isfinite(u).ravel(),
     })
     return table, centre
+
+
+def _blocks(frames: Callable[[int], np.ndarray], n: int, start: int,
+            direction: int) -> Iterator[tuple[int, np.ndarray]]:
+    """``(a, block)`` pairs, ``block[k]`` being frame ``a + k``, covering the frames after ``start`` (``direction``
+    1) or before it (-1), in tracking order: from the frame source's own blocks (``frames.block``) when it has
+    them, else stacked frame by frame."""
+    size = int(getattr(frames, "block_size", _BLOCK))
+    edges = range(start - start % size, n, size) if direction == 1 else range(start - start % size, -1, -size)
+    for a in edges:
+        b = min(a + size, n)
+        block_of = getattr(frames, "block", None)
+        yield a, (block_of(a, b) if block_of is not None else np.stack([frames(i) for i in range(a, b)]))
+
+
+def _run_compiled(frames: Callable[[int], np.ndarray], times: npt.NDArray[np.float64], st: _State, s: TrackSetup,
+                  centre: tuple[float, float], out: tuple[np.ndarray, np.ndarray, np.ndarray], start: int,
+                  direction: int, progress: Callable[[int], None] | None) -> None:
+    """The ``"window"`` loop: blocks of frames through the compiled step (:func:`~cageless.tracking.link_kernel.run_block`),
+    with the Python :func:`_step` for the frames it hands back."""
+    n = len(times)
+    times = np.ascontiguousarray(times, dtype=np.float64)
+    half = s.params.window_sigma * s.highlight_sigma
+    thr = s.params.weight_sigma * s.sigma_noise
+    for a, block in _blocks(frames, n, start, direction):
+        k0 = (max(start + 1, a) if direction == 1 else min(start - 1, a + len(block) - 1)) - a
+        k1 = len(block) if direction == 1 else -1
+        while k0 != k1:
+            arrays = [np.ascontiguousarray(x, dtype=d) for x, d in
+                      ((st.theta, np.float64), (st.radius, np.float64), (st.omega, np.float64),
+                       (st.misses, np.int64), (st.ref_mass, np.float64))]
+            st.theta, st.radius, st.omega, st.misses, st.ref_mass = arrays
+            t_state = np.array([st.t])
+            k = run_block(block, k0, k1, direction, a, times, s.background, s.mask, float(centre[0]), float(centre[1]),
+                          float(half), float(thr), int(s.params.iterations), float(s.params.lost_fraction),
+                          s.ring is not None, *arrays, t_state, *out)
+            st.t = float(t_state[0])
+            if k != k1:  # a frame the compiled step leaves to Python
+                _step(block[k], float(times[a + k]), st, s, centre, out, a + k)
+                k += direction
+            if progress:
+                progress(abs(k - k0))
+            k0 = k
 
 
 def _step(frame: np.ndarray, t: float, st: _State, s: TrackSetup, centre: tuple[float, float],

@@ -36,7 +36,7 @@ from cageless.tracking.io import CineReader, FrameSource, open_video
 from cageless.tracking.kinematics import DEFAULT_WINDOW, revolution_speed
 from cageless.tracking.link import BallCountWarning, TrackSetup, track_frames
 from cageless.tracking.locate import BearingLocation, background_frame, locate_bearing
-from cageless.tracking.locate_motion import locate_by_motion, motion_map, plausible_band
+from cageless.tracking.locate_motion import holds_the_motion, locate_by_motion, motion_map, plausible_band
 from cageless.tracking.qc import QCReport, build_qc, slip_warnings, write_qc, write_selection_qc
 from cageless.tracking.select import SPEED_BAND, Selection, SelectionError, select_balls
 
@@ -134,6 +134,28 @@ class _CroppedFrames:
                 return self._stack[j, self.rows, self.cols]
             return self.video.frame_view(j)[self.rows, self.cols]
         k = i // self.chunk
+        return self._chunk(k)[i - k * self.chunk]
+
+    @property
+    def block_size(self) -> int:
+        """Frames per :meth:`block` (a memory-mapped block's pages are dropped after the next is asked for)."""
+        return _DROP_EVERY if self.zero_copy else self.chunk
+
+    def block(self, a: int, b: int) -> np.ndarray:
+        """Frames ``a..b-1`` as one ``(frames, rows, cols)`` array (a view where possible), ``a`` a multiple of
+        :attr:`block_size` and ``b - a`` at most that."""
+        if not self.zero_copy:
+            k = a // self.chunk
+            return self._chunk(k)[a - k * self.chunk:b - k * self.chunk]
+        j, last = self.offset + a, self.offset + b - 1
+        if self._span != (j, j):  # the previous block is done: unmap its pages
+            self.video.drop_pages(*self._span)  # type: ignore[attr-defined]
+        self._span = (min(j, last), max(j, last))
+        if self._stack is not None:
+            return self._stack[j:last + 1, self.rows, self.cols]
+        return np.stack([self.video.frame_view(x)[self.rows, self.cols] for x in range(j, last + 1)])
+
+    def _chunk(self, k: int) -> np.ndarray:
         block = self._cache.get(k)
         if block is None:
             a = self.offset + k * self.chunk
@@ -142,24 +164,25 @@ class _CroppedFrames:
             self._cache[k] = block
             if len(self._cache) > 2:
                 self._cache.popitem(last=False)
-        return block[i - k * self.chunk]
+        return block
 
 
 def _locate(video: FrameSource, background: np.ndarray, bearing: Bearing, path: Path) -> BearingLocation:
-    """The bearing and its ball band from brightness; from motion when that fails or gives a band that
-    does not fit a ball (dark ring faces, balls over bright faces)."""
+    """The bearing and its ball band from brightness; from motion when that fails, gives a band that
+    does not fit a ball, or a band where little moves (dark ring faces, balls over bright faces)."""
     g = bearing.geometry
     ratio = g.ball_diameter_m / (0.5 * g.pitch_diameter_m)
     err: TrackingError | None = None
+    spread = motion_map(video)
     try:
         loc = locate_bearing(background, path)
-        if plausible_band(loc, ratio):
+        if plausible_band(loc, ratio) and holds_the_motion(spread, loc):
             return loc
     except TrackingError as exc:
         if "no contrast" in exc.message:
             raise
         err = exc
-    alt = locate_by_motion(motion_map(video), path, ratio)
+    alt = locate_by_motion(spread, path, ratio)
     if alt is not None:
         log.info("%s: ball band found from motion (%.0f..%.0f px)", path, alt.band_inner, alt.band_outer)
         return alt

@@ -62,7 +62,7 @@ TRUTH_COLUMNS = ("frame", "time_s", "ball", "angle_rad", "speed_rad_s", "slip", 
 _AVI_MAX_FPS = 1000.0
 _SPEED_DT = 1e-6
 #: Bumped when what render_clip writes changes, so cached clips are rendered again.
-_FORMAT = 6
+_FORMAT = 7
 
 
 @dataclass

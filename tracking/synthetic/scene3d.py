@@ -292,11 +292,15 @@ class SceneRenderer:
             ex, ey = nx - F32(h[0]), ny - F32(h[1])
             a, b = ex * ca + ey * sa, -ex * sa + ey * ca
             rad += F32(p.highlight_peak * rel) * np.exp(-0.5 * ((a / sig_a) ** 2 + (b / sig_b) ** 2)) * inside
-        delta = cover * (rad * self.light_field[sl] - img[sl])
+        # Over the exposure the ball covers the scene behind it: the blurred image is the time average
+        # blur(cover * ball) + (1 - blur(cover)) * behind. (Blurring cover * (ball - behind) instead, as
+        # before, let the texture behind an opaque ball leak through it as behind - blur(behind).)
+        ball = cover * rad * self.light_field[sl]
         if blur > 0.3:
-            delta = cv2.filter2D(delta, -1, _line_kernel(blur, self._velocity_angle(theta)),
-                                 borderType=cv2.BORDER_CONSTANT)
-        img[sl] += delta * self.visible[sl]
+            kernel = _line_kernel(blur, self._velocity_angle(theta))
+            ball = cv2.filter2D(ball, -1, kernel, borderType=cv2.BORDER_CONSTANT)
+            cover = cv2.filter2D(cover.astype(F32), -1, kernel, borderType=cv2.BORDER_CONSTANT)
+        img[sl] += (ball - cover * img[sl]) * self.visible[sl]
 
     def _velocity_angle(self, theta: float) -> float:
         """Image direction (rad, in (u, v)) of a ball's motion at ``theta``."""
