@@ -240,7 +240,8 @@ def format_models(result: dict[str, Any]) -> str:
     return _cost_table(title, ("scene", "model"), result["rows"], lambda r: (r["scene"], r["model"]))
 
 
-OPTIONAL_EFFECTS = ("lubricant_damping", "race_traction", "ehl_film", "ball_ball_film", "gravity", "drag")
+OPTIONAL_EFFECTS = ("lubricant_damping", "race_traction", "ehl_film", "rolling_losses", "ball_ball_film", "gravity",
+                    "drag")
 
 
 def effects_study(rpm: float = 1800.0, radial_load_n: float = 500.0, axial_load_n: float = 0.0,
