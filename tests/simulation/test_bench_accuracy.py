@@ -14,6 +14,8 @@ def test_accuracy_study_table_and_plot(tmp_path):
     assert all(r["slip_error_pp"] < 0.05 for r in dp5)
     cvode = [r for r in result["rows"] if r["solver"].startswith("CVODE")]
     assert len(cvode) == 5 + len(CVODE_VARIANTS) and all(r["slip_error_pp"] < 0.05 for r in cvode)
+    rosw = [r for r in result["rows"] if r["solver"].startswith("rosw")]
+    assert len(rosw) == 3 and all(r["slip_error_pp"] < 0.05 for r in rosw)
     text = format_accuracy(result)
     assert "| dp5 (compiled RHS) | 1e-06 |" in text and "LSODA (numpy RHS)" in text
     plot_accuracy(result, str(tmp_path / "wp.png"))
