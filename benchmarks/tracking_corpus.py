@@ -5,8 +5,9 @@
 
 Renders each clip once into ``--cache`` (default ``/tmp/cageless-corpus``; reused while the
 software version and the seed's parameters are unchanged), tracks it with the current tracker,
-scores it (tracking/synthetic/score.py) beside an oracle (a plain centroid detector told where
-each highlight is: it shows the pixels support the bars) and prints, per set, one row per clip (its factors,
+scores it (tracking/synthetic/score.py) beside an oracle (a Gaussian-mask centroid told where
+each highlight is: where it passes, the pixels support the bars) and the Cramér-Rao bound on the angle
+(tracking/synthetic/crb.py: under the bar, no clip is out of reach in principle) and prints, per set, one row per clip (its factors,
 balls found, identity swaps, angle / speed / slip-profile errors, pass or fail and why), the
 pass count and the worst clip. ``--long`` runs the long variants (one cage revolution each; their videos
 are deleted after scoring unless ``--keep``). The short clips take about 9 GB for both sets.
@@ -23,6 +24,7 @@ from pathlib import Path
 
 from cageless.tracking.synthetic.matrix import SETS, format_coverage
 from cageless.tracking.synthetic.runner import ClipResult, badness, run_seeds
+from cageless.tracking.synthetic.score import BARS
 
 _COLS = ("Z", "res", "px/mm", "bits", "fmt", "rpm", "slip%", "faces", "lands", "sat", "dbl", "jpeg", "dir")
 
@@ -35,7 +37,8 @@ def _oracle(r: ClipResult) -> str:
     o = r.oracle
     if o is None:
         return "-"
-    return f"{'ok' if o['passed'] else 'FAIL'} {o['angle_rms_mrad']:.2f}"
+    crb = "-" if r.angle_crb_mrad is None else f"{r.angle_crb_mrad:.3f}"
+    return f"{'ok' if o['passed'] else 'FAIL'} {o['angle_rms_mrad']:.2f} / {crb}"
 
 
 def _row(r: ClipResult) -> str:
@@ -51,7 +54,7 @@ def _row(r: ClipResult) -> str:
 
 def format_set(name: str, results: list[ClipResult]) -> str:
     """Markdown table of one seed set, with its pass count and worst clip."""
-    head = ["seed", *_COLS, "found", "swaps", "angle mrad", "speed %", "slip MAE pp", "oracle (mrad)",
+    head = ["seed", *_COLS, "found", "swaps", "angle mrad", "speed %", "slip MAE pp", "oracle / CRB (mrad)",
             "result", "why", "render s",
             "track s"]
     lines = [f"### {name}", "", "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
@@ -63,8 +66,9 @@ def format_set(name: str, results: list[ClipResult]) -> str:
     n_oracle = sum(bool(r.oracle and r.oracle["passed"]) for r in results)
     lines += ["", f"{name}: {n_pass} of {len(results)} clips pass; {n_err} end in a tracker error (no trace); "
               f"{wrong} give a trace with the wrong ball count.",
-              f"The oracle (a plain centroid detector told where each highlight is) passes {n_oracle} of "
-              f"{len(results)}.",
+              f"The oracle (a Gaussian-mask centroid told where each highlight is) passes {n_oracle} of "
+              f"{len(results)}; the Cramér-Rao bound on the angle is at most "
+              f"{max(r.angle_crb_mrad or 0.0 for r in results):.3f} mrad (bar {BARS['angle_rms_mrad']}).",
               f"Worst clip: seed {worst.seed} ({worst.status}: {worst.message[:160]})", ""]
     return "\n".join(lines)
 

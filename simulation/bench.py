@@ -5,6 +5,8 @@ start-up; from that state, each candidate integrates the same window, and its
 error is measured against a tight-tolerance reference run in the same process:
 
 * the compiled Dormand-Prince loop across tolerances (rtol 1e-4 ... 1e-8);
+* the compiled Rosenbrock-W method (``rosw``, :mod:`cageless.simulation.integrators.rosw`) across tolerances, at its
+  10 us cap;
 * SUNDIALS CVODE (BDF) across tolerances and step caps (2, 5, 20 us), and at its default settings
   with each Jacobian of :data:`cageless.simulation.solve.JACOBIANS` and without its onset control;
 * scipy's LSODA, BDF and DOP853 on the same compiled right-hand side;
@@ -54,6 +56,7 @@ CANDIDATES: tuple[tuple[str, float, float], ...] = (
     ("CVODE", 1e-6, 2e-6), ("CVODE", 1e-6, 5e-6), ("CVODE", 1e-7, 5e-6), ("CVODE", 3e-8, 5e-6),
     ("CVODE", 1e-6, 2e-5),
     ("LSODA", 1e-6, 2e-6), ("BDF", 1e-6, 2e-6), ("DOP853", 1e-6, 2e-6),
+    ("rosw", 1e-6, 1e-5), ("rosw", 1e-7, 1e-5), ("rosw", 1e-8, 1e-5),
 )
 #: CVODE as ``simulate`` runs it (rtol 3e-8, 5 us) with one setting changed: the other Jacobians of
 #: :data:`cageless.simulation.solve.JACOBIANS` (the rows above use the structured one: what it saves, and what
@@ -240,7 +243,8 @@ def format_models(result: dict[str, Any]) -> str:
     return _cost_table(title, ("scene", "model"), result["rows"], lambda r: (r["scene"], r["model"]))
 
 
-OPTIONAL_EFFECTS = ("lubricant_damping", "race_traction", "ehl_film", "ball_ball_film", "gravity", "drag")
+OPTIONAL_EFFECTS = ("lubricant_damping", "race_traction", "ehl_film", "rolling_losses", "ball_ball_film", "gravity",
+                    "drag")
 
 
 def effects_study(rpm: float = 1800.0, radial_load_n: float = 500.0, axial_load_n: float = 0.0,

@@ -69,8 +69,14 @@ def _dry(s: Scene) -> tuple[bool, str]:
 
 
 def _drag(s: Scene) -> tuple[bool, str]:
-    rho = s.oil_air_density_kg_m3
-    return (True, f"oil-air mixture of {rho:g} kg/m^3") if rho is not None else (False, "no oil-air mixture given")
+    rho = s.mixture_density_kg_m3
+    if rho is None:
+        return False, "no oil-air mixture given"
+    if rho == 0:
+        return False, "oil-air mixture density set to 0"
+    if s.oil_air_density_kg_m3 is None:
+        return True, f"lubricated: oil-air mixture of {rho:.3g} kg/m^3 (5 % oil by volume, Parker 1984)"
+    return True, f"oil-air mixture of {rho:g} kg/m^3"
 
 
 EFFECTS: tuple[EffectSpec, ...] = (
@@ -82,14 +88,18 @@ EFFECTS: tuple[EffectSpec, ...] = (
                _always("traction drives the balls"), flag="F_TRAC", slots=("TA", "TB", "TC", "TD", "U_FLOOR")),
     EffectSpec("ehl_film", "Hamrock-Dowson central and minimum film at race contacts", _lubricated,
                needs_lubricant=True, flag="F_FILM"),
+    EffectSpec("rolling_losses", "hydrodynamic rolling force on the ball centre and moment about it at both race "
+               "contacts, from the film and the entrainment speed, with inlet starvation (Chiu 1974)", _lubricated,
+               needs_lubricant=True, flag="F_ROLL",
+               slots=("ETA0", "ALPHA_PV", "E_RED", "RXI", "RYI", "KAI", "RXO", "RYO", "KAO", "R_MEN", "H0")),
     EffectSpec("ball_ball_contact", "Hertz contact between neighbours with hysteresis damping (restitution R) "
                "and friction from the surface sliding speed", _always("no cage: neighbours meet"), flag="F_BB",
                slots=("KB", "CHI", "V_IN_MIN")),
     EffectSpec("ball_ball_film", "squeeze film between neighbouring balls", _lubricated, needs_lubricant=True,
                flag="F_BBFILM", slots=("ETA0", "H0")),
     EffectSpec("gravity", "m g on balls and ring", _gravity, flag="F_GRAV", slots=("G",)),
-    EffectSpec("drag", "1/2 C_D rho A V^2 against the orbital motion (no churning moment on the spin)", _drag,
-               flag="F_DRAG", slots=("CD", "RHO_MIX")),
+    EffectSpec("drag", "1/2 C_D(Re) rho A V^2 against the orbital motion (Schiller-Naumann C_D) and the churning "
+               "moment on the spin", _drag, flag="F_DRAG", slots=("CD", "RHO_MIX", "MU_MIX")),
     EffectSpec("dry_friction", "Coulomb-Stribeck friction of bare steel instead of the traction curve, at race and "
                "ball-ball contacts", _dry, flag="DRY", slots=("MU_DRY", "V_REG", "MU_STATIC", "V_STRIBECK")),
 )

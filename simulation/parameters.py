@@ -24,9 +24,12 @@ Sources
 * ``restitution``: ball-ball coefficient of restitution R; 0.8 is a
   representative value for lubricated steel spheres. The paper does not give
   one; R is swept in the stability tests.
-* ``drag_coefficient``: 0.47, the textbook drag coefficient of a smooth sphere
-  in the subcritical Reynolds range (F. M. White, Fluid Mechanics, Fig. 7.16).
-  Used only when the scene gives an oil-air mixture density.
+* ``drag_coefficient``: None, the Reynolds-dependent drag coefficient of
+  Schiller & Naumann (1933) joined to Newton's 0.44
+  (:mod:`cageless.simulation.physics.drag`); a number fixes C_D instead (0.47 is
+  the textbook subcritical value of a smooth sphere, F. M. White, Fluid
+  Mechanics, Fig. 7.16). Drag acts in a lubricated scene by default, in the
+  oil-air mixture of 5 % oil by volume (Parker, NASA TP-2275, 1984).
 * ``strips``: 5 strips across each race contact ellipse in the spatial model, a
   choice; the work-precision study measures what other counts cost.
 * ``min_approach_speed_m_s``: 0.01 m/s, a numerical floor on the approach speed
@@ -79,7 +82,8 @@ class ModelParameters:
         Ball-ball coefficient of restitution R, in [0, 1]; 0 is perfectly plastic (represented by a
         rebound below 0.1 %, :data:`cageless.simulation.forces.PLASTIC_CHI`).
     drag_coefficient
-        Drag coefficient C_D of a ball in the oil-air mixture, >= 0.
+        Fixed drag coefficient C_D of a ball in the oil-air mixture, > 0, or None (default) for the
+        Reynolds-dependent Schiller-Naumann law.
     dry_friction_coefficient
         Coulomb friction of a dry steel contact, in (0, 1), or None when not given.
     slip_regularisation_m_s
@@ -103,6 +107,11 @@ class ModelParameters:
         more elastically than R, as real steel impacts do as the speed falls (Goldsmith, *Impact*,
         1960, ch. 6); without the floor the damping of a contact that closes at rest is unbounded
         and the step collapses to nanoseconds.
+    meniscus_distance_m
+        Inlet meniscus distance r_s (m) of the hydrodynamic rolling force at the race contacts (the
+        ``rolling_losses`` effect, :mod:`cageless.simulation.physics.rolling_force`): how far upstream of the
+        contact the inlet is filled with oil; small is starved. Documented range 0.05-2 mm
+        (:data:`cageless.simulation.physics.rolling_force.MENISCUS_RANGE_M`).
     """
 
     cho_n_s_m: float = 5000.0
@@ -111,7 +120,7 @@ class ModelParameters:
     traction_peak_slide_roll: float = 0.02
     traction_sliding_coefficient: float = 0.04
     restitution: float = 0.8
-    drag_coefficient: float = 0.47
+    drag_coefficient: float | None = None
     dry_friction_coefficient: float | None = None
     slip_regularisation_m_s: float = 1e-3
     dry_static_coefficient: float | None = None
@@ -119,6 +128,7 @@ class ModelParameters:
     min_entrainment_m_s: float = 0.1
     min_approach_speed_m_s: float = 0.01
     strips: int = 5
+    meniscus_distance_m: float = 0.2652306786928945e-3  # fitted: simulation/parameter_sets.py
 
     def __post_init__(self) -> None:
         rules = {
@@ -128,11 +138,11 @@ class ModelParameters:
             "traction_peak_slide_roll": (lambda v: 0 < v < 1, "must lie in (0, 1)"),
             "traction_sliding_coefficient": (lambda v: 0 < v < 1, "must lie in (0, 1)"),
             "restitution": (lambda v: 0 <= v <= 1, "must lie in [0, 1]"),
-            "drag_coefficient": (lambda v: v >= 0, "must be >= 0"),
             "slip_regularisation_m_s": (lambda v: v > 0, "must be > 0"),
             "stribeck_speed_m_s": (lambda v: v > 0, "must be > 0"),
             "min_entrainment_m_s": (lambda v: v > 0, "must be > 0"),
             "min_approach_speed_m_s": (lambda v: v > 0, "must be > 0"),
+            "meniscus_distance_m": (lambda v: 0 < v <= 0.01, "must lie in (0, 10 mm]"),
         }
         for name, (ok, rule) in rules.items():
             value = getattr(self, name)
@@ -146,6 +156,11 @@ class ModelParameters:
         mu = self.dry_friction_coefficient
         if mu is not None and not (isinstance(mu, int | float) and math.isfinite(mu) and 0 < mu < 1):
             raise ParameterError("parameters.dry_friction_coefficient", "must lie in (0, 1), or be None", mu)
+        cd = self.drag_coefficient
+        if cd is not None and not (isinstance(cd, int | float) and not isinstance(cd, bool) and math.isfinite(cd)
+                                   and cd > 0):
+            raise ParameterError("parameters.drag_coefficient", "must be > 0, or None for the Reynolds-dependent "
+                                 "Schiller-Naumann law", cd)
         static = self.dry_static_coefficient
         if static is not None and not (isinstance(static, int | float) and math.isfinite(static) and mu is not None
                                        and mu <= static < 1):

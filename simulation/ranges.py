@@ -46,6 +46,9 @@ DOCUMENTED_RANGES: dict[str, DocumentedRange] = {
     "traction_peak_slide_roll": DocumentedRange(0.002, 0.1, "brackets the representative 2 % slide-to-roll"),
     "traction_sliding_coefficient": DocumentedRange(0.005, 0.2, "brackets the representative sliding value 0.04"),
     "drag_coefficient": DocumentedRange(0.05, 5.0, "the smooth-sphere drag curve, White Fig. 7.16"),
+    "meniscus_distance_m": DocumentedRange(0.05e-3, 2.0e-3, "from a starved inlet of the order of the contact "
+                                           "semi-axes to a flooded one limited by the groove (Chiu 1974 fit; see "
+                                           "docs/physics/lubricant.md)"),
     "lubricant.dynamic_viscosity_pa_s": DocumentedRange(0.005, 0.5, "about 6-600 mm^2/s, inside the ISO 3448 "
                                                                     "grade span"),
 }

@@ -103,7 +103,7 @@ def build_problem(scene: Scene, choice: ModelChoice, parameters: ModelParameters
     vertical = scene.orientation == "vertical"
     kw = {"gravity_m_s2": 0.0 if vertical else gravity,
           "inner_speed_rad_s": scene.conditions.speed_rad_s, "effects": effects, "parameters": parameters,
-          "speed_ramp_s": scene.speed_ramp_s, "oil_air_density_kg_m3": scene.oil_air_density_kg_m3}
+          "speed_ramp_s": scene.speed_ramp_s, "oil_air_density_kg_m3": scene.mixture_density_kg_m3}
     if choice.level == "spatial":
         return S.spatial_problem(scene.bearing, theta, radius, ring, scene.conditions.radial_load_n,
                                  axial_load_n=scene.conditions.axial_load_n,

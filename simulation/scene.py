@@ -39,7 +39,9 @@ class Scene:
     moment_load_nm
         Moment load on the inner ring (N m), >= 0.
     oil_air_density_kg_m3
-        Density of the oil-air mixture the balls churn through, or ``None`` for none (no drag).
+        Density of the oil-air mixture the balls churn through (kg/m^3). ``None``: in a lubricated scene the
+        mixture of 5 % oil by volume in air (:func:`cageless.simulation.physics.drag.mixture_density`, Parker, NASA
+        TP-2275, 1984), in a dry scene none; 0 turns drag off.
     duration_s
         Simulated time after the start (s), > 0.
     speed_ramp_s
@@ -76,9 +78,21 @@ class Scene:
         if self.orientation not in ORIENTATIONS:
             raise ParameterError("scene.orientation", f"must be one of {ORIENTATIONS}", self.orientation)
         rho = self.oil_air_density_kg_m3
-        if rho is not None and not (math.isfinite(rho) and rho > 0):
-            raise ParameterError("scene.oil_air_density_kg_m3", "must be a finite number > 0, or None for no mixture",
-                                 rho)
+        if rho is not None and not (math.isfinite(rho) and rho >= 0):
+            raise ParameterError("scene.oil_air_density_kg_m3", "must be a finite number >= 0 (0: no drag), or None "
+                                 "for the default mixture", rho)
+
+    @property
+    def mixture_density_kg_m3(self) -> float | None:
+        """The oil-air mixture density drag uses (kg/m^3): as given, else the default mixture of a lubricated
+        scene (5 % oil by volume), else None (dry, none given)."""
+        if self.oil_air_density_kg_m3 is not None:
+            return float(self.oil_air_density_kg_m3)
+        if self.bearing.lubricant is None:
+            return None
+        from cageless.simulation.physics.drag import mixture_density
+
+        return mixture_density(self.bearing.lubricant.density_kg_m3)
 
     @property
     def lubricated(self) -> bool:

@@ -2,6 +2,9 @@
 
 :func:`solve` runs a :class:`Problem` with the method named in :data:`METHODS`:
 
+* ``"rosw"``: the Rosenbrock-W method ROS34PW2 with its whole loop compiled, linearly implicit in each ball's
+  states and the ring's (:mod:`cageless.simulation.integrators.rosw`), with DP5's controls; its step is set by
+  accuracy, not by the race damping's stability limit;
 * ``"dp5"``: Dormand-Prince 5(4) with its whole loop compiled (the default); it rejects and retries
   any step longer than ``Problem.onset_step`` in which a contact opens or closes, or across which a
   force jumps by more than the fraction ``force_jump`` (see :func:`solve`), and counts both;
@@ -40,6 +43,7 @@ from scipy.integrate import BDF, DOP853, LSODA, RK45, Radau
 
 from cageless.errors import ParameterError, suggest
 from cageless.simulation.integrators.dp5 import STATUS_OK, dp5_integrate
+from cageless.simulation.integrators.rosw import JAC_EVERY, rosw_integrate
 from cageless.simulation.jacobian import JacobianStructure
 from cageless.simulation.kernels import model_gaps, model_post, model_rhs
 from cageless.simulation.problem import Problem
@@ -103,6 +107,53 @@ def _compiled(name: str, integrate: Callable[..., int]) -> Callable[..., Solutio
                         n_stiff_steps=int(stats[7]), extra={"log": log, "last_h": float(stats[3])})
 
     return run
+
+
+def _rosw_blocks(pr: Problem) -> tuple[npt.NDArray[np.int64], ...]:
+    """The blocks the Rosenbrock-W method treats implicitly, from the problem's Jacobian structure
+    (:class:`~cageless.simulation.jacobian.JacobianStructure`): each ball's states (grouped by colour), the
+    ring's states, the rows every ball reaches, and the rest explicit. A model without a structure is one
+    dense block."""
+    structure = JacobianStructure.for_problem(pr)
+    n = len(pr.y0)
+    none = np.zeros(0, dtype=np.int64)
+    if structure is None:
+        return (np.arange(n, dtype=np.int64).reshape(n, 1), np.zeros((1, 1), dtype=np.int64),
+                np.zeros((0, 1), dtype=np.int64), none, none)
+    ring = structure.other_cols.reshape(-1, 1).astype(np.int64)
+    explicit = np.setdiff1d(np.arange(n), np.concatenate([structure.ball_cols.ravel(), ring.ravel()]))
+    return (structure.ball_cols.astype(np.int64), structure.groups.astype(np.int64), ring, explicit.astype(np.int64),
+            structure.ring_rows.astype(np.int64))
+
+
+#: The Rosenbrock-W method's absolute tolerances: the problem's times this factor times rtol / 1e-6, so one rtol
+#: moves both. Its steps are set by its error test, and at the problem's own atol (which the explicit DP5 runs
+#: far below, held by stability) that test admits 0.036 pp of slip error over 5 ms at 3000 rpm, 500 N
+#: (planar, from a settled state); at this factor 0.036 pp at rtol 1e-6, 2.5e-3 pp at 1e-7, 2.2e-4 pp at 1e-8
+#: (benchmarks/solver_speed.py).
+ROSW_ATOL_FACTOR = 1e-2
+
+
+def _rosw(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float, first_step: float | None,
+          max_steps: int, force_jump: float, jac_every: int = JAC_EVERY) -> Solution:
+    """The compiled Rosenbrock-W method (:mod:`cageless.simulation.integrators.rosw`), with absolute tolerances
+    scaled by :data:`ROSW_ATOL_FACTOR` and rtol."""
+    out = np.full((len(t_eval), len(pr.y0)), np.nan)
+    stats = np.zeros(9)
+    floor = np.zeros(len(pr.y0)) if pr.jump_floor is None else pr.jump_floor.astype(np.float64)
+    log = pr.log.copy()
+    h0 = first_step or min(max_step, 1e-3 * max(t_eval[-1] - pr.t0, 1e-12))
+    t0 = time.perf_counter()
+    status = rosw_integrate(pr.model_id, pr.params, log, pr.y0.astype(np.float64), float(pr.t0), t_eval,
+                            float(rtol), pr.atol.astype(np.float64) * (ROSW_ATOL_FACTOR * rtol / 1e-6), float(h0),
+                            float(max_step), int(max_steps), out, stats, float(pr.onset_step), floor,
+                            float(force_jump if pr.jump_floor is not None else 0.0), _rosw_blocks(pr),
+                            int(jac_every))
+    return Solution(t=t_eval, y=out, status=int(status), message=_MESSAGES[int(status)], method="rosw",
+                    n_steps=int(stats[0]), n_rejected=int(stats[1]), n_rhs=int(stats[2]),
+                    wall_s=time.perf_counter() - t0, n_onset_retries=int(stats[4]),
+                    n_contact_changes=int(stats[5]), n_force_jump_retries=int(stats[6]),
+                    extra={"log": log, "last_h": float(stats[3]), "n_jacobians": int(stats[8])})
 
 
 def step_scipy(pr: Problem, t_eval: FloatArray, method: str, rtol: float, max_step: float = np.inf,
@@ -407,6 +458,7 @@ class Method(Protocol):
 
 METHODS: dict[str, Method] = {
     "dp5": _compiled("dp5", dp5_integrate),
+    "rosw": _rosw,
     "CVODE": lambda pr, t, rtol, max_step, first_step, max_steps, force_jump: step_cvode(pr, t, rtol, max_step,
                                                                                        first_step, max_steps),
     **{m: _scipy(m) for m in ("RK45", "DOP853", "LSODA", "BDF", "Radau")},

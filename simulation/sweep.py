@@ -88,7 +88,7 @@ def simulate_point(point: Mapping[str, Any], base: Mapping[str, Any]) -> tuple[A
     from cageless.kinematics import startup_duration
     from cageless.simulation.parameters import ModelParameters
     from cageless.simulation.scene import Scene
-    from cageless.simulation.simulation import Simulation
+    from cageless.simulation.simulation import Choices, Simulation
 
     scene_kw = {n: point.get(n, base[n]) for n in SCENE_NAMES}
     model = {k: v for k, v in point.items() if k not in SCENE_NAMES and "." not in k and k != "seed"}
@@ -101,7 +101,8 @@ def simulate_point(point: Mapping[str, Any], base: Mapping[str, Any]) -> tuple[A
             scene_kw["speed_rpm"], g.ball_diameter_m, g.pitch_diameter_m)
         scene = Scene(conditions=OperatingConditions(**scene_kw), bearing=bearing,
                       duration_s=settle + base["duration_s"], seed=int(point["seed"]))
-        sim = Simulation(scene, ModelParameters().with_overrides({**base["parameters"], **model}))
+        choices = Choices(effects=dict(base.get("effects") or {}), force=bool(base.get("effects")))
+        sim = Simulation(scene, ModelParameters().with_overrides({**base["parameters"], **model}), choices)
         trace = sim.run(config={"command": base.get("command", "sweep")})
     except CagelessError as exc:
         return None, None, settle, str(exc)
@@ -122,21 +123,25 @@ def _run_point(point: dict[str, Any], base: dict[str, Any]) -> dict[str, Any]:
 
 def sweep_base(speed_rpm: float, radial_load_n: float = 0.0, axial_load_n: float = 0.0, duration_s: float = 0.1,
                settle_s: float | None = None, parameters: Mapping[str, float] | None = None,
-               bearing: Bearing | None = None, command: str = "sweep") -> dict[str, Any]:
-    """The fixed part of every grid point (plain values, so it travels to worker processes and Dask)."""
+               bearing: Bearing | None = None, command: str = "sweep",
+               effects: Mapping[str, bool] | None = None) -> dict[str, Any]:
+    """The fixed part of every grid point (plain values, so it travels to worker processes and Dask);
+    ``effects`` are effect overrides (name -> on), applied as forced."""
     return {"speed_rpm": speed_rpm, "radial_load_n": radial_load_n, "axial_load_n": axial_load_n,
             "duration_s": duration_s, "settle_s": settle_s, "parameters": dict(parameters or {}),
-            "bearing": (bearing or default_bearing()).to_dict(), "command": command}
+            "bearing": (bearing or default_bearing()).to_dict(), "command": command, "effects": dict(effects or {})}
 
 
 def run_sweep(vary: Mapping[str, Sequence[float]], seeds: int, speed_rpm: float, radial_load_n: float = 0.0,
               axial_load_n: float = 0.0, duration_s: float = 0.1, settle_s: float | None = None,
               parameters: Mapping[str, float] | None = None, bearing: Bearing | None = None, workers: int = 2,
-              scheduler: str | None = None, progress: bool = True) -> pd.DataFrame:
+              scheduler: str | None = None, progress: bool = True,
+              effects: Mapping[str, bool] | None = None) -> pd.DataFrame:
     """Run the grid and return one row per run (the varied values, seed, peak slip in %, status)."""
     from cageless.parallel import gather, job_pool
 
-    base = sweep_base(speed_rpm, radial_load_n, axial_load_n, duration_s, settle_s, parameters, bearing)
+    base = sweep_base(speed_rpm, radial_load_n, axial_load_n, duration_s, settle_s, parameters, bearing,
+                      effects=effects)
     points = sweep_grid(vary, seeds)
     with job_pool(workers, scheduler) as pool:
         rows = gather([pool.submit(_run_point, p, base) for p in points], "sweep runs", progress)

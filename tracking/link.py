@@ -186,13 +186,15 @@ def find_start(frames: Callable[[int], np.ndarray], n_frames: int, s: TrackSetup
 def track_frames(frames: Callable[[int], np.ndarray], times: npt.NDArray[np.float64], s: TrackSetup,
                  path: str = "video", strict: bool = False,
                  progress: Callable[[int], None] | None = None,
-                 offset: int = 0) -> tuple[pd.DataFrame, tuple[float, float]]:
+                 offset: int = 0, compiled: bool = True) -> tuple[pd.DataFrame, tuple[float, float]]:
     """Track all frames; return the track table and the highlight-circle centre used for prediction.
 
     ``frames(i)`` returns frame ``i`` (cropped like ``s.background``); ``progress(k)`` is called
     with the number of frames done since the last call. ``offset`` is the absolute number of frame 0
     (for a segment of a longer video). With a chosen ball circle (``s.ring``) tracking starts from
-    the selection's anchors; without, from the first frame showing the expected count.
+    the selection's anchors; without, from the first frame showing the expected count. With the
+    ``"window"`` detector the frames go through the compiled step in blocks (``compiled=False``: the
+    Python step on every frame, the reference it is tested against).
     """
     n = len(times)
     omega0 = None
@@ -218,7 +220,7 @@ def track_frames(frames: Callable[[int], np.ndarray], times: npt.NDArray[np.floa
         progress(1)
     for direction in (1, -1):
         state = _State(**{k: (val.copy() if isinstance(val, np.ndarray) else val) for k, val in init.__dict__.items()})
-        if s.params.method == "window":
+        if compiled and s.params.method == "window":
             _run_compiled(frames, times, state, s, centre, (u, v, mass), start, direction, progress)
             continue
         rng = range(start + 1, n) if direction == 1 else range(start - 1, -1, -1)

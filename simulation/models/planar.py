@@ -51,9 +51,10 @@ from cageless.simulation.effects import check_lubricant, effect_flags
 from cageless.simulation.parameters import ModelParameters
 from cageless.simulation.problem import Problem
 from cageless.simulation.models.base import (LAYOUT, P_CD, P_CHI, P_CHO, P_D, P_DI, P_DO, P_DRY, P_ETA0, P_FR,
-                                    P_F_BB, P_F_BBFILM, P_F_DRAG, P_F_GRAV, P_F_LUB, P_F_RACE, P_F_TRAC, P_G, P_H0,
+                                    P_F_BB, P_F_BBFILM, P_F_DRAG, P_F_GRAV, P_F_LUB, P_F_RACE, P_F_ROLL, P_F_TRAC, P_G, P_H0,
                                     P_I, P_KB, P_KI, P_KO, P_M, P_MR, P_RAMP, P_RHO_MIX, P_V_IN_MIN, P_WI, P_Z)
-from cageless.simulation.models.contact_laws import RACE_LAWS, race_extra, tangential
+from cageless.simulation.models.contact_laws import RACE_LAWS, ball_churning, ball_drag, race_extra, tangential
+from cageless.simulation.models.rolling import race_rolling, rolling_slots
 
 __all__ = [
     "PlanarLayout", "planar_problem", "planar_energy", "packed_start", "contact_events", "DEFAULT_CHO_N_S_M",
@@ -113,6 +114,11 @@ def _race_forces(y, p, j, z, w_i, c, s):  # pragma: no cover - compiled
             f_t = -tangential(u, u_r, q, p)
             p_diss -= f_t * u
             torque += half * f_t
+        if p[P_F_ROLL] > 0.5:  # rolling losses (models/rolling.py): pressure on the centre, shear at the surface
+            f_p, f_s = race_rolling(0.5 * (r * thd + half * om - p[P_DO] * thd), q, False, p)
+            torque += half * f_s
+            p_diss -= f_p * r * thd + f_s * (r * thd + half * om)
+            f_t += f_p + f_s
         fy += -q * c - f_t * s
         fz += -q * s + f_t * c
     sx, sz = r * c - cy, r * s - cz
@@ -144,6 +150,13 @@ def _race_forces(y, p, j, z, w_i, c, s):  # pragma: no cover - compiled
             p_diss -= f_t * u
             p_in += w_i * r_i * f_t
             torque -= half * f_t
+        if p[P_F_ROLL] > 0.5:
+            r_i, vt = 0.5 * p[P_DI], vx * tx + vz * tz
+            f_p, f_s = race_rolling(0.5 * (vt * (1.0 - 2.0 * r_i / ln) - half * om + w_i * r_i), q, True, p)
+            torque -= half * f_s
+            p_diss -= f_p * vt + f_s * (vt - half * om - w_i * r_i)
+            p_in += w_i * r_i * f_s
+            f_t += f_p + f_s
         gy, gz = q * nx + f_t * tx, q * nz + f_t * tz
         fy += gy
         fz += gz
@@ -235,7 +248,7 @@ def planar_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
             dydt[4 * z + j] += torque
             dydt[4 * z + k] += torque
             power += p_diss
-    drag = 0.5 * p[P_CD] * p[P_RHO_MIX] * 0.25 * np.pi * d * d if p[P_F_DRAG] > 0.5 else 0.0
+    drag = p[P_F_DRAG] > 0.5
     for j in range(z):
         r = y[j]
         c, s = log[trig + j], log[trig + z + j]
@@ -243,10 +256,11 @@ def planar_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
         rd, thd = y[2 * z + j], y[3 * z + j]
         f_rad = fy * c + fz * s
         f_tan = -fy * s + fz * c
-        if drag > 0.0:
-            v = r * thd
-            f_tan -= drag * v * abs(v)
-            power += drag * v * v * abs(v)
+        if drag:  # the mixture's drag on the orbital motion and churning moment on the spin
+            f_d, m_c = ball_drag(r * thd, p), ball_churning(y[4 * z + j], p)
+            f_tan += f_d
+            dydt[4 * z + j] += m_c
+            power -= f_d * r * thd + m_c * y[4 * z + j]
         dydt[2 * z + j] = f_rad / m + r * thd * thd
         dydt[3 * z + j] = (f_tan / m - 2.0 * rd * thd) / r
         dydt[4 * z + j] /= inertia
@@ -280,8 +294,8 @@ def planar_ring_share(t, y, p, log, j, out):  # pragma: no cover - compiled
             ca, sa, cb, sb = np.cos(y[z + a]), np.sin(y[z + a]), np.cos(y[z + b]), np.sin(y[z + b])
             out[3] += _pair_forces(y, p, log, a, b, z, ca, sa, cb, sb)[3]
     if p[P_F_DRAG] > 0.5:
-        v = y[j] * y[3 * z + j]
-        out[3] += 0.5 * p[P_CD] * p[P_RHO_MIX] * 0.25 * np.pi * p[P_D] * p[P_D] * v * v * abs(v)
+        v, om = y[j] * y[3 * z + j], y[4 * z + j]
+        out[3] -= ball_drag(v, p) * v + ball_churning(om, p) * om
 
 
 def planar_ring_rows(n_balls: int) -> list[int]:
@@ -439,7 +453,7 @@ def _params(bearing: Bearing, radial_load_n: float, gravity_m_s2: float, inner_s
     ta, tb, tc, td = par.traction_coefficients
     LAYOUT.fill(p, {"CHO": par.cho_n_s_m, "H0": par.film_thickness_m, "TA": ta, "TB": tb, "TC": tc, "TD": td,
                     "V_REG": par.slip_regularisation_m_s, "U_FLOOR": par.min_entrainment_m_s,
-                    "CD": par.drag_coefficient, "V_IN_MIN": par.min_approach_speed_m_s})
+                    "CD": par.drag_coefficient or 0.0, "V_IN_MIN": par.min_approach_speed_m_s})
     if p[P_DRY] and p[P_F_TRAC]:
         if par.dry_friction_coefficient is None:
             raise ParameterError("dry_friction_coefficient", "a dry scene needs the Coulomb friction of the bare "
@@ -450,11 +464,30 @@ def _params(bearing: Bearing, radial_load_n: float, gravity_m_s2: float, inner_s
                         "V_STRIBECK": par.stribeck_speed_m_s})
     else:
         p[P_DRY] = 0.0  # no friction law is evaluated: nothing to switch
+    if p[P_F_ROLL]:
+        LAYOUT.fill(p, rolling_slots(bearing, par))
     if p[P_F_DRAG]:
-        if oil_air_density_kg_m3 is None:
+        if oil_air_density_kg_m3 is None and lubricated:  # the default mixture of a lubricated scene
+            from cageless.simulation.physics.drag import mixture_density
+
+            oil_air_density_kg_m3 = mixture_density(bearing.lubricant.density_kg_m3)
+        if not oil_air_density_kg_m3:
             raise ParameterError("oil_air_density_kg_m3", "drag is on but no oil-air mixture density is given")
         p[P_RHO_MIX] = oil_air_density_kg_m3
+        p[LAYOUT.index("MU_MIX")] = mixture_viscosity_for(bearing, oil_air_density_kg_m3)
     return p
+
+
+def mixture_viscosity_for(bearing: Bearing, rho_mix: float) -> float:
+    """Viscosity (Pa s) of an oil-air mixture of density ``rho_mix``: the oil's volume fraction from the density,
+    then the volume-weighted mean (:func:`cageless.simulation.physics.drag.mixture_viscosity`); air when dry."""
+    from cageless.simulation.physics import drag
+
+    lub = bearing.lubricant
+    if lub is None:
+        return drag.AIR_VISCOSITY_PA_S
+    x = (rho_mix - drag.AIR_DENSITY_KG_M3) / (lub.density_kg_m3 - drag.AIR_DENSITY_KG_M3)
+    return drag.mixture_viscosity(lub.dynamic_viscosity_pa_s, min(max(x, 0.0), 1.0))
 
 
 def planar_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLike, ring0: tuple[float, float],

@@ -87,10 +87,11 @@ def reference_rhs(t: float, y: npt.NDArray[np.float64], p: npt.NDArray[np.float6
         power += _pairs(y, p, log, fy, fz, torque)
     f_rad, f_tan = fy * c + fz * s, -fy * s + fz * c
     if p[B.P_F_DRAG] > 0.5:
-        v = r * thd
-        k_d = 0.5 * p[B.P_CD] * p[B.P_RHO_MIX] * 0.25 * np.pi * d * d
-        f_tan = f_tan - k_d * v * np.abs(v)
-        power += np.sum(k_d * v * v * np.abs(v))
+        v, om = r * thd, y[4 * z:5 * z]
+        f_d, m_c = _drag(v, om, p)
+        f_tan = f_tan + f_d
+        torque = torque + m_c
+        power -= np.sum(f_d * v + m_c * om)
     out = np.empty_like(y)
     out[:z], out[z:2 * z] = rd, thd
     out[2 * z:3 * z] = f_rad / m + r * thd**2
@@ -101,6 +102,20 @@ def reference_rhs(t: float, y: npt.NDArray[np.float64], p: npt.NDArray[np.float6
     out[5 * z + 4] = power_in
     out[5 * z + 5] = power
     return out
+
+
+def _drag(v: np.ndarray, om: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Drag (N) on the orbital speeds v and churning moments (N m) on the spins om, vectorised."""
+    d, rho, mu = p[B.P_D], p[B.P_RHO_MIX], p[B.P_MU_MIX]
+    if p[B.P_CD] > 0:
+        f = -0.125 * np.pi * p[B.P_CD] * rho * d * d * v * np.abs(v)
+    else:
+        re = rho * np.abs(v) * d / mu
+        cd = np.maximum(24.0 / np.maximum(re, 1e-300) * (1.0 + 0.15 * re ** 0.687), 0.44)
+        f = -np.sign(v) * 0.125 * np.pi * cd * rho * d * d * v * v
+    w, r = np.abs(om), 0.5 * d
+    m = -np.sign(om) * (8.0 * np.pi * mu * r ** 3 * w + 3.225 * np.sqrt(rho * mu) * r ** 4 * w ** 1.5)
+    return f, m
 
 
 def _pairs(y: np.ndarray, p: np.ndarray, log: np.ndarray, fy: np.ndarray, fz: np.ndarray,

@@ -45,7 +45,8 @@ from cageless.simulation.forces import FASTMATH, hertz_damped
 from cageless.simulation.hertz import compliance, hertz_contact, race_curvatures
 from cageless.simulation.models import base as B
 from cageless.simulation.models import planar as P
-from cageless.simulation.models.contact_laws import RACE_LAWS, race_extra, tangential
+from cageless.simulation.models.contact_laws import RACE_LAWS, ball_churning, ball_drag, race_extra, tangential
+from cageless.simulation.models.rolling import spatial_rolling
 from cageless.simulation.problem import Problem
 
 __all__ = ["MODEL_ID", "SpatialLayout", "spatial_problem", "spatial_rhs", "spatial_signature", "race_geometry",
@@ -230,6 +231,15 @@ def _race(y, p, j, z, inner, w_i, rot, c, s, wt):  # pragma: no cover - compiled
     if inner:  # reaction on the ring: -F at the contact point, and -t2
         rmx, rmy, rmz = _cross(xrx, xry, xrz, -fx, -fy, -fz)
         rmx, rmy, rmz = rmx - t2x, rmy - t2y, rmz - t2z
+    if p[B.P_F_ROLL] > 0.5 and q > 0.0:  # rolling losses (models/rolling.py); the ring takes its own reaction
+        w = (w_i * rot[0], w_i * rot[3], w_i * rot[6]) if inner else (0.0, 0.0, 0.0)
+        gx, gy, gz, hx, hy, hz, pin, pd, qx, qy, qz = spatial_rolling(
+            p, inner, q, (rvx, rvy, rvz), (nx, ny, nz), (tx, ty, tz), (ox, oy, oz), w, (xrx, xry, xrz),
+            (rot[0], rot[3], rot[6]), wt if inner else (0.0, 0.0, 0.0), r_c, rq)
+        fx, fy, fz, mx, my, mz = fx + gx, fy + gy, fz + gz, mx + hx, my + hy, mz + hz
+        p_in, p_diss = p_in + pin, p_diss + pd
+        if inner:
+            rmx, rmy, rmz = rmx + qx, rmy + qy, rmz + qz
     return fx, fy, fz, mx, my, mz, p_in, p_diss, delta, rmx, rmy, rmz
 
 
@@ -282,6 +292,23 @@ def _pair(y, p, log, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
             fx, fy, fz = fx + g * ux, fy + g * uy, fz + g * uz  # on k: +g u
             mx, my, mz = _cross(half * nx, half * ny, half * nz, -g * ux, -g * uy, -g * uz)
     return fx, fy, fz, mx, my, mz, p_diss
+
+
+@numba.njit(cache=True, fastmath=FASTMATH)
+def _churn(y, p, j, z, dydt):  # pragma: no cover - compiled
+    """The churning moment against ball j's spin vector, added to its moment slots of ``dydt`` when given;
+    returns its power (<= 0)."""
+    b = 5 * z + 6
+    ox, oy, oz = y[4 * z + j], y[b + 2 * z + j], y[b + 3 * z + j]
+    w = math.sqrt(ox * ox + oy * oy + oz * oz)
+    if w == 0.0:
+        return 0.0
+    k = ball_churning(w, p) / w
+    if dydt is not None:
+        dydt[4 * z + j] += k * ox
+        dydt[b + 2 * z + j] += k * oy
+        dydt[b + 3 * z + j] += k * oz
+    return k * w * w
 
 
 @numba.njit(cache=True, fastmath=FASTMATH)
@@ -340,16 +367,16 @@ def spatial_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
                 dydt[o + j] += mo
                 dydt[o + k] += mo
             power += pd
-    drag = 0.5 * p[B.P_CD] * p[B.P_RHO_MIX] * 0.25 * np.pi * d * d if p[B.P_F_DRAG] > 0.5 else 0.0
+    drag = p[B.P_F_DRAG] > 0.5
     for j in range(z):
         r, rd, thd = y[j], y[2 * z + j], y[3 * z + j]
         c, s = log[trig + j], log[trig + z + j]
         fy, fz = dydt[2 * z + j], dydt[3 * z + j]
         f_rad, f_tan = fy * c + fz * s, -fy * s + fz * c
-        if drag > 0.0:
-            v = r * thd
-            f_tan -= drag * v * abs(v)
-            power += drag * v * v * abs(v)
+        if drag:
+            f_d = ball_drag(r * thd, p)
+            f_tan += f_d
+            power -= f_d * r * thd + _churn(y, p, j, z, dydt)
         dydt[j], dydt[z + j] = rd, thd
         dydt[2 * z + j] = f_rad / m + r * thd * thd
         dydt[3 * z + j] = (f_tan / m - 2.0 * rd * thd) / r
@@ -401,7 +428,7 @@ def spatial_ring_share(t, y, p, log, j, out):  # pragma: no cover - compiled
             out[6] += _pair(y, p, log, a, b, z, ca, sa, cb, sb)[6]
     if p[B.P_F_DRAG] > 0.5:
         v = y[j] * y[3 * z + j]
-        out[6] += 0.5 * p[B.P_CD] * p[B.P_RHO_MIX] * 0.25 * np.pi * p[B.P_D] ** 2 * v * v * abs(v)
+        out[6] -= ball_drag(v, p) * v + _churn(y, p, j, z, None)
 
 
 def spatial_ring_rows(n_balls: int) -> list[int]:

@@ -30,50 +30,51 @@ ALL = [("TUNING", s) for s in TUNING] + [("HOLDOUT", s) for s in HOLDOUT]
 
 #: Seeds today's tracker fails on the short clips, with how (benchmarks/tracking_corpus.py, 2026-11-23: the
 #: tracker of commit e3726da passed TUNING 4 of 32 and HOLDOUT 1 of 32; with the ball selection stage
-#: (tracking/select.py) TUNING 14 of 32 and HOLDOUT 12 of 32). Remove a seed when it passes.
+#: (tracking/select.py) TUNING 14 and HOLDOUT 12; with the ball band found from motion on dark faces, on the
+#: corpus of format 8 (no texture leaking through blurred balls, an MPEG-4 codec factor on the AVI clips)
+#: TUNING 13 of 32 and HOLDOUT 14 of 32). Remove a seed when it passes.
 KNOWN_FAILURES: dict[int, str] = {
-    1000: "angle_rms 0.564 mrad > 0.5",
-    1001: "angle_rms 0.559 mrad > 0.5; speed_rms 0.64 % of cage speed > 0.5; slip_mae 0.382 pp > 0.3",
-    1002: "no trace: the bright region is not circular (fit residual 54.8 px on radius 500.9 px): no bearing in view.",
-    1003: "angle_rms 0.683 mrad > 0.5",
+    1000: "angle_rms 0.562 mrad > 0.5",
+    1001: "angle_rms 0.562 mrad > 0.5; speed_rms 0.638 % of cage speed > 0.5; slip_mae 0.382 pp > 0.3",
+    1002: "angle_rms 1.31 mrad > 0.5; speed_rms 0.508 % of cage speed > 0.5",
+    1003: "angle_rms 0.669 mrad > 0.5",
     1006: "no trace: found 7 balls moving together along one circle, but the bearing has 14.",
+    1010: "angle_rms 0.514 mrad > 0.5",
     1011: "angle_rms 1.39 mrad > 0.5; speed_rms 1.38 % of cage speed > 0.5; slip_mae 0.961 pp > 0.3",
     1012: "no trace: found 15 balls moving together along one circle, but the bearing has 16.",
     1013: "angle_rms 2.17 mrad > 0.5",
-    1014: "angle_rms 0.639 mrad > 0.5",
+    1014: "angle_rms 0.632 mrad > 0.5",
     1015: "no trace: found 14 balls moving together along one circle, but the bearing has 15.",
     1019: "no trace: found 11 balls moving together along one circle, but the bearing has 17.",
     1020: "angle_rms 0.667 mrad > 0.5",
     1022: "no trace: found 11 balls moving together along one circle, but the bearing has 13.",
     1023: "angle_rms 0.648 mrad > 0.5; speed_rms 0.502 % of cage speed > 0.5",
-    1024: "angle_rms 0.577 mrad > 0.5",
-    1027: "angle_rms 1.52 mrad > 0.5; slip_mae 0.313 pp > 0.3",
+    1024: "angle_rms 0.576 mrad > 0.5",
+    1027: "angle_rms 1.49 mrad > 0.5; slip_mae 0.311 pp > 0.3",
     1029: "no trace: found 13 balls moving together along one circle, but the bearing has 16.",
-    1031: "angle_rms 0.74 mrad > 0.5; speed_rms 0.573 % of cage speed > 0.5",
-    7000: "angle_rms 0.543 mrad > 0.5",
-    7002: "no trace: no bright ring-shaped region found: no bearing in view.",
+    1031: "angle_rms 0.593 mrad > 0.5; speed_rms 0.511 % of cage speed > 0.5",
+    7002: "angle_rms 0.608 mrad > 0.5",
     7004: "no trace: found 9 balls moving together along one circle, but the bearing has 12.",
     7005: "no trace: found 19 balls moving together along one circle, but the bearing has 20.",
-    7006: "angle_rms 0.634 mrad > 0.5; speed_rms 0.598 % of cage speed > 0.5; slip_mae 0.35 pp > 0.3",
-    7007: "angle_rms 0.528 mrad > 0.5",
-    7008: "angle_rms 1.73 mrad > 0.5; speed_rms 0.987 % of cage speed > 0.5; slip_mae 0.403 pp > 0.3",
-    7009: "no trace: no bright ring-shaped region found: no bearing in view.",
+    7006: "angle_rms 0.634 mrad > 0.5; speed_rms 0.595 % of cage speed > 0.5; slip_mae 0.349 pp > 0.3",
+    7007: "angle_rms 0.943 mrad > 0.5",
+    7008: "angle_rms 1.72 mrad > 0.5; speed_rms 0.991 % of cage speed > 0.5; slip_mae 0.403 pp > 0.3",
+    7009: "angle_rms 0.787 mrad > 0.5",
     7011: "angle_rms 0.728 mrad > 0.5; speed_rms 1.2 % of cage speed > 0.5; slip_mae 0.492 pp > 0.3",
-    7012: "angle_rms 8.01 mrad > 0.5; speed_rms 1.28 % of cage speed > 0.5; slip_mae 1.02 pp > 0.3",
+    7012: "angle_rms 7.94 mrad > 0.5; speed_rms 1.28 % of cage speed > 0.5; slip_mae 1.01 pp > 0.3",
     7013: "no trace: found 16 balls moving together along one circle, but the bearing has 18.",
-    7018: "no trace: no bright ring-shaped region found: no bearing in view.",
+    7018: "angle_rms 3.57 mrad > 0.5; speed_rms 0.796 % of cage speed > 0.5; slip_mae 0.435 pp > 0.3",
     7020: "angle_rms 1.46 mrad > 0.5; speed_rms 0.502 % of cage speed > 0.5",
-    7023: "angle_rms 0.904 mrad > 0.5",
-    7024: "no trace: no bright ring-shaped region found: no bearing in view.",
+    7023: "angle_rms 0.903 mrad > 0.5",
     7025: "angle_rms 1.11 mrad > 0.5; speed_rms 1.01 % of cage speed > 0.5; slip_mae 0.386 pp > 0.3",
     7026: "no trace: found 8 balls moving together along one circle, but the bearing has 18.",
     7028: "angle_rms 0.779 mrad > 0.5",
-    7029: "speed_rms 0.55 % of cage speed > 0.5",
+    7029: "speed_rms 0.551 % of cage speed > 0.5",
     7031: "no trace: found 10 balls moving together along one circle, but the bearing has 12.",
 }
 
 #: The same for the long variants (one cage revolution each; baseline the same day: TUNING 4 of 32 pass,
-#: HOLDOUT 1 of 32; not yet re-run with the ball selection). Seeds 1005, 1019, 1021, 1025, 7001 pass long
+#: HOLDOUT 1 of 32; not yet re-run with the ball selection nor on the corpus of format 8). Seeds 1005, 1019, 1021, 1025, 7001 pass long
 #: (1018 passes only short, 1019 only long).
 _LONG_PASS = {1005, 1019, 1021, 1025, 7001}
 KNOWN_FAILURES_LONG: dict[int, str] = {

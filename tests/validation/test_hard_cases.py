@@ -87,6 +87,14 @@ def static_deflection(scene: Scene) -> float:
     return float((q / k_o) ** (2 / 3))
 
 
+def impact_overlap(scene: Scene, k_b: float) -> float:
+    """Largest Hertz overlap (m) of two balls closing head-on at half the pure-rolling orbital speed v:
+    delta = (5 m_eff v^2 / (4 K))^(2/5), m_eff = m / 2 (Johnson, *Contact Mechanics*, 1985, §11.4)."""
+    g = scene.bearing.geometry
+    v = 0.5 * 0.5 * g.pitch_diameter_m * theoretical_cage_speed(g, scene.conditions.speed_rad_s)
+    return float((5 * 0.5 * scene.bearing.masses.ball_mass_kg * v * v / (4 * k_b)) ** 0.4)
+
+
 @pytest.mark.parametrize("level", ["auto", "spatial"])
 @pytest.mark.parametrize("name", list(CASES))
 def test_hard_case_is_stable(name, level):
@@ -100,9 +108,13 @@ def test_hard_case_is_stable(name, level):
     # interpenetration
     k_b, k_i, k_o = (pr.parameter(name) for name in ("KB", "KI", "KO"))
     c = tr.groups["contacts"]
-    overlap = max(np.nanmax(c["ball_ball_normal"] / k_b) ** (2 / 3), np.nanmax(c["inner_normal"] / k_i) ** (2 / 3),
-                  np.nanmax(c["outer_normal"] / k_o) ** (2 / 3))
+    overlap = max(np.nanmax(c["inner_normal"] / k_i) ** (2 / 3), np.nanmax(c["outer_normal"] / k_o) ** (2 / 3))
     assert overlap < max(OVERLAP_FACTOR * static_deflection(scene), 2e-6), (overlap, static_deflection(scene))
+    # ball-ball: the same, or the Hertz overlap of a head-on impact closing at half the orbital speed, whichever
+    # is larger. With the rolling losses (issue 16) balls leave the loaded zone slowed, and at 12000 rpm the
+    # start-up has a 33 um impact (measured; 17 um without the losses): 4.6 m/s closing, 0.4 of the orbital speed.
+    bb = np.nanmax(c["ball_ball_normal"] / k_b) ** (2 / 3)
+    assert bb < max(OVERLAP_FACTOR * static_deflection(scene), 2e-6, impact_overlap(scene, k_b)), bb
     # energy balance
     energy = energy_balance(pr, sol.y)
     assert energy.input_work[-1] > 0 and energy.drift < 1e-5 * energy.input_work[-1]

@@ -81,7 +81,9 @@ def test_chiu_coefficient_matches_the_published_fit():
     assert rf.chiu_coefficient(2.0) == pytest.approx(9.7171, abs=1e-4)
     assert rf.chiu_coefficient(10.0) == pytest.approx(61.3555, abs=1e-4)
     for t in (1.5, 2.0, 3.0, 4.5, 6.0, 10.0, 30.0, 100.0):  # outside (4.94, 5] the two forms are equal
-        assert rf.chiu_coefficient(t) == rf.chiu_coefficient_published(t)
+        # equal to the last bit or two: the compiled code may fuse the multiply-add when it is compiled inside
+        # a fastmath model kernel first
+        assert rf.chiu_coefficient(t) == pytest.approx(rf.chiu_coefficient_published(t), rel=1e-14, abs=1e-14)
     # below t = exp(10.10 / 28.59) = exp(0.353270) = 1.42372 the starved inlet gives no rolling force
     assert rf.T_ZERO == pytest.approx(1.42372, rel=1e-5)
     assert rf.chiu_coefficient(1.4) == 0.0 and rf.chiu_coefficient(1.45) > 0.0

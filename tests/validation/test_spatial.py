@@ -62,10 +62,15 @@ def test_spatial_matches_planar_under_pure_radial_load(rpm, duration):
     """Measured: RMS 0.03 / 0.03 / 0.002 pp and peak differences 0.04 / 0.009 / 0.001 pp at 1800 / 3000 /
     6000 rpm. 1800 rpm is chaotic: the two models part at round-off within 2 ms of the start, so only
     statistics compare, and they need the longer run (over 0.22 s the RMS is 0.08-0.22 pp depending on
-    round-off; over 0.65 s it is 0.03 pp, against 0.05 pp between two planar runs at rtol 1e-6 and 1e-7)."""
+    round-off; over 0.65 s it is 0.03 pp, against 0.05 pp between two planar runs at rtol 1e-6 and 1e-7).
+    With the rolling losses and drag on (issue 16) 3000 rpm turns chaotic as well, and its statistics wander:
+    two planar runs at rtol 1e-6 and 1e-7 differ by 0.25 pp RMS over 0.15 s and 1.2 pp over 0.4 s, so no run
+    length compares them within 0.2 pp. At 1800 and 3000 rpm this test therefore runs without those two effects (the
+    right-hand sides, with every default effect on, agree to 1e-9: the test above); 6000 rpm keeps them."""
     scene = Scene(conditions=OperatingConditions(rpm, 500.0), duration_s=duration)
-    flat = simulate(scene, choose_model(scene), progress=False).trace
-    full = simulate(scene, choose_model(scene, level="spatial"), progress=False).trace
+    off = {"rolling_losses": False, "drag": False} if rpm < 6000 else {}
+    flat = simulate(scene, choose_model(scene, effects=off, force=True), progress=False).trace
+    full = simulate(scene, choose_model(scene, level="spatial", effects=off, force=True), progress=False).trace
     d = 100 * np.abs(_profile(flat) - _profile(full))
     assert np.sqrt(np.nanmean(d**2)) < 0.2
     assert abs(100 * (np.nanmax(_profile(flat)[:180]) - np.nanmax(_profile(full)[:180]))) < 0.2

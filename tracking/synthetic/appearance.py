@@ -35,14 +35,19 @@ import numpy as np
 from cageless.bearing import Bearing, Geometry, Masses
 from cageless.parameter_sets import wang2026
 
-__all__ = ["ClipParams", "FACTORS", "draw_params", "bearing_for", "factor_u", "factor_stratum", "RESOLUTIONS"]
+__all__ = ["ClipParams", "FACTORS", "draw_params", "bearing_for", "factor_u", "factor_stratum", "RESOLUTIONS",
+           "CODECS"]
 
 #: Camera resolutions (width, height) the draw picks from.
 RESOLUTIONS = ((640, 480), (800, 600), (1024, 768), (1280, 720), (1280, 800))
 #: Frame rates (frames/s).
 FRAME_RATES = (6000.0, 8000.0, 10000.0, 12500.0, 16000.0, 20000.0)
-#: Output containers: Phantom cine at 8, packed 12 and 16 bit, and MJPG in AVI (8 bit).
+#: Output containers: Phantom cine at 8, packed 12 and 16 bit, and an 8-bit AVI (named for its first codec).
 CONTAINERS = ("cine-8", "cine-p12", "cine-16", "avi-mjpg")
+#: Codecs of the AVI: Motion-JPEG (each frame on its own, at the drawn JPEG quality) or MPEG-4 Part 2
+#: (Xvid: motion-compensated inter-frame prediction of DCT blocks, the artefacts of H.264's family; the
+#: OpenCV wheels carry no H.264 encoder).
+CODECS = ("mjpeg", "mpeg4")
 
 #: The factor names, in the fixed order that sets each one's recurrence constant. Append only.
 FACTORS = (
@@ -52,7 +57,7 @@ FACTORS = (
     "elongation", "elong_angle", "second_light", "second_rel", "second_azimuth", "vignetting", "gradient",
     "gradient_angle", "flicker", "flicker_hz", "ring_face", "ring_level", "texture", "land_mode", "land_frac",
     "ball_albedo", "rim", "cavity", "static_glints", "turning_glints", "glint_rel", "dust", "specks",
-    "hot_pixels", "jpeg", "dark_frames", "dropped_frames", "bit_depth_16", "black_level",
+    "hot_pixels", "jpeg", "dark_frames", "dropped_frames", "bit_depth_16", "black_level", "codec",
 )
 _BLOCK = 8
 _INDEX = {name: i for i, name in enumerate(FACTORS)}
@@ -159,6 +164,8 @@ class ClipParams:
     # clip length
     n_frames: int
     n_frames_long: int
+    # the AVI's codec ("none" for a cine)
+    codec: str = "none"
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready fields."""
@@ -266,6 +273,9 @@ def draw_params(seed: int) -> ClipParams:
     r_n2 = 0.25 * ((width - 1) ** 2 + (height - 1) ** 2)
     k1 *= min(1.0, 1.2e-4 * r_n2 / max(abs(k1) * e_px * (rho_px + e_px), 1e-12))
     jpeg = int(round(_cont(s, "jpeg", 30, 90))) if bit_depth == 8 else 0
+    codec = _pick(s, "codec", CODECS) if container == "avi-mjpg" else "none"
+    if codec == "mpeg4":
+        jpeg = 0  # the encoder's own quantisation
     if container == "cine-8" and rng.random() < 0.35:
         jpeg = 0  # some 8-bit cines are clean
     # The highlight is the brightest thing on a ball: the rim (the ring faces mirrored in the ball's edge)
@@ -300,7 +310,7 @@ def draw_params(seed: int) -> ClipParams:
         glint_rel=_cont(s, "glint_rel", 0.5, 3.0), n_dust=int(round(_cont(s, "dust", 0, 30))),
         n_specks=int(round(_cont(s, "specks", 0, 10))), n_hot_pixels=int(round(_cont(s, "hot_pixels", 0, 300))),
         jpeg_quality=jpeg, dark_frame_rate=dark, dropped_frame_rate=dropped,
-        n_frames=n_frames, n_frames_long=n_long,
+        n_frames=n_frames, n_frames_long=n_long, codec=codec,
     )
 
 

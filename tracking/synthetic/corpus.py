@@ -62,7 +62,7 @@ TRUTH_COLUMNS = ("frame", "time_s", "ball", "angle_rad", "speed_rad_s", "slip", 
 _AVI_MAX_FPS = 1000.0
 _SPEED_DT = 1e-6
 #: Bumped when what render_clip writes changes, so cached clips are rendered again.
-_FORMAT = 7
+_FORMAT = 8
 
 
 @dataclass
@@ -269,6 +269,8 @@ def _write_sidecars(folder: Path, stem: str, params: ClipParams) -> None:
 
 
 def _write_video(base: Path, params: ClipParams, frames: Iterator[np.ndarray], times: np.ndarray) -> Path:
+    if params.container == "avi-mjpg" and params.codec == "mpeg4":
+        return _write_mpeg4(base.with_suffix(".avi"), frames, params, len(times))
     if params.container == "avi-mjpg":
         return _write_mjpg(base.with_suffix(".avi"), frames, params)
     fmt = params.container.removeprefix("cine-")
@@ -296,6 +298,33 @@ def _write_mjpg(path: Path, frames: Iterator[np.ndarray], params: ClipParams) ->
     cap.release()
     if found != len(jpegs):
         raise VideoError(path, f"the MJPG file holds {found} of {len(jpegs)} frames.")
+    return path
+
+
+def _write_mpeg4(path: Path, frames: Iterator[np.ndarray], params: ClipParams, n: int) -> Path:
+    """MPEG-4 Part 2 (Xvid) in AVI through OpenCV's FFmpeg writer at its default bit rate: motion-compensated
+    inter-frame prediction, so a frame's artefacts depend on the frames before it."""
+    fps = min(params.fps, _AVI_MAX_FPS)
+    with atomic_path(path) as tmp:
+        out = tmp.with_suffix(".avi")  # OpenCV picks the container by the extension
+        try:
+            writer = cv2.VideoWriter(str(out), cv2.VideoWriter_fourcc(*"XVID"), fps,
+                                     (params.width, params.height), False)
+            if not writer.isOpened():
+                raise VideoError(path, "OpenCV cannot open an MPEG-4 (XVID) writer.")
+            for frame in frames:
+                writer.write(frame)
+            writer.release()
+            out.replace(tmp)
+        finally:
+            out.unlink(missing_ok=True)
+    cap = cv2.VideoCapture(str(path))
+    found = 0
+    while cap.grab():
+        found += 1
+    cap.release()
+    if found != n:
+        raise VideoError(path, f"the MPEG-4 file holds {found} of {n} frames.")
     return path
 
 
@@ -328,6 +357,6 @@ def describe(params: ClipParams) -> dict[str, Any]:
             "bits": params.bit_depth, "fmt": params.container, "rpm": round(params.speed_rpm),
             "slip%": round(100 * params.slip_peak, 1), "faces": params.ring_face, "lands": params.land_mode,
             "fps": int(params.fps), "sat": params.saturated, "dbl": params.second_light_rel > 0,
-            "jpeg": params.jpeg_quality, "dir": params.direction}
+            "jpeg": params.jpeg_quality, "codec": params.codec, "dir": params.direction}
 
 

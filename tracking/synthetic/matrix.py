@@ -58,6 +58,8 @@ CHECKS: tuple[tuple[str, str, Callable[[Sequence[ClipParams]], bool]], ...] = (
     ("distortion", "barrel and pincushion",
      lambda ps: min(p.distortion_k1 for p in ps) < 0 < max(p.distortion_k1 for p in ps)),
     ("JPEG", "quality 30 and none", lambda ps: {30, 0} <= {p.jpeg_quality for p in ps}),
+    ("video codec", "MJPEG and MPEG-4 Part 2 (inter-frame) AVI",
+     lambda ps: {"mjpeg", "mpeg4"} <= {p.codec for p in ps if p.container == "avi-mjpg"}),
     ("dust", "0 and 30 spots", lambda ps: {0, 30} <= {p.n_dust for p in ps}),
     ("hot pixels", "0 and 300", lambda ps: {0, 300} <= {p.n_hot_pixels for p in ps}),
     ("static glints", "0 and 12", lambda ps: {0, 12} <= {p.n_static_glints for p in ps}),

@@ -32,6 +32,7 @@ import numpy as np
 
 from cageless.trace import Trace
 from cageless.tracking.synthetic.corpus import ClipSpec, describe, render_clip
+from cageless.tracking.synthetic.crb import angle_crb_mrad
 from cageless.tracking.synthetic.score import BARS, Score, ideal_trace, score_trace
 
 __all__ = ["ClipResult", "run_seed", "run_seeds", "badness", "oracle_trace", "gaussian_mask_centroid"]
@@ -47,6 +48,7 @@ class ClipResult:
     message: str = ""
     score: dict[str, Any] | None = None
     oracle: dict[str, Any] | None = None
+    angle_crb_mrad: float | None = None
     render_s: float = 0.0
     track_s: float = 0.0
     n_frames: int = 0
@@ -72,6 +74,7 @@ def _track_and_score(spec: ClipSpec) -> ClipResult:
     seed = spec.seed
     factors = describe(spec.params)
     oracle = score_trace(oracle_trace(spec), spec.truth, spec.bearing).to_dict()
+    crb = angle_crb_mrad(spec.params, n_frames=2)
     start = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -79,13 +82,14 @@ def _track_and_score(spec: ClipSpec) -> ClipResult:
             res = track_video(spec.video, spec.conditions, spec.bearing, TrackOptions(threads=1), progress=False)
         except CagelessError as exc:
             return ClipResult(seed, factors, "error", str(exc).splitlines()[0][:300], oracle=oracle,
-                              render_s=spec.render_s,
+                              angle_crb_mrad=crb, render_s=spec.render_s,
                               track_s=time.perf_counter() - start, n_frames=spec.n_frames,
                               warnings=_messages(caught))
     track_s = time.perf_counter() - start
     score: Score = score_trace(res.trace, spec.truth, spec.bearing)
     return ClipResult(seed, factors, "pass" if score.passed else "fail", "; ".join(score.failures),
-                      score=score.to_dict(), oracle=oracle, render_s=spec.render_s, track_s=track_s,
+                      score=score.to_dict(), oracle=oracle, angle_crb_mrad=crb, render_s=spec.render_s,
+                      track_s=track_s,
                       n_frames=spec.n_frames,
                       warnings=_messages(caught))
 

@@ -14,6 +14,7 @@ examples:
   cageless sweep --speed-rpm 1800 --radial-load-n 500 --vary lubricant.viscosity=0.02:0.06:5 --seeds 4
   cageless sweep --radial-load-n 500 --vary speed_rpm=1800,3000,6000 --vary cho_n_s_m=2500,7500 -o sweep
   cageless sweep --speed-rpm 1800 --vary film_thickness_m=1e-7:3.5e-7:6 --scheduler tcp://10.0.0.5:8786
+  cageless sweep --speed-rpm 1800 --vary film_thickness_m=1e-7,3.5e-7 --effect ehl_film=off     a fixed film
 """
 
 
@@ -37,6 +38,8 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
                    help="start-up left out (s; default three cage revolutions at each point, at least 0.04)")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", dest="set_values",
                    help="fixed model-parameter changes for every run")
+    p.add_argument("--effect", action="append", default=[], metavar="NAME=on|off",
+                   help="switch an effect on or off for every run (forced; repeatable), e.g. ehl_film=off")
     p.add_argument("--workers", type=int, default=2, help="local processes (default 2)")
     p.add_argument("--scheduler", help="address of a Dask scheduler")
     p.add_argument("-o", "--out", default="sweep", help="output folder (default ./sweep)")
@@ -60,8 +63,11 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     bearing = bearing_from_config(config)
     vary = parse_vary(args.vary, bearing)
     fixed = parameter_values(args, config)  # [parameters] of --config, then --set
+    from cageless.simulation.effects import parse_effect_overrides
+
     runs = run_sweep(vary, args.seeds, args.speed_rpm, args.radial_load_n, args.axial_load_n, args.duration,
-                     args.settle, fixed, bearing, args.workers, args.scheduler, progress=not args.quiet)
+                     args.settle, fixed, bearing, args.workers, args.scheduler, progress=not args.quiet,
+                     effects=parse_effect_overrides(args.effect))
     paths = write_sweep(runs, list(vary), args.out)
     note = describe_calibration(config.get("calibration"))
     if note:

@@ -1,0 +1,146 @@
+"""Simulator speed: today's `auto` and DP5 against the compiled Rosenbrock-W method, in one run.
+
+    python benchmarks/solver_speed.py [--repeats 3] [--window 0.005] [--cases planar,spatial,bunching,20kN]
+                                      [--json out.json]
+
+Cases (every effect of a lubricated scene):
+
+* ``planar``: 3000 rpm, 500 N, from the state 30 ms after the start, a ``--window`` long;
+* ``spatial``: 3000 rpm, 500 N radial + 400 N axial, 5 strips, the same;
+* ``bunching``: 1800 rpm, 500 N, from the packed start (the balls bunch), 20 ms;
+* ``20kN``: 3000 rpm, 20 kN, from the start, 20 ms.
+
+The settled cases measure the slip error as ``cageless bench accuracy`` does (largest difference of the
+balls' orbital speed over all balls and samples, in percentage points of the cage speed) against a DP5
+reference at rtol 1e-10 and a 0.25 us cap. The ball ring is chaotic, so the 20 ms runs from the start are
+compared with the reference over their first 2 ms only (``early_slip_error_pp``), and by their energy
+balance (drift over input work).
+
+Candidates are run interleaved (every candidate once per round, ``--repeats`` rounds) and each keeps its
+shortest wall time: the machine is shared, and noise only adds time. Ratios are to ``auto`` in the same
+run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from cageless.conditions import OperatingConditions
+from cageless.kinematics import theoretical_cage_speed
+from cageless.simulation.bench import _errors, _settled_problem
+from cageless.simulation.parameters import ModelParameters
+from cageless.simulation.run import energy_balance
+from cageless.simulation.scene import Scene
+from cageless.simulation.simulation import Choices, Simulation
+from cageless.simulation.solve import solve
+
+log = logging.getLogger("solver_speed")
+
+#: (label, method, rtol, max_step; None: the method's default as ``simulate`` runs it).
+CANDIDATES = (
+    ("auto (today's default)", "auto", 1e-6, None),
+    ("dp5, rtol 1e-6, cap 2 us", "dp5", 1e-6, 2e-6),
+    ("rosw, rtol 1e-6 (cap 10 us)", "rosw", 1e-6, None),
+    ("rosw, rtol 1e-7 (cap 10 us)", "rosw", 1e-7, None),
+    ("rosw, rtol 1e-8 (cap 10 us)", "rosw", 1e-8, None),
+)
+
+
+def _from_start(rpm: float, load_n: float, axial_n: float = 0.0, level: str | None = None):  # noqa: ANN202
+    scene = Scene(conditions=OperatingConditions(rpm, load_n, axial_n))
+    pr = Simulation(scene, ModelParameters(), Choices(level=level)).build()
+    return pr, theoretical_cage_speed(scene.bearing.geometry, scene.conditions.speed_rad_s)
+
+
+def _cases(window: float, names: list[str]) -> dict[str, tuple[Any, float, np.ndarray]]:
+    table = {
+        "planar": lambda: (*_settled_problem(3000, 500, 0.03, level="planar"), np.linspace(0, window, 51)),
+        "spatial": lambda: (*_settled_problem(3000, 500, 0.03, axial_n=400, level="spatial", strips=5),
+                            np.linspace(0, window, 51)),
+        "bunching": lambda: (*_from_start(1800, 500), np.linspace(0, 0.02, 201)),
+        "20kN": lambda: (*_from_start(3000, 20000), np.linspace(0, 0.02, 201)),
+    }
+    return {name: table[name]() for name in names}
+
+
+def _run(pr: Any, t: np.ndarray, method: str, rtol: float, cap: float | None) -> Any:
+    kw = {} if cap is None else {"max_step": cap}
+    if method == "auto" and cap is None:
+        return solve(pr, t, method="auto", rtol=rtol)
+    if cap is None:
+        from cageless.simulation.auto_switch import default_max_step
+        kw = {"max_step": default_max_step(method)}
+    return solve(pr, t, method=method, rtol=rtol, **kw)
+
+
+def measure(case: str, pr: Any, cage: float, t: np.ndarray, repeats: int) -> list[dict[str, Any]]:
+    """Every candidate on one case, interleaved, best of ``repeats``."""
+    ref = solve(pr, t, rtol=1e-10, max_step=2.5e-7)
+    z = pr.n_balls
+    radius = float(np.mean(pr.y0[:z]))
+    early = t <= t[0] + 0.002
+    best: dict[str, float] = {}
+    sols: dict[str, Any] = {}
+    for _ in range(repeats):
+        for label, method, rtol, cap in CANDIDATES:
+            sol = _run(pr, t, method, rtol, cap)
+            sols[label] = sol
+            best[label] = min(best.get(label, np.inf), sol.wall_s)
+    rows = []
+    span = float(t[-1] - t[0])
+    for label, *_ in CANDIDATES:
+        sol = sols[label]
+        slip, pos = _errors(sol.y, ref.y, z, cage, radius)
+        slip_early = _errors(sol.y[early], ref.y[early], z, cage, radius)[0]
+        energy = energy_balance(pr, sol.y)
+        rows.append({"case": case, "solver": label, "method": sol.method, "ok": bool(sol.success),
+                     "wall_s_per_sim_s": best[label] / span, "slip_error_pp": slip, "early_slip_error_pp": slip_early,
+                     "position_error_um": pos, "steps": sol.n_steps, "rejected": sol.n_rejected,
+                     "rhs_calls": sol.n_rhs, "energy_drift": float(energy.drift / max(energy.input_work[-1], 1e-30))})
+    base = rows[0]["wall_s_per_sim_s"]
+    for r in rows:
+        r["speedup_vs_auto"] = base / r["wall_s_per_sim_s"]
+    return rows
+
+
+def format_rows(rows: list[dict[str, Any]]) -> str:
+    lines = ["| case | solver | wall s / sim s | speed-up vs auto | slip error (pp) | first 2 ms (pp) | energy drift "
+             "| steps | RHS |", "|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        flag = "" if r["ok"] else " (failed)"
+        lines.append(f"| {r['case']} | {r['solver']}{flag} | {r['wall_s_per_sim_s']:.2f} | {r['speedup_vs_auto']:.2f} | "
+                     f"{r['slip_error_pp']:.2g} | {r['early_slip_error_pp']:.2g} | {r['energy_drift']:.1e} | "
+                     f"{r['steps']} | {r['rhs_calls']} |")
+    return "\n".join(lines)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--window", type=float, default=0.005, help="simulated seconds of the settled cases")
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--cases", default="planar,spatial,bunching,20kN")
+    ap.add_argument("--json", type=Path)
+    args = ap.parse_args()
+    logging.basicConfig(level=logging.INFO, format="%(message)s")
+    rows = []
+    for case, (pr, cage, t) in _cases(args.window, args.cases.split(",")).items():
+        pr = replace(pr)
+        log.info("case %s", case)
+        rows += measure(case, pr, cage, t, args.repeats)
+        log.info("%s", format_rows(rows))
+    print(format_rows(rows))
+    if args.json:
+        tmp = args.json.with_suffix(".tmp")
+        tmp.write_text(json.dumps(rows, indent=1))
+        tmp.replace(args.json)
+
+
+if __name__ == "__main__":
+    main()

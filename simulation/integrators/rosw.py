@@ -1,0 +1,547 @@
+"""A Rosenbrock-W method (ROS34PW2) with its whole loop compiled, linearly implicit per ball.
+
+Why: the explicit DP5's step is held at about 1.1 us by the race lubricant damping (2 C_ho / m =
+2.8e6 1/s), a stability limit, while the contact dynamics themselves (the Hertz period of a loaded ball is
+about 50 us) allow much longer steps. The damping, the race Hertz stiffness and the traction's slope act
+within one ball: they sit in the diagonal blocks of the Jacobian. A linearly implicit method that treats
+only those blocks implicitly has its step set by accuracy again, at the cost of a few small solves a stage.
+
+The method is ROS34PW2 of Rang & Angermann, "New Rosenbrock W-methods of order 3 for partial differential
+algebraic equations of index 1", BIT Numer. Math. 45 (2005) 761-787: four stages, order 3 (embedded
+order 2), L-stable, stiffly accurate. It is a *W*-method: its order conditions hold for any matrix in
+place of the Jacobian, so a Jacobian that keeps only the per-ball blocks (and the ring's own block),
+evaluated now and then, and without the time derivative of the ring's speed ramp, still gives order 3;
+only the stability of what is left out (ball-ball coupling, the ring's coupling to the balls) is an
+explicit method's, and those modes are slow (periods of tens of microseconds). The stages are written in
+the transformed variables u_i = sum_j gamma_ij k_j of Hairer & Wanner, *Solving ODEs II*, 2nd ed.
+(1996), sect. IV.7, eq. (7.25), so no Jacobian-vector product is needed:
+
+    (I / (h gamma) - W) u_i = f(t + alpha_i h, y + sum_j a_ij u_j) + sum_j (c_ij / h) u_j.
+
+W is block diagonal: ball j's states (the problem's Jacobian structure names them; the solver never
+indexes the model's parameters) form one block, estimated by grouped difference quotients (balls of one
+colour are perturbed together, :func:`cageless.simulation.jacobian.ball_colours`); the ring's states form
+another, estimated one column at a time; every other state (the energy counters) is explicit. Each
+block is LU-factorised once per step. A model without a Jacobian structure (the textbook test models)
+is one dense block.
+
+W is re-evaluated when a step is rejected (if it is not fresh), when a contact opened or closed in the
+last accepted step (a damping term switched on or off), and at least every :data:`JAC_EVERY` accepted
+steps. The first stage is the end derivative of the last step (f(y) is needed for the dense output
+anyway), so a step costs three new right-hand sides plus one at its end.
+
+The controls of the compiled DP5 loop (:mod:`cageless.simulation.integrators.dp5`) are kept: a step longer than
+``h_onset`` in which a contact opens or closes is retried at ``h_onset``; one across which a force jumps
+is retried at half the length; samples come from cubic Hermite interpolation between step ends; the
+model's bookkeeping (the contact log) runs after every accepted step.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from cageless.simulation.integrators.dp5 import (STATUS_MAX_STEPS, STATUS_NONFINITE, STATUS_OK,
+                                                 STATUS_STEP_UNDERFLOW, _force_jumped, _hermite)
+from cageless.simulation.kernels import model_post, model_rhs, model_ring_share, model_signature
+
+__all__ = ["rosw_integrate", "JAC_EVERY", "GAMMA", "transformed_tableau"]
+
+#: Accepted steps after which W is re-evaluated even if no contact changed. Measured at 3000 rpm, 500 N,
+#: planar, 5 ms from a settled state (see benchmarks/rosw_speed.py): every step costs 1.8 times
+#: the wall time of every 20 steps, with the same slip error.
+JAC_EVERY = 20
+
+#: Pass the error estimate through (I - h gamma W)^-1 before its norm (Shampine's filter, Hairer & Wanner II,
+#: sect. IV.8, eq. (8.20)), so the fast-decaying components that the method damps do not reject steps.
+FILTER_ERROR = True
+
+# ROS34PW2 (Rang & Angermann 2005, Table 4.2): alpha (the propagation table), gamma (the stage table,
+# diagonal GAMMA), b (order 3) and b_hat (the embedded order 2).
+GAMMA = 4.3586652150845900e-01
+_ALPHA = np.array([[0.0, 0.0, 0.0, 0.0],
+                   [8.7173304301691801e-01, 0.0, 0.0, 0.0],
+                   [8.4457060015369423e-01, -1.1299064236484185e-01, 0.0, 0.0],
+                   [0.0, 0.0, 1.0, 0.0]])
+_GAMMA_TABLE = np.array([[GAMMA, 0.0, 0.0, 0.0],
+                         [-8.7173304301691801e-01, GAMMA, 0.0, 0.0],
+                         [-9.0338057013044082e-01, 5.4180672388095326e-02, GAMMA, 0.0],
+                         [2.4212380706095346e-01, -1.2232505839045147e+00, 5.4526025533510214e-01, GAMMA]])
+_B = np.array([2.4212380706095346e-01, -1.2232505839045147e+00, 1.5452602553351020e+00, 4.3586652150845900e-01])
+_B_HAT = np.array([3.7810903145819369e-01, -9.6042292212423178e-02, 0.5, 2.1793326075422950e-01])
+
+
+def transformed_tableau() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The coefficients in the variables u = Gamma k (Hairer & Wanner II, (7.25)): a = alpha Gamma^-1,
+    c = diag(1/gamma) - Gamma^-1 (strictly lower), m = b Gamma^-1, the error weights (b - b_hat) Gamma^-1,
+    and the stage times alpha_i = sum_j alpha_ij."""
+    inv = np.linalg.inv(_GAMMA_TABLE)
+    a = _ALPHA @ inv
+    c = np.diag(1.0 / np.diag(_GAMMA_TABLE)) - inv
+    return a, np.tril(c, -1), _B @ inv, (_B - _B_HAT) @ inv, _ALPHA.sum(axis=1)
+
+
+_A, _C, _M, _E, _ALPHA_T = transformed_tableau()
+
+
+@numba.njit(cache=True)
+def _fd_blocks(model_id, t, y, p, log, f0, cols, groups, jb, y_work, f1, floor, ring_rows, js, share0,
+               share1):  # pragma: no cover - compiled
+    """Grouped difference quotients of the blocks: ``jb[b, 0, r, f]`` = d f[cols[r, b]] / d y[cols[f, b]], and
+    with three blocks or more (a ring of balls) ``jb[b, 1]`` and ``jb[b, 2]``, the same against the states of
+    blocks b - 1 and b + 1 (ball-ball contacts join neighbours only). Blocks of one group are at least three
+    apart (:func:`cageless.simulation.jacobian.ball_colours`), so they share no row, and one right-hand side
+    per (field, group) serves them all. The
+    increment of state i is sqrt(eps) max(|y_i|, floor_i), as in CVODE's difference quotients. With
+    ``ring_rows`` (the rows every ball reaches: the ring's accelerations, the energy counters), each
+    perturbed ball's own share of them (:func:`cageless.simulation.kernels.model_ring_share`) gives
+    ``js[b, q, f]`` = d f[ring_rows[q]] / d y[cols[f, b]]."""
+    n_fields, n_ring, nb = cols.shape[0], ring_rows.shape[0], cols.shape[1]
+    srur = np.sqrt(np.finfo(np.float64).eps)
+    for i in range(y.shape[0]):
+        y_work[i] = y[i]
+    if n_ring > 0:
+        for b in range(cols.shape[1]):
+            model_ring_share(model_id, t, y, p, log, b, share0[b])
+    for f in range(n_fields):
+        for g in range(groups.shape[0]):
+            for m in range(groups.shape[1]):
+                b = groups[g, m]
+                if b < 0:
+                    break
+                col = cols[f, b]
+                y_work[col] = y[col] + srur * max(abs(y[col]), floor[col])
+            model_rhs(model_id, t, y_work, p, log, f1)
+            for m in range(groups.shape[1]):
+                b = groups[g, m]
+                if b < 0:
+                    break
+                col = cols[f, b]
+                dh = y_work[col] - y[col]
+                for r in range(n_fields):
+                    jb[b, 0, r, f] = (f1[cols[r, b]] - f0[cols[r, b]]) / dh
+                if nb >= 3:  # the neighbours' rows: ball b is the lower neighbour of b + 1, the upper of b - 1
+                    up, down = (b + 1) % nb, (b - 1 + nb) % nb
+                    for r in range(n_fields):
+                        jb[up, 1, r, f] = (f1[cols[r, up]] - f0[cols[r, up]]) / dh
+                        jb[down, 2, r, f] = (f1[cols[r, down]] - f0[cols[r, down]]) / dh
+                if n_ring > 0:
+                    model_ring_share(model_id, t, y_work, p, log, b, share1)
+                    for q in range(n_ring):
+                        js[b, q, f] = (share1[q] - share0[b, q]) / dh
+                y_work[col] = y[col]
+    return n_fields * groups.shape[0]
+
+
+@numba.njit(cache=True)
+def _lu(a, piv, b):  # pragma: no cover - compiled
+    """In-place LU with partial pivoting of the small matrix a[b] (Golub & Van Loan, alg. 3.4.1; whole rows
+    exchanged). Indexed in place, not through a view: views cost reference counting in the inner loop."""
+    k = a.shape[1]
+    for c in range(k):
+        best, ip = abs(a[b, c, c]), c
+        for r in range(c + 1, k):
+            if abs(a[b, r, c]) > best:
+                best, ip = abs(a[b, r, c]), r
+        piv[b, c] = ip
+        if ip != c:
+            for q in range(k):
+                a[b, c, q], a[b, ip, q] = a[b, ip, q], a[b, c, q]
+        d = a[b, c, c]
+        for r in range(c + 1, k):
+            a[b, r, c] /= d
+            for q in range(c + 1, k):
+                a[b, r, q] -= a[b, r, c] * a[b, c, q]
+
+
+@numba.njit(cache=True)
+def _lu_solve(a, piv, b, x):  # pragma: no cover - compiled
+    """x = a[b]^-1 x in place, a[b] factorised by :func:`_lu`: the row exchanges first, then the two triangles."""
+    k = a.shape[1]
+    for c in range(k):
+        ip = piv[b, c]
+        if ip != c:
+            x[c], x[ip] = x[ip], x[c]
+    for c in range(k):
+        for r in range(c + 1, k):
+            x[r] -= a[b, r, c] * x[c]
+    for r in range(k - 1, -1, -1):
+        s = x[r]
+        for q in range(r + 1, k):
+            s -= a[b, r, q] * x[q]
+        x[r] = s / a[b, r, r]
+
+
+@numba.njit(cache=True)
+def _factor(jb, inv_hg, lu, piv):  # pragma: no cover - compiled
+    """LU of I / (h gamma) - jb[b] for every block b (no coupling between blocks)."""
+    for b in range(jb.shape[0]):
+        for r in range(jb.shape[1]):
+            for c in range(jb.shape[2]):
+                lu[b, r, c] = -jb[b, r, c]
+            lu[b, r, r] += inv_hg
+        _lu(lu, piv, b)
+
+
+@numba.njit(cache=True)
+def _ball_factor(jb, inv_hg, lu, piv, pm, order, x):  # pragma: no cover - compiled
+    """Block LU of the balls' part of I / (h gamma) - W, block tridiagonal in the ring order ``order`` (the ring
+    cut where its neighbours' coupling is weakest, :func:`_cut`): D'_i = D_i - L_i P_i, P_{i+1} = D'_i^-1 U_i,
+    with D, L, U the diagonal, lower and upper blocks (block Thomas algorithm). ``pm[order[i]]`` holds P_i."""
+    nb, k = jb.shape[0], jb.shape[2]
+    for i in range(nb):
+        b = order[i]
+        for r in range(k):
+            for c in range(k):
+                acc = -jb[b, 0, r, c]
+                if i > 0:
+                    for q in range(k):
+                        acc += jb[b, 1, r, q] * pm[b, q, c]  # L = -W_lower
+                lu[b, r, c] = acc
+            lu[b, r, r] += inv_hg
+        _lu(lu, piv, b)
+        if i + 1 < nb:
+            nxt = order[i + 1]
+            for c in range(k):
+                for r in range(k):
+                    x[r] = -jb[b, 2, r, c]  # U = -W_upper
+                _lu_solve(lu, piv, b, x)
+                for r in range(k):
+                    pm[nxt, r, c] = x[r]
+
+
+@numba.njit(cache=True)
+def _ball_solve(lu, piv, pm, jb, order, cols, rhs, out, x):  # pragma: no cover - compiled
+    """out[balls] = (balls' part of I / (h gamma) - W)^-1 rhs[balls], by :func:`_ball_factor`'s factors."""
+    nb, k = lu.shape[0], lu.shape[1]
+    for i in range(nb):
+        b = order[i]
+        for r in range(k):
+            acc = rhs[cols[r, b]]
+            if i > 0:
+                prev = order[i - 1]
+                for q in range(k):
+                    acc += jb[b, 1, r, q] * out[cols[q, prev]]
+            x[r] = acc
+        _lu_solve(lu, piv, b, x)
+        for r in range(k):
+            out[cols[r, b]] = x[r]
+    for i in range(nb - 2, -1, -1):
+        b, nxt = order[i], order[i + 1]
+        for r in range(k):
+            acc = 0.0
+            for q in range(k):
+                acc += pm[nxt, r, q] * out[cols[q, nxt]]
+            x[r] = acc
+        for r in range(k):
+            out[cols[r, b]] -= x[r]
+
+
+@numba.njit(cache=True)
+def _cut(jb, order):  # pragma: no cover - compiled
+    """Order the ring of blocks from just after the pair with the weakest coupling (zero for balls apart), so
+    that dropping that pair's coupling (W may be any matrix) leaves a block tridiagonal system."""
+    nb = jb.shape[0]
+    best, cut = np.inf, nb - 1
+    if nb >= 3:
+        for b in range(nb):
+            up = (b + 1) % nb
+            w = 0.0
+            for r in range(jb.shape[2]):
+                for c in range(jb.shape[3]):
+                    w += abs(jb[b, 2, r, c]) + abs(jb[up, 1, r, c])
+            if w < best:
+                best, cut = w, b
+    for i in range(nb):
+        order[i] = (cut + 1 + i) % nb
+
+
+@numba.njit(cache=True)
+def _block_solve(lu, piv, cols, rhs, out, x):  # pragma: no cover - compiled
+    """out[cols[:, b]] = (I / (h gamma) - W_b)^-1 rhs[cols[:, b]] for every uncoupled block b (by _factor)."""
+    nb, k = lu.shape[0], lu.shape[1]
+    for b in range(nb):
+        for r in range(k):
+            x[r] = rhs[cols[r, b]]
+        _lu_solve(lu, piv, b, x)
+        for r in range(k):
+            out[cols[r, b]] = x[r]
+
+
+@numba.njit(cache=True)
+def _prepare(st, wk, inv_hg):  # pragma: no cover - compiled
+    """Factorise I / (h gamma) - W for a step: the ball blocks, then the Schur complement on the ring's states,
+    S = I / (h gamma) - R - F Y with Y = (I / (h gamma) - B)^-1 E (E: the balls' rows in the ring's columns,
+    F: the ring's rows in the balls' columns)."""
+    cols, groups, ring_cols, explicit, ring_rows = st
+    jb, lu, piv, jr, lur, pivr, js, share0, share1, x, g, yy, fy, fz, pm, order = wk
+    _ball_factor(jb, inv_hg, lu, piv, pm, order, x)
+    nr = ring_cols.shape[0]
+    for c in range(nr):
+        yy[c, :] = 0.0
+        _ball_solve(lu, piv, pm, jb, order, cols, g[c], yy[c], x)
+        fy[c, :] = 0.0
+        for q in range(ring_rows.shape[0]):
+            acc = 0.0
+            for b in range(cols.shape[1]):
+                for f in range(cols.shape[0]):
+                    acc += js[b, q, f] * yy[c, cols[f, b]]
+            fy[c, ring_rows[q]] = acc
+    for r in range(nr):
+        for c in range(nr):
+            jr[0, r, c] = g[c, ring_cols[r, 0]] + fy[c, ring_cols[r, 0]]
+    _factor(jr, inv_hg, lur, pivr)
+
+
+@numba.njit(cache=True)
+def _solve(st, wk, hg, rhs, out):  # pragma: no cover - compiled
+    """out = (I / (h gamma) - W)^-1 rhs by block elimination (``rhs`` is overwritten): the ball blocks, the
+    Schur complement on the ring's states (:func:`_prepare`), the balls' back-substitution, then the explicit
+    states (the energy counters), h gamma times their right-hand side plus their coupling to the balls and
+    the ring. O(Z) work: nothing dense of the full size is formed."""
+    cols, groups, ring_cols, explicit, ring_rows = st
+    jb, lu, piv, jr, lur, pivr, js, share0, share1, x, g, yy, fy, fz, pm, order = wk
+    _ball_solve(lu, piv, pm, jb, order, cols, rhs, out, x)
+    fz[:] = 0.0
+    for q in range(ring_rows.shape[0]):
+        acc = 0.0
+        for b in range(cols.shape[1]):
+            for f in range(cols.shape[0]):
+                acc += js[b, q, f] * out[cols[f, b]]
+        fz[ring_rows[q]] = acc
+    nr = ring_cols.shape[0]
+    if nr > 0:
+        for r in range(nr):
+            rhs[ring_cols[r, 0]] += fz[ring_cols[r, 0]]
+        _block_solve(lur, pivr, ring_cols, rhs, out, x)
+        for c in range(nr):
+            ur = out[ring_cols[c, 0]]
+            for b in range(cols.shape[1]):
+                for f in range(cols.shape[0]):
+                    out[cols[f, b]] += yy[c, cols[f, b]] * ur
+    for i in range(explicit.shape[0]):
+        e = explicit[i]
+        acc = rhs[e] + fz[e]
+        for c in range(nr):
+            acc += (fy[c, e] + g[c, e]) * out[ring_cols[c, 0]]
+        out[e] = hg * acc
+
+
+@numba.njit(cache=True)
+def _jacobian(model_id, t, y, p, log, f0, st, wk, y_work, f1, floor):  # pragma: no cover - compiled
+    """Evaluate W: the ball blocks (grouped) with their coupling to the shared rows, and the ring's columns
+    (one at a time, every row: the ring's own block, the balls' rows E and the counters' rows); returns
+    the right-hand sides used."""
+    cols, groups, ring_cols, explicit, ring_rows = st
+    jb, lu, piv, jr, lur, pivr, js, share0, share1, x, g, yy, fy, fz, pm, order = wk
+    n_rhs = _fd_blocks(model_id, t, y, p, log, f0, cols, groups, jb, y_work, f1, floor, ring_rows, js, share0,
+                       share1)
+    _cut(jb, order)
+    srur = np.sqrt(np.finfo(np.float64).eps)
+    for c in range(ring_cols.shape[0]):
+        col = ring_cols[c, 0]
+        y_work[col] = y[col] + srur * max(abs(y[col]), floor[col])
+        model_rhs(model_id, t, y_work, p, log, f1)
+        dh = y_work[col] - y[col]
+        for i in range(y.shape[0]):
+            g[c, i] = (f1[i] - f0[i]) / dh
+        y_work[col] = y[col]
+    return n_rhs + ring_cols.shape[0]
+
+
+@numba.njit(cache=True)
+def _stages(model_id, t, h, p, log, vec, u, st, wk):  # pragma: no cover - compiled
+    """The four stages of one step from (t, y = vec[0]) with f(y) = vec[1]: the new state into vec[5] and the
+    error vector into vec[6]."""
+    y, k1, yt, fs, ynew, err_w = vec[0], vec[1], vec[3], vec[4], vec[5], vec[6]
+    n = y.shape[0]
+    for s in range(4):
+        if s == 0:
+            for i in range(n):
+                fs[i] = k1[i]
+        else:
+            for i in range(n):
+                acc = y[i]
+                for j in range(s):
+                    acc += _A[s, j] * u[j, i]
+                yt[i] = acc
+            model_rhs(model_id, t + _ALPHA_T[s] * h, yt, p, log, fs)
+            for i in range(n):
+                acc = 0.0
+                for j in range(s):
+                    acc += _C[s, j] * u[j, i]
+                fs[i] += acc / h
+        _solve(st, wk, h * GAMMA, fs, u[s])
+    for i in range(n):
+        ynew[i] = y[i] + _M[0] * u[0, i] + _M[1] * u[1, i] + _M[2] * u[2, i] + _M[3] * u[3, i]
+        err_w[i] = _E[0] * u[0, i] + _E[1] * u[1, i] + _E[2] * u[2, i] + _E[3] * u[3, i]
+
+
+@numba.njit(cache=True)
+def _error_norm(y, ynew, err_w, atol, rtol):  # pragma: no cover - compiled
+    """The RMS of err_i / (atol_i + rtol max(|y_i|, |ynew_i|)), inf when the new state is not finite."""
+    n = y.shape[0]
+    err = 0.0
+    for i in range(n):
+        if not np.isfinite(ynew[i]):
+            return np.inf
+        sc = atol[i] + rtol * max(abs(y[i]), abs(ynew[i]))
+        err += (err_w[i] / sc) ** 2
+    return np.sqrt(err / n)
+
+
+@numba.njit(cache=True)
+def _controls(model_id, y_new, p, sig, h, h_onset, k1, k7, jump_floor, force_jump):  # pragma: no cover
+    """The contact-onset and force-jump tests of an error-accepted step: (verdict, new signature), verdict
+    0 accept, 1 retry at the onset step (a contact changed in a long step), 2 retry at half the length
+    (a force jumped), 3 accept with a contact change."""
+    verdict = 0
+    sig_new = sig
+    if h_onset > 0.0:
+        sig_new = model_signature(model_id, y_new, p)
+        if sig_new != sig:
+            if h > h_onset:
+                return 1, sig
+            verdict = 3
+    if force_jump > 0.0 and h > h_onset and _force_jumped(k1, k7, jump_floor, force_jump):
+        return 2, sig
+    return verdict, sig_new
+
+
+# Counters of the loop, kept in one integer array so the helpers can update them.
+_STEPS, _REJ, _RHS, _ONSET, _CHANGES, _JUMPS, _JACS = 0, 1, 2, 3, 4, 5, 6
+
+
+@numba.njit(cache=True)
+def _accept(model_id, t, h, y, ynew, k1, k7, p, log, t_out, out, k):  # pragma: no cover - compiled
+    """Write the samples inside (t, t + h], move to the step's end, run the bookkeeping; next sample index."""
+    t_new = t + h
+    while k < t_out.shape[0] and t_out[k] <= t_new:
+        _hermite(t, h, y, ynew, k1, k7, t_out[k], out[k])
+        k += 1
+    for i in range(y.shape[0]):
+        y[i] = ynew[i]
+        k1[i] = k7[i]
+    model_post(model_id, t_new, y, p, log)
+    return k
+
+
+@numba.njit(cache=True)
+def _workspace(n, cols, ring_cols, ring_rows):  # pragma: no cover - compiled
+    """Vectors (10 x n: y, k1, k7, yt, fs, ynew, err_w, y_work, f1, difference-quotient floor), the stage
+    increments (4 x n), and the blocks: (jb, lu, piv, jr, lur, pivr, js, share0, share1, x, g, yy, fy, fz): the
+    ball blocks, their factors and pivots, the ring's Schur complement, its factors and pivots, the shared
+    rows' coupling to the balls, two shares, a scratch vector, the ring's Jacobian columns (by column), Y, F Y, F u, the
+    block Thomas factors P and the balls' order."""
+    nb, kf, nr, nq = cols.shape[1], cols.shape[0], ring_cols.shape[0], ring_rows.shape[0]
+    vec = np.zeros((10, n))
+    u = np.zeros((4, n))
+    wk = (np.zeros((nb, 3, kf, kf)), np.zeros((nb, kf, kf)), np.zeros((nb, kf), dtype=np.int64),
+          np.zeros((1, nr, nr)), np.zeros((1, nr, nr)), np.zeros((1, nr), dtype=np.int64),
+          np.zeros((nb, nq, kf)), np.zeros((nb, max(nq, 1))), np.zeros(max(nq, 1)), np.zeros(max(kf, nr, 1)),
+          np.zeros((nr, n)), np.zeros((nr, n)), np.zeros((nr, n)), np.zeros(n), np.zeros((nb, kf, kf)),
+          np.arange(nb))
+    return vec, u, wk
+
+
+@numba.njit(cache=True)
+def _write_stats(stats, cnt, h):  # pragma: no cover - compiled
+    stats[0], stats[1], stats[2], stats[3] = cnt[_STEPS], cnt[_REJ], cnt[_RHS], h
+    stats[4], stats[5], stats[6], stats[7], stats[8] = cnt[_ONSET], cnt[_CHANGES], cnt[_JUMPS], 0, cnt[_JACS]
+
+
+@numba.njit(cache=True)
+def _start(model_id, t0, y0, p, log, t_out, out, atol, rtol, vec):  # pragma: no cover - compiled
+    """Set up the loop's vectors at the start; write the samples at or before it; next sample index."""
+    n = y0.shape[0]
+    for i in range(n):
+        vec[0, i] = y0[i]
+        vec[9, i] = atol[i] / rtol  # the smallest perturbation scale of the difference quotients
+    model_rhs(model_id, t0, vec[0], p, log, vec[1])
+    k = 0
+    while k < t_out.shape[0] and t_out[k] <= t0:
+        out[k, :] = vec[0]
+        k += 1
+    return k
+
+
+@numba.njit(cache=True)
+def _step(model_id, t, h, p, log, atol, rtol, vec, u, st, wk, fresh_w, cnt):  # pragma: no cover - compiled
+    """One attempted step of length h from (t, vec[0]): W evaluated if ``fresh_w``, factorised, the stages;
+    returns the error norm (inf if the state became non-finite)."""
+    if fresh_w:
+        cnt[_RHS] += _jacobian(model_id, t, vec[0], p, log, vec[1], st, wk, vec[7], vec[8], vec[9])
+        cnt[_JACS] += 1
+    _prepare(st, wk, 1.0 / (h * GAMMA))
+    _stages(model_id, t, h, p, log, vec, u, st, wk)
+    cnt[_RHS] += 3
+    if FILTER_ERROR:  # (I - h gamma W)^-1 err: the stiff components' part of the estimate damped
+        hg = h * GAMMA
+        vec[4, :] = vec[6]
+        _solve(st, wk, hg, vec[4], vec[6])
+        for i in range(vec.shape[1]):
+            vec[6, i] /= hg
+    return _error_norm(vec[0], vec[5], vec[6], atol, rtol)
+
+
+@numba.njit(cache=True)
+def rosw_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_steps, out, stats, h_onset,
+                   jump_floor, force_jump, st, jac_every):  # pragma: no cover - compiled
+    """Integrate from ``t0`` and write ``y`` at each ``t_out[k]`` into ``out[k]`` (as
+    :func:`cageless.simulation.integrators.dp5.dp5_integrate`, the same controls and status codes).
+
+    ``st`` = (cols, groups, ring_cols, explicit, ring_rows): ``cols[f, b]`` is the state of field f of block
+    b (the balls), ``groups`` the blocks perturbed together (padded with -1), ``ring_cols`` the ring's block
+    (may be empty), ``explicit`` every other state, ``ring_rows`` the rows every ball reaches (may be empty).
+    ``jac_every`` <= 0 keeps W = 0 (an explicit method of order 3, for the tests of the W-property).
+    ``stats`` (9) receives [n_steps, n_rejected, n_rhs, last_h, n_onset_retries, n_contact_changes,
+    n_force_jump_retries, 0, n_jacobians].
+    """
+    vec, u, wk = _workspace(y0.shape[0], st[0], st[2], st[4])
+    y, k1, k7, ynew = vec[0], vec[1], vec[2], vec[5]
+    cnt = np.zeros(7, dtype=np.int64)
+    cnt[_RHS] = 1
+    k = _start(model_id, t0, y0, p, log, t_out, out, atol, rtol, vec)
+    t, h, age, status = t0, h0, jac_every, STATUS_OK  # age >= jac_every: evaluate W before the next step
+    sig = model_signature(model_id, y, p) if h_onset > 0.0 else 0.0
+    rejected = False
+    t_end = t_out[t_out.shape[0] - 1]
+    tiny = 1e-13 * max(abs(t_end), t_end - t0)  # round-off scale of the time axis
+    while k < t_out.shape[0]:
+        h = min(h, h_max, t_end - t)
+        if cnt[_STEPS] + cnt[_REJ] >= max_steps or h < tiny:
+            status = STATUS_MAX_STEPS if h >= tiny else STATUS_STEP_UNDERFLOW
+            break
+        err = _step(model_id, t, h, p, log, atol, rtol, vec, u, st, wk, 0 < jac_every <= age, cnt)
+        age = 0 if 0 < jac_every <= age else age
+        if not err <= 1.0:  # rejected, or not finite
+            cnt[_REJ] += 1
+            if rejected and age > 0:  # a second rejection in a row: a stale W may be why, evaluate it afresh
+                age = jac_every
+            rejected = True
+            h *= max(0.2, 0.9 * err ** (-1.0 / 3.0)) if np.isfinite(err) else 0.25
+            if not np.isfinite(err) and h < tiny:
+                status = STATUS_NONFINITE
+                break
+            continue
+        model_rhs(model_id, t + h, ynew, p, log, k7)
+        cnt[_RHS] += 1
+        grow = 1.0 if rejected else 5.0  # no growth right after a rejection
+        rejected = False
+        verdict, sig = _controls(model_id, ynew, p, sig, h, h_onset, k1, k7, jump_floor, force_jump)
+        if verdict == 1 or verdict == 2:  # a contact changed in a long step, or a force jumped
+            cnt[_REJ] += 1
+            cnt[_ONSET if verdict == 1 else _JUMPS] += 1
+            h = h_onset if verdict == 1 else max(0.5 * h, h_onset)
+            continue
+        cnt[_CHANGES] += verdict == 3
+        age = jac_every if verdict == 3 else age + 1  # a contact opened or closed: a damping term switched
+        k = _accept(model_id, t, h, y, ynew, k1, k7, p, log, t_out, out, k)
+        if t_end - (t + h) <= tiny:  # only round-off left: the remaining samples are this state
+            out[k:, :] = ynew
+            k = t_out.shape[0]
+        t += h
+        cnt[_STEPS] += 1
+        h *= min(grow, max(0.2, 0.9 * max(err, 1e-10) ** (-1.0 / 3.0)))
+    _write_stats(stats, cnt, h)
+    return status
