@@ -252,8 +252,8 @@ def _blocks(frames: Callable[[int], np.ndarray], n: int, start: int,
 def _run_compiled(frames: Callable[[int], np.ndarray], times: npt.NDArray[np.float64], st: _State, s: TrackSetup,
                   centre: tuple[float, float], out: tuple[np.ndarray, np.ndarray, np.ndarray], start: int,
                   direction: int, progress: Callable[[int], None] | None) -> None:
-    """The ``"window"`` loop: blocks of frames through the compiled step (:func:`~cageless.tracking.link_kernel.run_block`),
-    with the Python :func:`_step` for the frames it hands back."""
+    """The ``"window"`` loop: blocks of frames through the compiled step
+    (:func:`~cageless.tracking.link_kernel.run_block`), with the Python :func:`_step` for the frames it hands back."""
     n = len(times)
     times = np.ascontiguousarray(times, dtype=np.float64)
     half = s.params.window_sigma * s.highlight_sigma
