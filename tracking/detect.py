@@ -225,7 +225,9 @@ def _centroids(frame, background, mask, u0, v0, half, threshold, iterations):  #
     out_v = np.full(n, np.nan)
     out_m = np.zeros(n)
     for j in range(n):
-        u, v = u0[j], v0[j]
+        # The start rounded to single precision (about 1e-4 px): the tapered weights make the result depend
+        # on it continuously, and callers that predict it in another order must still get the same result.
+        u, v = np.float64(np.float32(u0[j])), np.float64(np.float32(v0[j]))
         if not (np.isfinite(u) and np.isfinite(v)):
             continue
         r = half[j]
