@@ -91,7 +91,7 @@ EFFECTS: tuple[EffectSpec, ...] = (
     EffectSpec("rolling_losses", "hydrodynamic rolling force on the ball centre and moment about it at both race "
                "contacts, from the film and the entrainment speed, with inlet starvation (Chiu 1974)", _lubricated,
                needs_lubricant=True, flag="F_ROLL",
-               slots=("ETA0", "ALPHA_PV", "E_RED", "RXI", "RYI", "KAI", "RXO", "RYO", "KAO", "R_MEN", "H0")),
+               slots=("ETA0", "RC_I", "RH_I", "LT_FILM_I", "LT_FIX_I", "RC_O", "RH_O", "LT_FILM_O", "LT_FIX_O")),
     EffectSpec("ball_ball_contact", "Hertz contact between neighbours with hysteresis damping (restitution R) "
                "and friction from the surface sliding speed", _always("no cage: neighbours meet"), flag="F_BB",
                slots=("KB", "CHI", "V_IN_MIN")),

@@ -27,10 +27,8 @@ import math
 import numba
 
 from cageless.simulation.forces import FASTMATH
-from cageless.simulation.models.base import (P_D, P_E_RED, P_ETA0, P_ALPHA_PV, P_F_FILM, P_H0, P_KAI, P_KAO, P_R_MEN,
-                                             P_RXI, P_RXO, P_RYI, P_RYO)
-from cageless.simulation.physics.film_traction import hd_central_film
-from cageless.simulation.physics.rolling_force import rolling_force_along
+from cageless.simulation.models.base import (P_D, P_ETA0, P_F_FILM, P_LT_FILM_I, P_LT_FILM_O, P_LT_FIX_I, P_LT_FIX_O,
+                                             P_RC_I, P_RC_O, P_RH_I, P_RH_O)
 
 __all__ = ["race_rolling", "spatial_rolling", "rolling_slots"]
 
@@ -38,18 +36,28 @@ __all__ = ["race_rolling", "spatial_rolling", "rolling_slots"]
 @numba.njit(cache=True, fastmath=FASTMATH, inline="always")
 def race_rolling(u_e, q, inner, p):  # pragma: no cover - compiled
     """Signed (pressure, shear) forces (N) on the ball along t at a race contact with entraining speed ``u_e``
-    (m/s, signed along t) and normal force ``q`` (N); (0, 0) when the contact carries no load."""
+    (m/s, signed along t) and normal force ``q`` (N); (0, 0) when the contact carries no load.
+
+    :func:`cageless.simulation.physics.rolling_force.rolling_force_along` with u_eta = 0, its film from
+    :func:`cageless.simulation.physics.film_traction.hd_central_film`, written in logarithms so that a call costs
+    two logarithms (the contact's constants are in the slots, :func:`rolling_slots`):
+    h = C |u|^0.67 Q^-0.067, ln t = ln r_s - ln(2 R_x h) / 2, C_0 = eta |u| sqrt(R_x R_y) / (3 + 2k).
+    """
     if q <= 0.0 or u_e == 0.0:
         return 0.0, 0.0
     if inner:
-        r_x, r_y, kap = p[P_RXI], p[P_RYI], p[P_KAI]
+        rc, rh, lt_film, lt_fix = p[P_RC_I], p[P_RH_I], p[P_LT_FILM_I], p[P_LT_FIX_I]
     else:
-        r_x, r_y, kap = p[P_RXO], p[P_RYO], p[P_KAO]
+        rc, rh, lt_film, lt_fix = p[P_RC_O], p[P_RH_O], p[P_LT_FILM_O], p[P_LT_FIX_O]
+    au = abs(u_e)
     if p[P_F_FILM] > 0.5:
-        h = hd_central_film(p[P_ETA0], p[P_ALPHA_PV], p[P_E_RED], u_e, q, r_x, kap)
+        ln_t = lt_film - 0.5 * (0.67 * math.log(au) - 0.067 * math.log(q))
     else:
-        h = p[P_H0]
-    return rolling_force_along(p[P_ETA0], u_e, h, r_x, r_y, p[P_R_MEN], p[P_D])
+        ln_t = lt_fix
+    fbar = max(28.59 * ln_t - 10.10, 36.57 * ln_t - 22.85, 0.0)  # chiu_coefficient
+    c = p[P_ETA0] * au * fbar
+    sgn = 1.0 if u_e > 0.0 else -1.0
+    return sgn * c * rh, -sgn * c * rc
 
 
 @numba.njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -95,22 +103,37 @@ def spatial_rolling(p, inner, q, rv, n, t, om, w, xr, axis, wt, r_c, rq):  # pra
 
 
 def rolling_slots(bearing, parameters) -> dict[str, float]:  # type: ignore[no-untyped-def]
-    """The ``rolling_losses`` slots for ``bearing`` and the run's parameters: inlet viscosity, pressure-viscosity
-    coefficient, reduced modulus E', each race's radii R_x (rolling direction), R_y (across) and ellipticity,
-    and the meniscus distance."""
+    """The ``rolling_losses`` slots for ``bearing`` and the run's parameters, per race (suffix _I, _O):
+
+    * RC = sqrt(R_x R_y) / (2 (3 + 2k)): F_R = eta |u| Fbar RC;
+    * RH = 2 sqrt(R_x R_y) R_x / ((3 + 2k) D): F_H = eta |u| Fbar RH;
+    * LT_FILM = ln r_s - ln(2 R_x C) / 2, with the Hamrock-Dowson film h = C |u|^0.67 Q^-0.067,
+      C = R_x 2.69 (eta / (E' R_x))^0.67 (alpha E')^0.53 (E' R_x^2)^0.067 (1 - 0.61 exp(-0.73 kappa));
+    * LT_FIX = ln r_s - ln(2 R_x h_0) / 2 (the fixed film, ``ehl_film`` off);
+
+    R_x = (D/2)(d_m +- D)/d_m along the rolling direction, R_y = f D / (2 f - 1) across it, k = R_x / R_y,
+    kappa the ellipticity of the Hertz contact, E' = E / (1 - nu^2).
+    """
     from cageless.simulation.hertz import compliance, hertz_contact, race_curvatures
 
     g, mat, lub = bearing.geometry, bearing.material, bearing.lubricant
     d, dm = g.ball_diameter_m, g.pitch_diameter_m
     rc = race_curvatures(g)
     eta_c = compliance(mat)
-    out = {"ALPHA_PV": lub.pressure_viscosity_coefficient_1_pa,
-           "E_RED": mat.youngs_modulus_pa / (1.0 - mat.poisson_ratio ** 2),
-           "RXO": 0.5 * d * (dm + d) / dm, "RXI": 0.5 * d * (dm - d) / dm,
-           "RYO": g.outer_curvature_factor * d / (2.0 * g.outer_curvature_factor - 1.0),
-           "RYI": g.inner_curvature_factor * d / (2.0 * g.inner_curvature_factor - 1.0),
-           "KAI": hertz_contact(*rc["inner"], eta_c).kappa, "KAO": hertz_contact(*rc["outer"], eta_c).kappa,
-           "R_MEN": parameters.meniscus_distance_m}
+    e_red = mat.youngs_modulus_pa / (1.0 - mat.poisson_ratio ** 2)
+    eta, alpha, r_s = lub.dynamic_viscosity_pa_s, lub.pressure_viscosity_coefficient_1_pa, parameters.meniscus_distance_m
+    out = {}
+    for tag, r_x, f, race in (("I", 0.5 * d * (dm - d) / dm, g.inner_curvature_factor, "inner"),
+                              ("O", 0.5 * d * (dm + d) / dm, g.outer_curvature_factor, "outer")):
+        r_y = f * d / (2.0 * f - 1.0)
+        k = r_x / r_y
+        kappa = hertz_contact(*rc[race], eta_c).kappa
+        c_film = (r_x * 2.69 * (eta / (e_red * r_x)) ** 0.67 * (alpha * e_red) ** 0.53
+                  * (e_red * r_x * r_x) ** 0.067 * (1.0 - 0.61 * math.exp(-0.73 * kappa)))
+        root = math.sqrt(r_x * r_y) / (3.0 + 2.0 * k)
+        out.update({f"RC_{tag}": 0.5 * root, f"RH_{tag}": 2.0 * root * r_x / d,
+                    f"LT_FILM_{tag}": math.log(r_s) - 0.5 * math.log(2.0 * r_x * c_film),
+                    f"LT_FIX_{tag}": math.log(r_s) - 0.5 * math.log(2.0 * r_x * parameters.film_thickness_m)})
     if not all(math.isfinite(v) for v in out.values()):
-        raise ValueError("rolling_losses: non-finite contact geometry")
+        raise ValueError("rolling_losses: non-finite contact constants")
     return out

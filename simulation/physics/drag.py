@@ -110,5 +110,5 @@ def churning_moment(omega: float, d: float, rho: float, mu: float) -> float:  # 
         return 0.0
     r = 0.5 * d
     w = abs(omega)
-    m = 8.0 * math.pi * mu * r ** 3 * w + 3.225 * math.sqrt(rho * mu) * r ** 4 * w ** 1.5
+    m = 8.0 * math.pi * mu * r ** 3 * w + 3.225 * math.sqrt(rho * mu) * r ** 4 * w * math.sqrt(w)
     return -math.copysign(m, omega)

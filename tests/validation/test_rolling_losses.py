@@ -112,6 +112,7 @@ def test_rolling_force_and_moment_match_chiu_by_hand(level, race):
 def test_rolling_force_uses_the_hamrock_dowson_film_when_the_film_effect_is_on():
     """With ``ehl_film`` on, the film in t is the compiled Hamrock-Dowson central film of the contact, so the
     force differs from the fixed-film one by the ln of the film ratio alone (C_0 does not depend on h)."""
+    from cageless.simulation.hertz import compliance, hertz_contact, race_curvatures
     from cageless.simulation.physics.film_traction import hd_central_film
 
     scene, pr = _problem()
@@ -129,11 +130,12 @@ def test_rolling_force_uses_the_hamrock_dowson_film_when_the_film_effect_is_on()
     lub, mat = scene.bearing.lubricant, scene.bearing.material
     u = 0.5 * (r * thd + 0.5 * d * om - g.outer_race_diameter_m * thd)
     q = pr.parameter("KO") * 2e-6 ** 1.5
+    r_x = 0.5 * d * (g.pitch_diameter_m + d) / g.pitch_diameter_m
+    kappa = hertz_contact(*race_curvatures(g)["outer"], compliance(mat)).kappa
     h = hd_central_film(lub.dynamic_viscosity_pa_s, lub.pressure_viscosity_coefficient_1_pa,
-                        mat.youngs_modulus_pa / (1 - mat.poisson_ratio ** 2), u, q, pr.parameter("RXO"),
-                        pr.parameter("KAO"))
+                        mat.youngs_modulus_pa / (1 - mat.poisson_ratio ** 2), u, q, r_x, kappa)
     assert 0.05e-6 < h < 2e-6
-    t0, t1 = R_S / math.sqrt(2 * H0 * pr.parameter("RXO")), R_S / math.sqrt(2 * h * pr.parameter("RXO"))
+    t0, t1 = R_S / math.sqrt(2 * H0 * r_x), R_S / math.sqrt(2 * h * r_x)
 
     def fbar(t):
         return max(28.59 * math.log(t) - 10.10, 36.57 * math.log(t) - 22.85, 0.0)
