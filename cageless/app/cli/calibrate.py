@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from cageless.app.cli.common import finite_float
+from cageless.app.cli.common import add_parameter_set_option, finite_float
 
 __all__ = ["register", "run"]
 
@@ -46,6 +46,7 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
                    "revolution; 0.1 with a target)")
     p.add_argument("--settle", type=finite_float,
                    help="start-up left out (s; default three cage revolutions, at least 0.04)")
+    add_parameter_set_option(p)
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", dest="set_values",
                    help="hold a model parameter at a value (repeatable)")
     p.add_argument("--workers", type=int, default=2, help="local processes (default 2)")

@@ -50,12 +50,16 @@ def common_options() -> ArgumentParser:
     parent = ArgumentParser(add_help=False)
     group = parent.add_argument_group("common options")
     group.add_argument("--config", metavar="FILE.toml", help="read defaults and bearing overrides from a TOML file")
-    group.add_argument("--parameter-set", metavar="NAME",
-                       help="named model parameter set to start from: paper-table2 (default; calibrated at 3000 rpm, "
-                       "500 N against the paper's measured slip) or representative (the earlier, uncalibrated values)")
     group.add_argument("-q", "--quiet", action="store_true", help="no progress bars, warnings and errors only")
     group.add_argument("-v", "--verbose", action="count", default=0, help="more log output (-vv for debug)")
     return parent
+
+
+def add_parameter_set_option(parser: ArgumentParser) -> None:
+    """Add ``--parameter-set`` to a command that simulates (simulate, sweep, report, calibrate)."""
+    parser.add_argument("--parameter-set", metavar="NAME",
+                        help="named model parameter set to start from: paper-table2 (default; calibrated at 3000 rpm, "
+                        "500 N against the paper's measured slip) or representative (the earlier, uncalibrated values)")
 
 
 def apply_config_defaults(

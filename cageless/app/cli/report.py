@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from cageless.app.cli.common import finite_float
+from cageless.app.cli.common import add_parameter_set_option, finite_float
 
 __all__ = ["register", "run"]
 
@@ -42,6 +42,7 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--slip-reference", choices=("cage", "loaded-zone"), default="cage",
                    help="what slip is referred to: the pure-rolling cage speed of the stated speed (default) or "
                    "each trace's own loaded-zone speed (removes a flat bias from scale or clearance)")
+    add_parameter_set_option(p)
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", dest="set_values",
                    help="change an open model parameter (see `cageless simulate --help`)")
     p.add_argument("--rtol", type=finite_float, default=1e-6, help="simulation tolerance (default 1e-6)")

@@ -13,7 +13,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from cageless.app.cli.common import finite_float
+from cageless.app.cli.common import add_parameter_set_option, finite_float
 from cageless.config import bearing_from_config
 
 __all__ = ["register", "run"]
@@ -22,7 +22,7 @@ _EXAMPLES = """\
 examples:
   cageless simulate --speed-rpm 3000 --radial-load-n 500 --explain
   cageless simulate --speed-rpm 3000 --radial-load-n 500 --axial-load-n 400 --explain
-  cageless simulate --speed-rpm 1800 --radial-load-n 500 --effect drag=on --oil-air-density 5 --explain
+  cageless simulate --speed-rpm 1800 --radial-load-n 500 --oil-air-density 20 --explain
   cageless simulate --speed-rpm 3000 --axial-load-n 300 --level planar --force --explain
   cageless simulate --speed-rpm 6000 --radial-load-n 500 --duration 0.1
   cageless simulate --speed-rpm 1800 --radial-load-n 500 --set cho_n_s_m=2500 --ensemble 4
@@ -47,7 +47,7 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
                    help="prescribed inner-ring tilt about y (rad); the ring tilts further under the contacts")
     p.add_argument("--moment-load-nm", type=finite_float, default=0.0,
                    help="moment load on the inner ring about y (N m); selects the spatial level")
-    p.add_argument("--oil-air-density", type=finite_float, help="oil-air mixture density (kg/m^3); enables drag")
+    p.add_argument("--oil-air-density", type=finite_float, help="oil-air mixture density (kg/m^3; default 42.4, 5 %% oil by volume, in a lubricated scene; 0 turns drag off)")
     p.add_argument("--clearance-um", type=finite_float,
                    help="diametral clearance (um), races moved apart symmetrically (default: the bearing's, 0 for "
                    "the paper's; ISO 5753-1 C4 for this size is 23-41 um)")
@@ -68,6 +68,7 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--restitution", type=finite_float,
                    help="ball-ball coefficient of restitution R, 0 <= R <= 1, 0 perfectly plastic (same as --set "
                    "restitution=R)")
+    add_parameter_set_option(p)
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", dest="set_values",
                    help="change an open model parameter, e.g. --set cho_n_s_m=2500 (repeatable; "
                    "simulation/parameters.py lists them with their sources)")
@@ -101,7 +102,8 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
                   duration_s=args.duration, speed_ramp_s=args.speed_ramp, seed=args.seed)
     choice = choose_model(scene, args.level, parse_effect_overrides(args.effect), args.force)
     if args.explain:
-        print(choice.to_json() if args.json else choice.explain())
+        _parameters(args, config)  # the same checks of --parameter-set, --config and --set as a run
+        print(choice.to_json() if args.json else f"{choice.explain()}\n{_parameter_line(args, config)}")
         return 0
     return _run(args, scene, choice, config)
 
@@ -125,6 +127,16 @@ def _validate(args: argparse.Namespace, bearing: Any) -> None:
     elif args.ensemble == 1:
         check_output_file(f"sim_{args.speed_rpm:g}rpm_Fr{args.radial_load_n:g}.trace.h5", "the default output",
                           overwrite=args.overwrite)
+
+
+def _parameter_line(args: argparse.Namespace, config: dict[str, Any]) -> str:
+    """One line naming the parameter set a run starts from and what changes it."""
+    from cageless.simulation.parameter_sets import DEFAULT_SET
+
+    name = args.parameter_set or DEFAULT_SET
+    changes = [*config.get("parameters", {}), *(s.split("=", 1)[0] for s in args.set_values)]
+    tail = f", changed by --config/--set: {', '.join(changes)}" if changes else ""
+    return f"parameters: set '{name}'{tail}"
 
 
 def _parameters(args: argparse.Namespace, config: dict[str, Any]) -> Any:
@@ -152,12 +164,15 @@ def _run(args: argparse.Namespace, scene: Any, choice: Any, config: dict[str, An
                                          sample_rate_hz=args.sample_rate), model=choice)
     from cageless.app.calibrate import describe_calibration
 
+    from cageless.simulation.parameter_sets import DEFAULT_SET
+
     note = describe_calibration(config.get("calibration"))
-    config = {"command": "simulate", "set": args.set_values, **({"calibration": note} if note else {})}
+    line = _parameter_line(args, config)
+    config = {"command": "simulate", "parameter_set": args.parameter_set or DEFAULT_SET, "set": args.set_values,
+              **({"calibration": note} if note else {})}
     if args.scheduler and args.ensemble == 1:
         raise UsageError("--scheduler runs an ensemble on a Dask cluster: give --ensemble N as well")
-    if note:
-        print(f"parameters: {note}")
+    print(f"parameters: {note}" if note else line)
     if args.ensemble == 1:
         trace = sim.run(out=out, progress=not args.quiet, config=config)
         print(f"effects: {', '.join(choice.active)}")

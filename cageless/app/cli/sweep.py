@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from cageless.app.cli.common import finite_float
+from cageless.app.cli.common import add_parameter_set_option, finite_float
 
 __all__ = ["register", "run"]
 
@@ -36,6 +36,7 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--duration", type=finite_float, default=0.1, help="simulated time after the start-up (s)")
     p.add_argument("--settle", type=finite_float,
                    help="start-up left out (s; default three cage revolutions at each point, at least 0.04)")
+    add_parameter_set_option(p)
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", dest="set_values",
                    help="fixed model-parameter changes for every run")
     p.add_argument("--effect", action="append", default=[], metavar="NAME=on|off",
