@@ -73,6 +73,8 @@ class LabOptions:
     scheduler: str | None = None
     force: bool = False
     parameters: dict[str, float] = field(default_factory=dict)
+    #: The named model parameter set the parameters start from (``--parameter-set``).
+    parameter_set: str = "paper-table2"
     #: Where the parameters came from when a calibration file gave them (one line), or None.
     calibration: str | None = None
     n_balls: int | None = None
@@ -83,7 +85,8 @@ class LabOptions:
         """JSON-ready, without the scheduler address (it does not change results)."""
         return {"duration_s": self.duration_s, "settle_s": self.settle_s, "revolutions": self.revolutions,
                 "bin_deg": self.bin_deg, "rtol": self.rtol,
-                "force": self.force, "parameters": dict(self.parameters), "n_balls": self.n_balls,
+                "force": self.force, "parameter_set": self.parameter_set, "parameters": dict(self.parameters),
+                "n_balls": self.n_balls,
                 "slip_reference": self.slip_reference,
                 **({"calibration": self.calibration} if self.calibration else {})}
 

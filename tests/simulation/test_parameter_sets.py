@@ -35,3 +35,27 @@ def test_cli_parameter_set_reaches_the_run(capsys, tmp_path):
     assert main(["simulate", "--speed-rpm", "3000", "--radial-load-n", "500", "--parameter-set", "nope",
                  "-o", str(tmp_path / "x.trace.h5")]) == 2  # refused before anything compiles
     assert "is not a parameter set" in capsys.readouterr().err
+
+
+def test_the_parameter_set_is_named_in_explain_the_run_and_its_trace(capsys, tmp_path):
+    from cageless.app.cli import main
+    from cageless.trace import read_trace
+
+    assert main(["simulate", "--speed-rpm", "3000", "--parameter-set", "nope", "--explain"]) == 2  # checked as a run
+    capsys.readouterr()
+    assert main(["simulate", "--speed-rpm", "3000", "--explain", "--set", "cho_n_s_m=2500"]) == 0
+    assert "parameters: set 'paper-table2', changed by --config/--set: cho_n_s_m" in capsys.readouterr().out
+    out = tmp_path / "x.trace.h5"
+    assert main(["simulate", "--speed-rpm", "3000", "--radial-load-n", "500", "--parameter-set", "representative",
+                 "--duration", "0.003", "-q", "-o", str(out)]) == 0
+    assert "parameters: set 'representative'" in capsys.readouterr().out
+    trace = read_trace(out)
+    assert trace.config["parameter_set"] == "representative"
+    assert trace.config["parameters"]["meniscus_distance_m"] == 0.002  # the set's value (parameter_sets.py)
+
+
+def test_lab_options_record_the_parameter_set():
+    from cageless.app.lab import LabOptions
+
+    assert LabOptions().to_dict()["parameter_set"] == "paper-table2"
+    assert LabOptions(parameter_set="representative").to_dict()["parameter_set"] == "representative"

@@ -61,6 +61,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     from cageless.app.lab import LabOptions, run_lab
     from cageless.app.calibrate import describe_calibration
     from cageless.app.cli.common import parameter_values
+    from cageless.simulation.parameter_sets import DEFAULT_SET
 
     from cageless.app.lab import CACHE_NAME, REPORT_PRODUCTS
     from cageless.outputs import check_output_dir, check_products
@@ -76,9 +77,9 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     options = LabOptions(duration_s=args.duration, settle_s=args.settle, revolutions=args.revolutions,
                          rtol=args.rtol, workers=args.workers,
                          scheduler=args.scheduler, force=args.force, parameters=values, calibration=note,
-                         n_balls=args.n_balls, slip_reference=args.slip_reference)
-    if note:
-        print(f"parameters: {note}")
+                         n_balls=args.n_balls, slip_reference=args.slip_reference,
+                         parameter_set=args.parameter_set or DEFAULT_SET)
+    print(f"parameters: {note}" if note else f"parameters: set '{options.parameter_set}'")
     res = run_lab(args.lab, args.out, options, bearing_from_config(config), progress=not args.quiet)
     for row in res.rows:
         if row.status == "failed":
