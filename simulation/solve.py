@@ -87,24 +87,35 @@ class Solution:
         return self.status == STATUS_OK
 
 
+def _run_compiled(name: str, integrate: Callable[..., int], pr: Problem, t_eval: FloatArray, rtol: float,
+                  atol: FloatArray, max_step: float, first_step: float | None, max_steps: int, force_jump: float,
+                  n_stats: int, *extra: Any) -> tuple[Solution, FloatArray]:
+    """Run a compiled integrator (the signature of dp5_integrate, then ``extra``); its solution and raw stats."""
+    out = np.full((len(t_eval), len(pr.y0)), np.nan)
+    stats = np.zeros(n_stats)
+    floor = np.zeros(len(pr.y0)) if pr.jump_floor is None else pr.jump_floor.astype(np.float64)
+    log = pr.log.copy()
+    h0 = first_step or min(max_step, 1e-3 * max(t_eval[-1] - pr.t0, 1e-12))
+    t0 = time.perf_counter()
+    status = integrate(pr.model_id, pr.params, log, pr.y0.astype(np.float64), float(pr.t0), t_eval, float(rtol),
+                       atol, float(h0), float(max_step), int(max_steps), out, stats,
+                       float(pr.onset_step), floor, float(force_jump if pr.jump_floor is not None else 0.0), *extra)
+    sol = Solution(t=t_eval, y=out, status=int(status), message=_MESSAGES[int(status)], method=name,
+                   n_steps=int(stats[0]), n_rejected=int(stats[1]), n_rhs=int(stats[2]),
+                   wall_s=time.perf_counter() - t0, n_onset_retries=int(stats[4]),
+                   n_contact_changes=int(stats[5]), n_force_jump_retries=int(stats[6]),
+                   extra={"log": log, "last_h": float(stats[3])})
+    return sol, stats
+
+
 def _compiled(name: str, integrate: Callable[..., int]) -> Callable[..., Solution]:
     """A registry entry for an integrator whose whole loop is compiled (same signature as dp5_integrate)."""
     def run(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float, first_step: float | None,
             max_steps: int, force_jump: float) -> Solution:
-        out = np.full((len(t_eval), len(pr.y0)), np.nan)
-        stats = np.zeros(8)
-        floor = np.zeros(len(pr.y0)) if pr.jump_floor is None else pr.jump_floor.astype(np.float64)
-        log = pr.log.copy()
-        h0 = first_step or min(max_step, 1e-3 * max(t_eval[-1] - pr.t0, 1e-12))
-        t0 = time.perf_counter()
-        status = integrate(pr.model_id, pr.params, log, pr.y0.astype(np.float64), float(pr.t0), t_eval, float(rtol),
-                           pr.atol.astype(np.float64), float(h0), float(max_step), int(max_steps), out, stats,
-                           float(pr.onset_step), floor, float(force_jump if pr.jump_floor is not None else 0.0))
-        return Solution(t=t_eval, y=out, status=int(status), message=_MESSAGES[int(status)], method=name,
-                        n_steps=int(stats[0]), n_rejected=int(stats[1]), n_rhs=int(stats[2]),
-                        wall_s=time.perf_counter() - t0, n_onset_retries=int(stats[4]),
-                        n_contact_changes=int(stats[5]), n_force_jump_retries=int(stats[6]),
-                        n_stiff_steps=int(stats[7]), extra={"log": log, "last_h": float(stats[3])})
+        sol, stats = _run_compiled(name, integrate, pr, t_eval, rtol, pr.atol.astype(np.float64), max_step,
+                                   first_step, max_steps, force_jump, 8)
+        sol.n_stiff_steps = int(stats[7])
+        return sol
 
     return run
 
@@ -138,22 +149,11 @@ def _rosw(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float, first_s
           max_steps: int, force_jump: float, jac_every: int = JAC_EVERY) -> Solution:
     """The compiled Rosenbrock-W method (:mod:`cageless.simulation.integrators.rosw`), with absolute tolerances
     scaled by :data:`ROSW_ATOL_FACTOR` and rtol."""
-    out = np.full((len(t_eval), len(pr.y0)), np.nan)
-    stats = np.zeros(9)
-    floor = np.zeros(len(pr.y0)) if pr.jump_floor is None else pr.jump_floor.astype(np.float64)
-    log = pr.log.copy()
-    h0 = first_step or min(max_step, 1e-3 * max(t_eval[-1] - pr.t0, 1e-12))
-    t0 = time.perf_counter()
-    status = rosw_integrate(pr.model_id, pr.params, log, pr.y0.astype(np.float64), float(pr.t0), t_eval,
-                            float(rtol), pr.atol.astype(np.float64) * (ROSW_ATOL_FACTOR * rtol / 1e-6), float(h0),
-                            float(max_step), int(max_steps), out, stats, float(pr.onset_step), floor,
-                            float(force_jump if pr.jump_floor is not None else 0.0), _rosw_blocks(pr),
-                            int(jac_every))
-    return Solution(t=t_eval, y=out, status=int(status), message=_MESSAGES[int(status)], method="rosw",
-                    n_steps=int(stats[0]), n_rejected=int(stats[1]), n_rhs=int(stats[2]),
-                    wall_s=time.perf_counter() - t0, n_onset_retries=int(stats[4]),
-                    n_contact_changes=int(stats[5]), n_force_jump_retries=int(stats[6]),
-                    extra={"log": log, "last_h": float(stats[3]), "n_jacobians": int(stats[8])})
+    atol = pr.atol.astype(np.float64) * (ROSW_ATOL_FACTOR * rtol / 1e-6)
+    sol, stats = _run_compiled("rosw", rosw_integrate, pr, t_eval, rtol, atol, max_step, first_step, max_steps,
+                               force_jump, 9, _rosw_blocks(pr), int(jac_every))
+    sol.extra["n_jacobians"] = int(stats[8])
+    return sol
 
 
 def step_scipy(pr: Problem, t_eval: FloatArray, method: str, rtol: float, max_step: float = np.inf,
