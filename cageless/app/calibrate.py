@@ -38,7 +38,7 @@ from cageless.bearing import Bearing, default_bearing
 from cageless.errors import CagelessError, ParameterError, TraceFormatError, UsageError, suggest
 
 __all__ = ["Target", "Bound", "CalibrationResult", "parse_bounds", "target_from_trace", "target_from_peak",
-           "calibrate", "describe_calibration", "UNLOADED_ZONE_DEG", "PENALTY_PP"]
+           "calibrate", "describe_calibration", "fit_warnings", "UNLOADED_ZONE_DEG", "PENALTY_PP"]
 
 #: The unloaded zone (deg) the objective covers (the report's definition).
 UNLOADED_ZONE_DEG = (0.0, 180.0)
@@ -227,6 +227,11 @@ class CalibrationResult:
     fixed: dict[str, Any]
     wall_s: float = 0.0
 
+    @property
+    def warnings(self) -> list[str]:
+        """Why the fitted values may not be determined by the target (empty when they are)."""
+        return fit_warnings(self)
+
 
 class _Budget(Exception):
     """The evaluation budget is spent."""
@@ -350,6 +355,43 @@ def calibrate(target: Target, bounds: list[Bound], budget: int | None = None, se
                              wall_s=time.perf_counter() - start)
 
 
+#: A fitted value closer to a bound than this share of its range is reported as at the edge.
+EDGE_SHARE = 0.02
+
+
+def fit_warnings(result: CalibrationResult) -> list[str]:
+    """Say where a calibration does not determine its parameters.
+
+    Four checks on the evaluation table: several parameters against one number (a peak-slip target);
+    a fitted value at the edge of its range; an objective whose whole spread over the evaluations is
+    within the seeds' own spread (the target does not see the parameter); and other evaluations,
+    far from the fitted values, that fit as well within that spread.
+    """
+    out: list[str] = []
+    ok = [r for r in result.evaluations if r["status"] == "ok"]
+    if result.target.profile is None and len(result.bounds) > 1:
+        out.append(f"a peak slip is one number: it cannot determine {len(result.bounds)} parameters; "
+                   "vary one, or fit a measured trace's profile")
+    for b in result.bounds:
+        share = (result.fitted[b.name] - b.low) / (b.high - b.low)
+        if min(share, 1.0 - share) < EDGE_SHARE:
+            out.append(f"{b.name} = {result.fitted[b.name]:.6g} is at the edge of its range {b.low:g}:{b.high:g}; "
+                       "the best value may lie outside it")
+    spread = np.nanmedian([r["seed_spread_pp"] for r in ok]) if len(ok) and result.seeds > 1 else 0.0
+    objectives = np.array([r["objective_pp"] for r in ok])
+    if len(ok) > 2 and np.isfinite(spread) and np.ptp(objectives) <= spread:
+        out.append(f"the objective changes by {np.ptp(objectives):.3f} pp over the evaluations, within the "
+                   f"seeds' spread ({spread:.3f} pp): this target does not determine the parameters")
+    elif len(ok) > 2 and np.isfinite(spread) and spread > 0:
+        near = [r for r in ok if r["objective_pp"] <= result.objective_pp + spread]
+        for b in result.bounds:
+            lo, hi = min(r[b.name] for r in near), max(r[b.name] for r in near)
+            if hi - lo > 0.25 * (b.high - b.low):
+                out.append(f"{b.name} from {lo:.6g} to {hi:.6g} fits as well (within the seeds' spread of "
+                           f"{spread:.3f} pp)")
+    return out
+
+
 def describe_calibration(table: Mapping[str, Any] | None) -> str | None:
     """One line for a ``[calibration]`` table of a parameter file: what was fitted, to which condition."""
     if not table:
@@ -394,6 +436,7 @@ def calibration_document(result: CalibrationResult, bearing_section: Mapping[str
         "startup_s": "three cage revolutions, at least 0.04 s" if result.settle_s is None else result.settle_s,
         "wall_s": round(result.wall_s, 2),
         "fitted": dict(result.fitted),
+        "warnings": result.warnings,
         "ranges": {b.name: [b.low, b.high] for b in result.bounds},
         "evaluations": [{k: v for k, v in r.items()} for r in result.evaluations],
     }

@@ -130,3 +130,19 @@ def test_info_bad_video_is_exit_1(tmp_path, capsys):
     bad.write_bytes(b"NOPE" * 20)
     assert main(["info", str(bad)]) == 1
     assert "bad.cine: wrong magic bytes" in capsys.readouterr().err
+
+
+def test_a_bad_set_value_names_the_option_not_the_internal_table(tmp_path, capsys):
+    argv = ["simulate", "--speed-rpm", "3000", "-o", str(tmp_path / "x.trace.h5")]
+    assert main([*argv, "--set", "cho_n_s_m=-1"]) == 2
+    assert capsys.readouterr().err == "error: --set cho_n_s_m=-1: must be >= 0.\n"
+    assert main([*argv, "--set", "traction_peak_coefficient=0.001"]) == 2
+    assert "--set traction_peak_coefficient=0.001: must exceed traction_sliding_coefficient" in capsys.readouterr().err
+    assert not (tmp_path / "x.trace.h5").exists()
+
+
+def test_a_missing_video_is_named_once(tmp_path, capsys):
+    missing = tmp_path / "nowhere.cine"
+    assert main(["track", str(missing), "-o", str(tmp_path / "o"), "-q"]) == 1
+    out = capsys.readouterr().out
+    assert out == f"FAILED {missing}: no such file or folder.\n"

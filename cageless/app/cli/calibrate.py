@@ -102,4 +102,6 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     fitted = ", ".join(f"{k} = {v:.6g}" for k, v in res.fitted.items())
     print(f"fitted at {target.condition}: {fitted}; {what} {res.objective_pp:.3f} pp after {len(res.evaluations)} "
           f"evaluations x {res.seeds} seeds ({res.method}; {res.wall_s:.0f} s) -> {out}")
+    for text in res.warnings:
+        print(f"warning: {text}")
     return 0 if all(r["status"] == "ok" for r in res.evaluations) else 1

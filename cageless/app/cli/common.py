@@ -99,7 +99,7 @@ def parameter_values(args: argparse.Namespace, config: dict[str, Any]) -> dict[s
     """The model-parameter changes of a run: the named ``--parameter-set``, then the ``[parameters]`` table of
     ``--config`` (e.g. a file written by ``cageless calibrate``), then ``--set`` on the command line, which wins. Checked by name
     and value; a bad file entry names the file."""
-    from cageless.errors import CagelessError
+    from cageless.errors import CagelessError, ParameterError
     from cageless.simulation.parameters import ModelParameters, parse_set_overrides
 
     table = config.get("parameters", {})
@@ -116,6 +116,14 @@ def parameter_values(args: argparse.Namespace, config: dict[str, Any]) -> dict[s
         from cageless.simulation.parameter_sets import set_values
 
         named = set_values(named)
-    values = {**(named or {}), **table, **parse_set_overrides(getattr(args, "set_values", []))}
-    ModelParameters().with_overrides(values)
+    given = parse_set_overrides(getattr(args, "set_values", []))
+    values = {**(named or {}), **table, **given}
+    try:
+        ModelParameters().with_overrides(values)
+    except ParameterError as exc:
+        name = exc.parameter.removeprefix("parameters.")
+        where = ("--set" if name in given else f"--config {args.config}: [parameters]" if name in table
+                 else f"--parameter-set {getattr(args, 'parameter_set', None)}")
+        shown = "" if exc.value is None else f"={exc.value:g}" if isinstance(exc.value, float) else f"={exc.value}"
+        raise UsageError(f"{where} {name}{shown}: {exc.rule}. {exc.hint}".rstrip()) from None
     return values

@@ -110,11 +110,15 @@ def _track_one(job: tuple[Path, OperatingConditions, Bearing, Any, Path]) -> tup
     except Exception as exc:  # noqa: BLE001 - one video's surprise must not stop the others
         log.debug("tracking %s failed", video, exc_info=True)
         return "failed", f"unexpected {type(exc).__name__}: {exc} (run with -v --workers 1 for the traceback)"
+    from cageless.comparison.metrics import unloaded_peak
+    from cageless.profiles import angle_profile
+
     tr = res.trace
-    unloaded = np.sin(tr.angle) > 0
+    # the peak of the 1 deg mean slip profile in the unloaded zone: the "experimental slip" of compare and report
+    peak = unloaded_peak(angle_profile(tr.angle, tr.slip, 1.0, valid=tr.valid))
     return "ok", {"path": str(res.path), "frames": tr.n_samples, "balls": tr.n_balls,
                   "detected": float(np.mean(res.qc.detection_rate)), "warnings": res.qc.warnings,
-                  "peak_slip": float(np.nanmax(np.nanmean(np.where(unloaded, tr.slip, np.nan), axis=1)))}
+                  "peak_slip": peak}
 
 
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
@@ -145,11 +149,21 @@ def _validate(args: argparse.Namespace) -> None:
     check_output_dir(args.out, "-o")
 
 
+def failed_line(video: Path | str, why: object) -> str:
+    """``FAILED <video>: <why>``, naming the video once even when the message starts with its path."""
+    text = str(why)
+    for prefix in (f"{video}: ", f"{Path(video).name}: "):
+        if text.startswith(prefix):
+            text = text[len(prefix):]
+            break
+    return f"FAILED {video}: {text}"
+
+
 def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bearing, options: Any, out: Path) -> int:
     failed = 0
     for e in entries:
         if not e.ok:
-            print(f"FAILED {e.video}: {e.error}")
+            print(failed_line(e.video, e.error))
             failed += 1
     jobs = []
     for e in entries:
@@ -157,10 +171,10 @@ def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bear
             try:  # a sidecar may describe another bearing (n_balls, ball_diameter_mm, pitch_diameter_mm)
                 jobs.append((e.video, e.resolved.conditions, bearing_with_keys(bearing, e.resolved), options, out))
             except CagelessError as exc:
-                print(f"FAILED {e.video}: {exc}")
+                print(failed_line(e.video, exc))
                 failed += 1
     workers = max(1, min(args.workers, len(jobs)))
-    with tqdm(total=len(jobs), desc="videos", unit="video", disable=args.quiet) as bar:
+    with tqdm(total=len(jobs), desc="videos", unit="video", disable=args.quiet or not jobs) as bar:
         results = _map(jobs, workers, bar)
         for (video, *_), (status, info) in zip(jobs, results, strict=True):
             if status == "ok":
@@ -169,7 +183,7 @@ def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bear
                            f"{100 * info['detected']:.1f}% detected, peak unloaded slip "
                            f"{100 * info['peak_slip']:.2f}% -> {info['path']}{warn}")
             else:
-                tqdm.write(f"FAILED {video.name}: {info}")
+                tqdm.write(failed_line(video.name, info))
                 failed += 1
     return 1 if failed else 0
 
