@@ -25,6 +25,7 @@ from cageless.simulation.effects import ModelChoice
 from cageless.simulation.hertz import compliance, hertz_contact, race_curvatures
 from cageless.simulation.models import planar as P
 from cageless.simulation.models import spatial as S
+from cageless.simulation.models.spatial_geometry import spatial_energy
 from cageless.simulation.models.observables import observables
 from cageless.simulation.parameters import ModelParameters
 from cageless.simulation.quasistatic import radial_load_distribution
@@ -132,7 +133,7 @@ def energy_balance(problem: Problem, y: npt.NDArray[np.float64]) -> EnergyBalanc
     """The energy account of ``problem`` along samples ``y`` (T, n), planar or spatial."""
     sl = P.PlanarLayout(problem.n_balls).slices()  # the counters sit at the same slots in the spatial layout
     work, lost = y[:, sl["input_work"]][:, 0], y[:, sl["dissipated"]][:, 0]
-    energy = S.spatial_energy(problem, y) if problem.model_id == S.MODEL_ID else P.planar_energy(problem, y)
+    energy = spatial_energy(problem, y) if problem.model_id == S.MODEL_ID else P.planar_energy(problem, y)
     return EnergyBalance(balance=energy + lost - work, input_work=work, dissipated=lost)
 
 

@@ -13,6 +13,7 @@ import numpy.typing as npt
 from cageless.simulation.hertz import compliance, hertz_contact, race_curvatures
 from cageless.simulation.models import base as B
 from cageless.simulation.models import spatial as S
+from cageless.simulation.models.spatial_geometry import race_geometry
 from cageless.simulation.models.planar_reference import tangential_force
 from cageless.simulation.problem import Problem
 from cageless.simulation.scene import Scene
@@ -59,7 +60,7 @@ def observables(pr: Problem, y: npt.NDArray[np.float64], scene: Scene,
         sl = S.SpatialLayout(z).slices()
         spin[:, :, 1], spin[:, :, 2] = y[:, sl["spin_y"]], y[:, sl["spin_z"]]
         ring[:, 0] = y[:, sl["ring_axial"]][:, 0]
-        for race, (overlap, angle, point) in S.race_geometry(pr, y).items():
+        for race, (overlap, angle, point) in race_geometry(pr, y).items():
             k_n = p[B.P_KI] if race == "inner" else p[B.P_KO]
             contacts[f"{race}_normal"] = k_n * overlap**1.5
             contacts[f"{race}_angle"] = angle
