@@ -35,7 +35,6 @@ peak force and duration, classed as rubbing when it lasts more than
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numba
 import numpy as np
@@ -49,9 +48,13 @@ from cageless.simulation import effects as effects_table
 from cageless.simulation.effects import check_lubricant, effect_flags
 from cageless.simulation.parameters import ModelParameters
 from cageless.simulation.problem import Problem
-from cageless.simulation.models.base import (LAYOUT, P_CD, P_CHI, P_CHO, P_D, P_DI, P_DO, P_DRY, P_ETA0, P_FR,
+from cageless.simulation.models.base import (LAYOUT, OBS_BB_NORMAL, OBS_BB_TRACTION, OBS_INNER_ENTRAIN, OBS_INNER_NORMAL,
+                                             OBS_INNER_TRACTION, OBS_OUTER_ENTRAIN, OBS_OUTER_NORMAL, OBS_OUTER_TRACTION,
+                                             P_CD, P_CHI, P_CHO, P_D, P_DI, P_DO, P_DRY, P_ETA0, P_FR,
                                     P_F_BB, P_F_BBFILM, P_F_DRAG, P_F_GRAV, P_F_LUB, P_F_RACE, P_F_ROLL, P_F_TRAC, P_G, P_H0,
                                     P_I, P_KB, P_KI, P_KO, P_M, P_MR, P_RAMP, P_RHO_MIX, P_V_IN_MIN, P_WI, P_Z)
+from cageless.simulation.models.energy import planar_energy
+from cageless.simulation.models.planar_layout import PlanarLayout
 from cageless.simulation.models.contact_log import (EVENT_FIELDS, ONSET_RESOLUTION, RUBBING_FACTOR, contact_events,
                                                      empty_log, log_size, planar_post)
 from cageless.simulation.models.contact_laws import RACE_LAWS, ball_churning, ball_drag, race_extra, tangential
@@ -59,7 +62,7 @@ from cageless.simulation.models.rolling import race_rolling, rolling_slots
 
 __all__ = [
     "PlanarLayout", "planar_problem", "planar_energy", "packed_start", "contact_events", "DEFAULT_CHO_N_S_M",
-    "RUBBING_FACTOR", "planar_ring_share", "planar_ring_rows", "planar_gaps", "planar_post", "log_size", "EVENT_FIELDS",
+    "RUBBING_FACTOR", "planar_observe", "planar_ring_share", "planar_ring_rows", "planar_gaps", "planar_post", "log_size", "EVENT_FIELDS",
     "ONSET_RESOLUTION",
 ]
 
@@ -70,34 +73,16 @@ MODEL_ID = 0
 DEFAULT_CHO_N_S_M = ModelParameters().cho_n_s_m
 
 
-@dataclass(frozen=True)
-class PlanarLayout:
-    """Where each quantity sits in the state vector of ``n_balls`` balls."""
-
-    n_balls: int
-
-    @property
-    def size(self) -> int:
-        """Number of states, 5 Z + 6."""
-        return 5 * self.n_balls + 6
-
-    def slices(self) -> dict[str, slice]:
-        """Named slices: r, theta, r_dot, theta_dot, spin, ring (y, z, y', z'), input work, dissipated energy."""
-        z = self.n_balls
-        return {"r": slice(0, z), "theta": slice(z, 2 * z), "r_dot": slice(2 * z, 3 * z),
-                "theta_dot": slice(3 * z, 4 * z), "spin": slice(4 * z, 5 * z), "ring": slice(5 * z, 5 * z + 4),
-                "input_work": slice(5 * z + 4, 5 * z + 5), "dissipated": slice(5 * z + 5, 5 * z + 6)}
-
-
 @numba.njit(cache=True, fastmath=FASTMATH)
-def _race_forces(y, p, j, z, w_i, c, s):  # pragma: no cover - compiled
-    """Race forces on ball j: (f_y, f_z, spin torque, ring f_y, ring f_z, input power, dissipated power)."""
-    fy, fz, torque, p_diss = _outer_race(y, p, j, z, c, s)
-    return _inner_race(y, p, j, z, w_i, c, s, fy, fz, torque, p_diss)
+def _race_forces(y, p, j, z, w_i, c, s, obs):  # pragma: no cover - compiled
+    """Race forces on ball j: (f_y, f_z, spin torque, ring f_y, ring f_z, input power, dissipated power); with
+    ``obs`` (an array, None in the right-hand side) its race observables are written there too."""
+    fy, fz, torque, p_diss = _outer_race(y, p, j, z, c, s, obs)
+    return _inner_race(y, p, j, z, w_i, c, s, fy, fz, torque, p_diss, obs)
 
 
 @numba.njit(cache=True, fastmath=FASTMATH, inline="always")
-def _outer_race(y, p, j, z, c, s):  # pragma: no cover - compiled
+def _outer_race(y, p, j, z, c, s, obs):  # pragma: no cover - compiled
     """Ball j against the fixed outer race: (f_y, f_z, spin torque, dissipated power)."""
     d = p[P_D]
     half = 0.5 * d
@@ -107,6 +92,8 @@ def _outer_race(y, p, j, z, c, s):  # pragma: no cover - compiled
     d_o = r + half - 0.5 * p[P_DO]
     if d_o > 0.0:
         q = p[P_KO] * d_o * np.sqrt(d_o)
+        if obs is not None:
+            obs[OBS_OUTER_NORMAL] = q
         if p[P_F_LUB] > 0.5:
             q_d = max(q + p[P_CHO] * rd, 0.0)  # d(delta_o)/dt = r'; never tensile
             p_diss += (q_d - q) * rd
@@ -120,6 +107,9 @@ def _outer_race(y, p, j, z, c, s):  # pragma: no cover - compiled
             u = r * thd + half * om  # ball surface against the fixed outer race, along e_theta
             u_r = 0.5 * abs(r * thd + half * om - p[P_DO] * thd)
             f_t = -tangential(u, u_r, q, p)
+            if obs is not None:  # the law on the elastic normal force
+                obs[OBS_OUTER_TRACTION] = -tangential(u, u_r, obs[OBS_OUTER_NORMAL], p)
+                obs[OBS_OUTER_ENTRAIN] = u_r
             p_diss -= f_t * u
             torque += half * f_t
         if p[P_F_ROLL] > 0.5:  # rolling losses (models/rolling.py): pressure on the centre, shear at the surface
@@ -133,7 +123,7 @@ def _outer_race(y, p, j, z, c, s):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, fastmath=FASTMATH, inline="always")
-def _inner_race(y, p, j, z, w_i, c, s, fy, fz, torque, p_diss):  # pragma: no cover - compiled
+def _inner_race(y, p, j, z, w_i, c, s, fy, fz, torque, p_diss, obs):  # pragma: no cover - compiled
     """Ball j against the driven inner ring, added to the outer race's (f_y, f_z, spin torque, dissipated
     power): the race forces of :func:`_race_forces`."""
     d = p[P_D]
@@ -151,6 +141,8 @@ def _inner_race(y, p, j, z, w_i, c, s, fy, fz, torque, p_diss):  # pragma: no co
         vx = rd * c - r * thd * s - cvy
         vz = rd * s + r * thd * c - cvz
         q = p[P_KI] * d_i * np.sqrt(d_i)
+        if obs is not None:
+            obs[OBS_INNER_NORMAL] = q
         if p[P_F_LUB] > 0.5:
             ddot = -(vx * nx + vz * nz)
             q_d = max(q + p[P_CHO] * ddot, 0.0)
@@ -168,6 +160,9 @@ def _inner_race(y, p, j, z, w_i, c, s, fy, fz, torque, p_diss):  # pragma: no co
             u = vt - half * om - w_i * r_i  # ball surface against the ring surface, along t
             u_r = 0.5 * abs(vt * (1.0 - 2.0 * r_i / ln) - half * om + w_i * r_i)
             f_t = -tangential(u, u_r, q, p)
+            if obs is not None:  # the law on the elastic normal force
+                obs[OBS_INNER_TRACTION] = -tangential(u, u_r, obs[OBS_INNER_NORMAL], p)
+                obs[OBS_INNER_ENTRAIN] = u_r
             p_diss -= f_t * u
             p_in += w_i * r_i * f_t
             torque -= half * f_t
@@ -187,8 +182,9 @@ def _inner_race(y, p, j, z, w_i, c, s, fy, fz, torque, p_diss):  # pragma: no co
 
 
 @numba.njit(cache=True, fastmath=FASTMATH)
-def _pair_forces(y, p, log, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
-    """Forces between balls j and k: (f_y on k, f_z on k, spin torque on both, dissipated power)."""
+def _pair_forces(y, p, log, j, k, z, cj, sj, ck, sk, obs):  # pragma: no cover - compiled
+    """Forces between balls j and k: (f_y on k, f_z on k, spin torque on both, dissipated power); with ``obs``
+    (None in the right-hand side) the pair's observables are written there too."""
     d = p[P_D]
     rj, rk = y[j], y[k]
     dx = rk * ck - rj * cj
@@ -215,7 +211,10 @@ def _pair_forces(y, p, log, j, k, z, cj, sj, ck, sk):  # pragma: no cover - comp
     # (floored: see ModelParameters.min_approach_speed_m_s)
     v_in = max(log[j] if log[j] > 0.0 else delta_dot, p[P_V_IN_MIN])
     f = hertz_damped(delta, delta_dot, v_in, p[P_KB], p[P_CHI])
-    p_diss = (f - p[P_KB] * delta * np.sqrt(delta)) * delta_dot
+    elastic = p[P_KB] * delta * np.sqrt(delta)
+    p_diss = (f - elastic) * delta_dot
+    if obs is not None:
+        obs[OBS_BB_NORMAL] = elastic
     f_t = torque = 0.0
     if p[P_F_TRAC] > 0.5:
         tx, tz = -nz, nx
@@ -223,6 +222,8 @@ def _pair_forces(y, p, log, j, k, z, cj, sj, ck, sk):  # pragma: no cover - comp
         u = (vjx - vkx) * tx + (vjz - vkz) * tz + 0.5 * d * (om_j + om_k)  # surface of j against k, along t
         u_r = 0.25 * d * abs(om_j - om_k)
         f_t = -tangential(u, u_r, f, p)  # on j, along t
+        if obs is not None:  # the law on the elastic normal force
+            obs[OBS_BB_TRACTION] = abs(tangential(u, u_r, elastic, p))
         p_diss -= f_t * u
         torque = 0.5 * d * f_t
         return f * nx - f_t * tx, f * nz - f_t * tz, torque, p_diss
@@ -273,7 +274,7 @@ def _start(y, p, log, dydt, z, trig, grav_on):  # pragma: no cover - compiled
 def _add_race(y, p, log, dydt, z, trig, w_i, fy_ring, fz_ring, power_in, power):  # pragma: no cover - compiled
     """Every ball's race forces into the accumulators; the ring's force and the powers, updated."""
     for j in range(z):
-        fy, fz, torque, ry, rz, p_in, p_diss = _race_forces(y, p, j, z, w_i, log[trig + j], log[trig + z + j])
+        fy, fz, torque, ry, rz, p_in, p_diss = _race_forces(y, p, j, z, w_i, log[trig + j], log[trig + z + j], None)
         dydt[2 * z + j] += fy
         dydt[3 * z + j] += fz
         dydt[4 * z + j] += torque
@@ -290,7 +291,7 @@ def _add_pairs(y, p, log, dydt, z, trig, power):  # pragma: no cover - compiled
     for j in range(z):
         k = j + 1 if j + 1 < z else 0
         fy, fz, torque, p_diss = _pair_forces(y, p, log, j, k, z, log[trig + j], log[trig + z + j], log[trig + k],
-                                             log[trig + z + k])
+                                             log[trig + z + k], None)
         dydt[2 * z + j] -= fy
         dydt[3 * z + j] -= fz
         dydt[2 * z + k] += fy
@@ -339,12 +340,12 @@ def planar_ring_share(t, y, p, log, j, out):  # pragma: no cover - compiled
     if p[P_F_RACE] > 0.5:
         ramp = p[P_RAMP]
         w_i = p[P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
-        _, _, _, ry, rz, p_in, p_diss = _race_forces(y, p, j, z, w_i, c, s)
+        _, _, _, ry, rz, p_in, p_diss = _race_forces(y, p, j, z, w_i, c, s, None)
         out[0], out[1], out[2], out[3] = ry / p[P_MR], rz / p[P_MR], p_in, p_diss
     if p[P_F_BB] > 0.5:
         for a, b in ((j - 1 if j > 0 else z - 1, j), (j, j + 1 if j + 1 < z else 0)):
             ca, sa, cb, sb = np.cos(y[z + a]), np.sin(y[z + a]), np.cos(y[z + b]), np.sin(y[z + b])
-            out[3] += _pair_forces(y, p, log, a, b, z, ca, sa, cb, sb)[3]
+            out[3] += _pair_forces(y, p, log, a, b, z, ca, sa, cb, sb, None)[3]
     if p[P_F_DRAG] > 0.5:
         v, om = y[j] * y[3 * z + j], y[4 * z + j]
         out[3] -= ball_drag(v, p) * v + ball_churning(om, p) * om
@@ -354,6 +355,23 @@ def planar_ring_rows(n_balls: int) -> list[int]:
     """State indices of the rows :func:`planar_ring_share` fills: the ring's y'' and z'', the input work
     and the dissipated energy."""
     return [5 * n_balls + 2, 5 * n_balls + 3, 5 * n_balls + 4, 5 * n_balls + 5]
+
+
+@numba.njit(cache=True)
+def planar_observe(t, y, p, log, out):  # pragma: no cover - compiled
+    """The observables of state ``y`` at time t from the right-hand side's own force functions: per ball j,
+    ``out[:, j]`` gets the fields of :data:`cageless.simulation.models.base.OBSERVABLES` (films excluded)."""
+    z = int(p[P_Z])
+    out[:, :] = 0.0
+    ramp = p[P_RAMP]
+    w_i = p[P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
+    for j in range(z):
+        k = j + 1 if j + 1 < z else 0
+        c, s = np.cos(y[z + j]), np.sin(y[z + j])
+        if p[P_F_RACE] > 0.5:
+            _race_forces(y, p, j, z, w_i, c, s, out[:, j])
+        if p[P_F_BB] > 0.5:
+            _pair_forces(y, p, log, j, k, z, c, s, np.cos(y[z + k]), np.sin(y[z + k]), out[:, j])
 
 
 @numba.njit(cache=True, inline="always")
@@ -531,32 +549,6 @@ def planar_jump_floor(p: npt.NDArray[np.float64], lay: PlanarLayout) -> npt.NDAr
     floor[sl["spin"]] = 0.5 * p[P_D] / p[P_I]
     floor[5 * z + 2:5 * z + 4] = 1.0 / p[P_MR]
     return floor
-
-
-def planar_energy(problem: Problem, y: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
-    """Total mechanical energy (J) along samples y (T, n): kinetic + Hertz + gravity + load potential.
-
-    Conserved when every active force is conservative; with damping on, this plus the dissipated
-    energy (the last state) is conserved.
-    """
-    p = problem.params
-    z = int(p[P_Z])
-    d, m, m_ring, g, f_r = p[P_D], p[P_M], p[P_MR], p[P_G], p[P_FR]
-    r, th, rd, thd = y[:, :z], y[:, z:2 * z], y[:, 2 * z:3 * z], y[:, 3 * z:4 * z]
-    cy, cz, cvy, cvz = (y[:, 5 * z + i] for i in range(4))
-    ke = 0.5 * m * np.sum(rd**2 + (r * thd) ** 2, axis=1) + 0.5 * m_ring * (cvy**2 + cvz**2)
-    ke += 0.5 * p[P_I] * np.sum(y[:, 4 * z:5 * z] ** 2, axis=1)
-    pe = m * g * np.sum(r * np.sin(th), axis=1) * (p[P_F_GRAV] > 0.5) + (m_ring * g * (p[P_F_GRAV] > 0.5) + f_r) * cz
-    if p[P_F_RACE] > 0.5:
-        d_o = np.clip(r + 0.5 * d - 0.5 * p[P_DO], 0, None)
-        ln = np.hypot(r * np.cos(th) - cy[:, None], r * np.sin(th) - cz[:, None])
-        d_i = np.clip(0.5 * p[P_DI] + 0.5 * d - ln, 0, None)
-        pe += 0.4 * (p[P_KO] * np.sum(d_o**2.5, axis=1) + p[P_KI] * np.sum(d_i**2.5, axis=1))
-    if p[P_F_BB] > 0.5:
-        x, zz = r * np.cos(th), r * np.sin(th)
-        gap = np.hypot(np.roll(x, -1, axis=1) - x, np.roll(zz, -1, axis=1) - zz)
-        pe += 0.4 * p[P_KB] * np.sum(np.clip(d - gap, 0, None) ** 2.5, axis=1)
-    return ke + pe
 
 
 def packed_start(bearing: Bearing, seed: int = 0, spread: float = 0.05) -> npt.NDArray[np.float64]:

@@ -49,20 +49,21 @@ from cageless.simulation.models.contact_laws import RACE_LAWS, ball_churning, ba
 from cageless.simulation.models.rolling import spatial_rolling
 from cageless.simulation.models.spatial_layout import (LAYOUT, N_PARAMS, P_AI, P_AO, P_FA, P_GAX, P_IR, P_MY, P_RGI,
                                                         P_RGO, P_STRIPS, P_TILT_Y, P_TILT_Z, SpatialLayout, _cross,
-                                                        _groove, _tilt)
+                                                        _groove, _tilt, spatial_gaps, spatial_signature)
 from cageless.simulation.problem import Problem
 
 __all__ = ["MODEL_ID", "LAYOUT", "N_PARAMS", "SpatialLayout", "spatial_problem", "spatial_rhs", "spatial_signature",
-           "spatial_ring_share", "spatial_ring_rows", "spatial_gaps", "ring_tilt_inertia"]
+           "spatial_observe", "spatial_ring_share", "spatial_ring_rows", "spatial_gaps", "ring_tilt_inertia"]
 
 MODEL_ID = 4
 
 
 @numba.njit(cache=True, fastmath=FASTMATH)
-def _race(y, p, j, z, inner, w_i, rot, c, s, wt):  # pragma: no cover - compiled
+def _race(y, p, j, z, inner, w_i, rot, c, s, wt, obs):  # pragma: no cover - compiled
     """One race contact of ball j, as ((force on the ball), (torque on the ball), input power, dissipated power,
     overlap, (moment on the inner ring about its centre)), each bracket 3 components in the fixed frame.
-    ``wt`` is the ring's tilting angular velocity (3)."""
+    ``wt`` is the ring's tilting angular velocity (3). With ``obs`` (an array, None in the right-hand side) the
+    contact's observables are written there too (:func:`spatial_observe`)."""
     half = 0.5 * p[B.P_D]
     if not inner:
         rot = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
@@ -75,15 +76,24 @@ def _race(y, p, j, z, inner, w_i, rot, c, s, wt):  # pragma: no cover - compiled
     n, t, xr, rv, r_c, k_n, a_c = _race_frame(y, p, j, z, inner, rot, c, s, wt, rq, cq, sq, ex, er, ln, rho, rg)
     nx, ny, nz = n
     xrx, xry, xrz = xr
-    q, p_diss = _race_normal(p, k_n, delta, rv, n)
+    q = k_n * delta * math.sqrt(delta)
+    side = 1 if inner else 0
+    if obs is not None:
+        obs[B.OBS_OUTER_NORMAL + side] = q
+    q, p_diss = _race_normal(p, q, delta, rv, n)
     fx, fy, fz = -q * nx, -q * ny, -q * nz
     mx = my = mz = 0.0
     t2x = t2y = t2z = 0.0
     p_in = 0.0
     if p[B.P_F_TRAC] > 0.5 and q > 0.0:
-        (gsx, gsy, gsz), (t2x, t2y, t2z), (mx, my, mz), p_in, p_diss = _race_traction(
+        (gsx, gsy, gsz), (t2x, t2y, t2z), (mx, my, mz), p_in, p_diss, _ = _race_traction(
             p, inner, q, w_i, rot, wt, (ox, oy, oz), n, t, xr, rv, a_c, r_c, rq, half, p_diss)
         fx, fy, fz = fx + gsx, fy + gsy, fz + gsz
+    if obs is not None and p[B.P_F_TRAC] > 0.5:  # the law on the elastic normal force, along t as the planar one's
+        g_el, _, _, _, _, u_r = _race_traction(p, inner, obs[B.OBS_OUTER_NORMAL + side], w_i, rot, wt, (ox, oy, oz), n,
+                                               t, xr, rv, a_c, r_c, rq, half, 0.0)
+        obs[B.OBS_OUTER_TRACTION + side] = g_el[0] * t[0] + g_el[1] * t[1] + g_el[2] * t[2]
+        obs[B.OBS_OUTER_ENTRAIN + side] = u_r
     rmx = rmy = rmz = 0.0
     if inner:  # reaction on the ring: -F at the contact point, and -t2
         rmx, rmy, rmz = _cross(xrx, xry, xrz, -fx, -fy, -fz)
@@ -136,12 +146,11 @@ def _race_frame(y, p, j, z, inner, rot, c, s, wt, rq, cq, sq, ex, er, ln, rho, r
 
 
 @numba.njit(cache=True, fastmath=FASTMATH, inline="always")
-def _race_normal(p, k_n, delta, rv, n):  # pragma: no cover - compiled
-    """The normal force of a race contact of overlap ``delta`` (Hertz, lubricant damping, the registered extra
-    laws) and the power it dissipates."""
+def _race_normal(p, q, delta, rv, n):  # pragma: no cover - compiled
+    """The normal force of a race contact of overlap ``delta`` and Hertz force ``q``, with the lubricant damping
+    and the registered extra laws, and the power it dissipates."""
     rvx, rvy, rvz = rv
     nx, ny, nz = n
-    q = k_n * delta * math.sqrt(delta)
     p_diss = 0.0
     if p[B.P_F_LUB] > 0.5:
         ddot = rvx * nx + rvy * ny + rvz * nz
@@ -160,7 +169,7 @@ def _race_normal(p, k_n, delta, rv, n):  # pragma: no cover - compiled
 def _race_traction(p, inner, q, w_i, rot, wt, o, n, t, xr, rv, a_c, r_c, rq, half, p_diss):  # pragma: no cover
     """Race traction integrated over the strips of the contact ellipse: the force on the ball (3), the moment
     of its spread along the major axis (3), the whole moment on the ball (3), the drive's input power, and the
-    dissipated power with the traction's share added."""
+    dissipated power with the traction's share added; and the entrainment speed u_r."""
     ox, oy, oz = o
     nx, ny, nz = n
     tx, ty, tz = t
@@ -200,7 +209,7 @@ def _race_traction(p, inner, q, w_i, rot, wt, o, n, t, xr, rv, a_c, r_c, rq, hal
         # drive power: the ring's spin times the moment of the ball's traction on it
         c1x, c1y, c1z = _cross(xrx, xry, xrz, gsx, gsy, gsz)
         p_in = (c1x + t2x) * wx + (c1y + t2y) * wy + (c1z + t2z) * wz
-    return (gsx, gsy, gsz), (t2x, t2y, t2z), (t1x + t2x, t1y + t2y, t1z + t2z), p_in, p_diss
+    return (gsx, gsy, gsz), (t2x, t2y, t2z), (t1x + t2x, t1y + t2y, t1z + t2z), p_in, p_diss, u_r
 
 
 @numba.njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -226,8 +235,9 @@ def _strip_sums(p, q, a, u_r, c0, c1, c2, p_diss):  # pragma: no cover - compile
 
 
 @numba.njit(cache=True, fastmath=FASTMATH)
-def _pair(y, p, log, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
-    """Ball j against ball k along the 3-D line of centres: force on k (3), moment on both (3), dissipated power."""
+def _pair(y, p, log, j, k, z, cj, sj, ck, sk, obs):  # pragma: no cover - compiled
+    """Ball j against ball k along the 3-D line of centres: force on k (3), moment on both (3), dissipated power;
+    with ``obs`` (None in the right-hand side) the pair's observables are written there too."""
     d = p[B.P_D]
     half = 0.5 * d
     b = 5 * z + 6
@@ -255,7 +265,10 @@ def _pair(y, p, log, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
         return zero
     v_in = max(log[j] if log[j] > 0.0 else ddot, p[B.P_V_IN_MIN])
     f = hertz_damped(delta, ddot, v_in, p[B.P_KB], p[B.P_CHI])
-    p_diss = (f - p[B.P_KB] * delta * math.sqrt(delta)) * ddot
+    elastic = p[B.P_KB] * delta * math.sqrt(delta)
+    p_diss = (f - elastic) * ddot
+    if obs is not None:
+        obs[B.OBS_BB_NORMAL] = elastic
     fx, fy, fz = f * nx, f * ny, f * nz
     mx = my = mz = 0.0
     if p[B.P_F_TRAC] > 0.5:
@@ -270,6 +283,8 @@ def _pair(y, p, log, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
             rx, ry, rz = _cross(ojx - okx, ojy - oky, ojz - okz, nx, ny, nz)
             u_r = 0.25 * d * math.sqrt(rx * rx + ry * ry + rz * rz)
             g = tangential(us, u_r, f, p) / us  # friction on j is -g u
+            if obs is not None:  # the law on the elastic normal force
+                obs[B.OBS_BB_TRACTION] = abs(tangential(us, u_r, elastic, p))
             p_diss += g * us * us
             fx, fy, fz = fx + g * ux, fy + g * uy, fz + g * uz  # on k: +g u
             mx, my, mz = _cross(half * nx, half * ny, half * nz, -g * ux, -g * uy, -g * uz)
@@ -353,7 +368,7 @@ def _add_race(y, p, log, dydt, z, trig, w_i, rot, wt, rf, rm, power_in, power): 
     rmx, rmy, rmz = rm
     for j in range(z):
         for inner in (False, True):
-            f, mo, pin, pd, _, qm = _race(y, p, j, z, inner, w_i, rot, log[trig + j], log[trig + z + j], wt)
+            f, mo, pin, pd, _, qm = _race(y, p, j, z, inner, w_i, rot, log[trig + j], log[trig + z + j], wt, None)
             fx, fy, fz = f
             mx, my, mz = mo
             qx, qy, qz = qm
@@ -378,7 +393,7 @@ def _add_pairs(y, p, log, dydt, z, trig, power):  # pragma: no cover - compiled
     for j in range(z):
         k = j + 1 if j + 1 < z else 0
         fx, fy, fz, mx, my, mz, pd = _pair(y, p, log, j, k, z, log[trig + j], log[trig + z + j], log[trig + k],
-                                           log[trig + z + k])
+                                           log[trig + z + k], None)
         dydt[b + z + j] -= fx
         dydt[2 * z + j] -= fy
         dydt[3 * z + j] -= fz
@@ -436,21 +451,44 @@ def spatial_ring_share(t, y, p, log, j, out):  # pragma: no cover - compiled
         s_bz, c_bz = math.sin(p[P_TILT_Z] + y[tb + 1]), math.cos(p[P_TILT_Z] + y[tb + 1])
         wt = (-s_bz * y[tb + 2], c_bz * y[tb + 2], y[tb + 3])
         rot = _tilt(y, p)
-        (fx, fy, fz), _, pin, pd, _, (qx, qy, qz) = _race(y, p, j, z, True, w_i, rot, c, s, wt)
+        (fx, fy, fz), _, pin, pd, _, (qx, qy, qz) = _race(y, p, j, z, True, w_i, rot, c, s, wt, None)
         m_ring = p[B.P_MR]
         out[0], out[1], out[2] = -fy / m_ring, -fz / m_ring, -fx / m_ring
         out[3], out[4] = (-s_bz * qx + c_bz * qy) / p[P_IR], qz / p[P_IR]
         out[5], out[6] = pin, pd
-        pin_o, pd_o = _race(y, p, j, z, False, w_i, rot, c, s, wt)[2:4]
+        pin_o, pd_o = _race(y, p, j, z, False, w_i, rot, c, s, wt, None)[2:4]
         out[5] += pin_o
         out[6] += pd_o
     if p[B.P_F_BB] > 0.5:
         for a, b in ((j - 1 if j > 0 else z - 1, j), (j, j + 1 if j + 1 < z else 0)):
             ca, sa, cb, sb = math.cos(y[z + a]), math.sin(y[z + a]), math.cos(y[z + b]), math.sin(y[z + b])
-            out[6] += _pair(y, p, log, a, b, z, ca, sa, cb, sb)[6]
+            out[6] += _pair(y, p, log, a, b, z, ca, sa, cb, sb, None)[6]
     if p[B.P_F_DRAG] > 0.5:
         v = y[j] * y[3 * z + j]
         out[6] -= ball_drag(v, p) * v + _churn(y, p, j, z, None)
+
+
+@numba.njit(cache=True)
+def spatial_observe(t, y, p, log, out):  # pragma: no cover - compiled
+    """The observables of state ``y`` at time t from the right-hand side's own force functions, as
+    :func:`cageless.simulation.models.planar.planar_observe` writes them (traction: its component along the
+    rolling direction)."""
+    z = int(p[B.P_Z])
+    out[:, :] = 0.0
+    ramp = p[B.P_RAMP]
+    w_i = p[B.P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
+    rot = _tilt(y, p)
+    tb = y.shape[0] - 4
+    s_bz, c_bz = math.sin(p[P_TILT_Z] + y[tb + 1]), math.cos(p[P_TILT_Z] + y[tb + 1])
+    wt = (-s_bz * y[tb + 2], c_bz * y[tb + 2], y[tb + 3])
+    for j in range(z):
+        k = j + 1 if j + 1 < z else 0
+        c, s = math.cos(y[z + j]), math.sin(y[z + j])
+        if p[B.P_F_RACE] > 0.5:
+            for inner in (False, True):
+                _race(y, p, j, z, inner, w_i, rot, c, s, wt, out[:, j])
+        if p[B.P_F_BB] > 0.5:
+            _pair(y, p, log, j, k, z, c, s, math.cos(y[z + k]), math.sin(y[z + k]), out[:, j])
 
 
 def spatial_ring_rows(n_balls: int) -> list[int]:
@@ -459,48 +497,6 @@ def spatial_ring_rows(n_balls: int) -> list[int]:
     b = 5 * n_balls + 6
     return [5 * n_balls + 2, 5 * n_balls + 3, b + 4 * n_balls + 1, b + 4 * n_balls + 4, b + 4 * n_balls + 5,
             5 * n_balls + 4, 5 * n_balls + 5]
-
-
-@numba.njit(cache=True, inline="always")
-def _overlaps(y, p, j, z, rot):  # pragma: no cover - compiled
-    """Ball j's contacts in three dimensions, as :func:`cageless.simulation.models.planar._overlaps` returns them."""
-    b = 5 * z + 6
-    c, s = math.cos(y[z + j]), math.sin(y[z + j])
-    k = j + 1 if j + 1 < z else 0
-    dx = y[b + k] - y[b + j]
-    dy = y[k] * math.cos(y[z + k]) - y[j] * c
-    dz = y[k] * math.sin(y[z + k]) - y[j] * s
-    return (_groove(y, p, j, z, False, rot, c, s)[6], _groove(y, p, j, z, True, rot, c, s)[6],
-            p[B.P_D] ** 2 - (dx * dx + dy * dy + dz * dz))
-
-
-@numba.njit(cache=True)
-def spatial_signature(y, p):  # pragma: no cover - compiled
-    """Which contacts are closed, as a number (see :func:`cageless.simulation.models.planar.planar_signature`)."""
-    z = int(p[B.P_Z])
-    rot = _tilt(y, p)
-    sig = 0.0
-    for j in range(z):
-        outer, inner, pair = _overlaps(y, p, j, z, rot)
-        if outer > 0.0:
-            sig += 1.0 + j
-        if inner > 0.0:
-            sig += 1.0 + z + j
-        if pair > 0.0:
-            sig += 1.0 + 2 * z + j
-    return sig * (sig + 1.0)
-
-
-@numba.njit(cache=True)
-def spatial_gaps(y, p, out):  # pragma: no cover - compiled
-    """Every contact's overlap (m), as :func:`cageless.simulation.models.planar.planar_gaps` orders them, in three
-    dimensions (the quantities :func:`spatial_signature` tests)."""
-    z = int(p[B.P_Z])
-    rot = _tilt(y, p)
-    d = p[B.P_D]
-    for j in range(z):
-        out[j], out[z + j], pair = _overlaps(y, p, j, z, rot)
-        out[2 * z + j] = d - math.sqrt(d * d - pair)
 
 
 def spatial_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLike, ring0: tuple[float, float],

@@ -1,5 +1,6 @@
 """The spatial model's layouts and groove geometry: its parameter slots (the planar ones extended), its state
-layout, and the compiled geometry of a ball in a groove that its kernels and its post-processing share.
+layout, the compiled geometry of a ball in a groove that its kernels and its post-processing share, and the
+contacts' overlaps the solvers watch (:func:`spatial_signature`, :func:`spatial_gaps`).
 """
 
 from __future__ import annotations
@@ -10,9 +11,9 @@ import numba
 
 from cageless.simulation.forces import FASTMATH
 from cageless.simulation.models import base as B
-from cageless.simulation.models.planar import PlanarLayout
+from cageless.simulation.models.planar_layout import PlanarLayout
 
-__all__ = ["LAYOUT", "N_PARAMS", "SpatialLayout"]
+__all__ = ["LAYOUT", "N_PARAMS", "SpatialLayout", "spatial_signature", "spatial_gaps"]
 
 #: The planar slots, then the groove curvature radii, the axial load, the prescribed misalignment (about y and
 #: z), the strip count, the contact-ellipse coefficients a / Q^(1/3), the ring's tilt inertia, the moment load
@@ -80,3 +81,45 @@ def _groove(y, p, j, z, inner, rot, c, s):  # pragma: no cover - compiled
     ex, er = qx, rq - rho  # from the groove centre to the ball centre, in the (x, radial) plane of the ring
     ln = math.sqrt(ex * ex + er * er)
     return rq, qy / rq, qz / rq, ex, er, ln, ln - (rg - 0.5 * p[B.P_D]), rho, rg
+
+
+@numba.njit(cache=True, inline="always")
+def _overlaps(y, p, j, z, rot):  # pragma: no cover - compiled
+    """Ball j's contacts in three dimensions, as :func:`cageless.simulation.models.planar._overlaps` returns them."""
+    b = 5 * z + 6
+    c, s = math.cos(y[z + j]), math.sin(y[z + j])
+    k = j + 1 if j + 1 < z else 0
+    dx = y[b + k] - y[b + j]
+    dy = y[k] * math.cos(y[z + k]) - y[j] * c
+    dz = y[k] * math.sin(y[z + k]) - y[j] * s
+    return (_groove(y, p, j, z, False, rot, c, s)[6], _groove(y, p, j, z, True, rot, c, s)[6],
+            p[B.P_D] ** 2 - (dx * dx + dy * dy + dz * dz))
+
+
+@numba.njit(cache=True)
+def spatial_signature(y, p):  # pragma: no cover - compiled
+    """Which contacts are closed, as a number (see :func:`cageless.simulation.models.planar.planar_signature`)."""
+    z = int(p[B.P_Z])
+    rot = _tilt(y, p)
+    sig = 0.0
+    for j in range(z):
+        outer, inner, pair = _overlaps(y, p, j, z, rot)
+        if outer > 0.0:
+            sig += 1.0 + j
+        if inner > 0.0:
+            sig += 1.0 + z + j
+        if pair > 0.0:
+            sig += 1.0 + 2 * z + j
+    return sig * (sig + 1.0)
+
+
+@numba.njit(cache=True)
+def spatial_gaps(y, p, out):  # pragma: no cover - compiled
+    """Every contact's overlap (m), as :func:`cageless.simulation.models.planar.planar_gaps` orders them, in three
+    dimensions (the quantities :func:`spatial_signature` tests)."""
+    z = int(p[B.P_Z])
+    rot = _tilt(y, p)
+    d = p[B.P_D]
+    for j in range(z):
+        out[j], out[z + j], pair = _overlaps(y, p, j, z, rot)
+        out[2 * z + j] = d - math.sqrt(d * d - pair)
