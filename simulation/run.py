@@ -25,6 +25,7 @@ from cageless.simulation.effects import ModelChoice
 from cageless.simulation.hertz import compliance, hertz_contact, race_curvatures
 from cageless.simulation.models import planar as P
 from cageless.simulation.models import spatial as S
+from cageless.simulation.models.energy import spatial_energy
 from cageless.simulation.models.observables import observables
 from cageless.simulation.parameters import ModelParameters
 from cageless.simulation.quasistatic import radial_load_distribution
@@ -132,7 +133,7 @@ def energy_balance(problem: Problem, y: npt.NDArray[np.float64]) -> EnergyBalanc
     """The energy account of ``problem`` along samples ``y`` (T, n), planar or spatial."""
     sl = P.PlanarLayout(problem.n_balls).slices()  # the counters sit at the same slots in the spatial layout
     work, lost = y[:, sl["input_work"]][:, 0], y[:, sl["dissipated"]][:, 0]
-    energy = S.spatial_energy(problem, y) if problem.model_id == S.MODEL_ID else P.planar_energy(problem, y)
+    energy = spatial_energy(problem, y) if problem.model_id == S.MODEL_ID else P.planar_energy(problem, y)
     return EnergyBalance(balance=energy + lost - work, input_work=work, dissipated=lost)
 
 
@@ -176,7 +177,7 @@ def to_trace(scene: Scene, choice: ModelChoice, pr: Problem, sol: Solution, rtol
     ok = np.all(np.isfinite(y), axis=1)
     angle, speed = y[:, z:2 * z], y[:, 3 * z:4 * z]
     film_on = any(e.name == "ehl_film" and e.on for e in choice.effects)
-    groups = observables(pr, np.where(ok[:, None], y, np.nan), scene, film_on)
+    groups = observables(pr, sol.t, np.where(ok[:, None], y, np.nan), scene, film_on)
     alpha = nominal_contact_angle(scene, groups)
     provenance["config"]["nominal_contact_angle_rad"] = alpha
     omega_c = theoretical_cage_speed(g, scene.conditions.speed_rad_s, alpha)

@@ -12,7 +12,7 @@ from __future__ import annotations
 from cageless.simulation.effects import parameter_slots
 from cageless.simulation.layout import ParameterLayout
 
-__all__ = ["BODY_SLOTS", "LAYOUT"]
+__all__ = ["BODY_SLOTS", "LAYOUT", "OBSERVABLES", "N_OBS"]
 
 #: The model body: ball count Z, ball diameter D, ball mass M and spin inertia I, the ring's translational
 #: mass MR, the race diameters DI and DO, the radial load FR, the ring speed WI and its ramp time RAMP.
@@ -34,3 +34,14 @@ P_F_DRAG, P_CD, P_RHO_MIX, P_MU_MIX = LAYOUT.slots("F_DRAG", "CD", "RHO_MIX", "M
 P_DRY, P_MU_DRY, P_V_REG, P_MU_STATIC, P_V_STRIBECK = LAYOUT.slots("DRY", "MU_DRY", "V_REG", "MU_STATIC",
                                                                    "V_STRIBECK")
 N_PARAMS = len(LAYOUT)
+
+#: What the models' observation pass (``planar_observe``, ``spatial_observe``) writes per ball j, in this order:
+#: the elastic (Hertz) part of the outer and inner race normal forces (N), the race traction the tangential
+#: law gives (N, on the ball along the rolling direction), the race contacts' entrainment speeds u_r (m/s),
+#: the elastic normal force and the friction magnitude between balls j and j+1 (N), then the race films (m),
+#: filled from the same pass by :func:`cageless.simulation.models.observables.kernel_observables`.
+OBSERVABLES = ("outer_normal", "inner_normal", "outer_traction", "inner_traction", "outer_entrainment",
+               "inner_entrainment", "ball_ball_normal", "ball_ball_traction", "outer_film", "inner_film")
+(OBS_OUTER_NORMAL, OBS_INNER_NORMAL, OBS_OUTER_TRACTION, OBS_INNER_TRACTION, OBS_OUTER_ENTRAIN, OBS_INNER_ENTRAIN,
+ OBS_BB_NORMAL, OBS_BB_TRACTION, OBS_OUTER_FILM, OBS_INNER_FILM) = range(len(OBSERVABLES))
+N_OBS = len(OBSERVABLES)

@@ -1,71 +1,70 @@
 """What a run reports besides the states: contact forces, films, contact angles, positions and spins.
 
-Computed along the samples from the states with the models' named parameter slots (the plain-numpy
-traction law of :mod:`cageless.simulation.models.planar_reference`); the trace's ``balls``, ``contacts`` and
-``inner_ring`` groups.
+The contact forces, entrainment speeds and films come from the compiled models themselves: at every sample
+:func:`kernel_observables` evaluates the model's own race and ball-ball force functions (the ones its
+right-hand side calls; :func:`cageless.simulation.kernels.model_observe`) and they write what they compute
+into an output array, so the trace cannot drift from the forces the solver integrated. They give:
+
+* ``*_normal``: the elastic (Hertz) part of each contact's normal force, K delta^1.5;
+* ``inner_traction``, ``outer_traction``: the race traction on the ball along the rolling direction, the
+  tangential law at the contact's own sliding and entrainment speeds on that elastic normal force (the
+  right-hand side applies it to the whole normal force, lubricant damping included);
+* ``ball_ball_traction``: the magnitude of the friction between balls j and j+1, likewise;
+* ``*_film``: the Hamrock-Dowson central film on the elastic load at the kernel's entrainment speed (NaN
+  where a contact is open, or where race traction is off: the race kernels then compute no entrainment).
+
+The spatial model's contact angles and points are geometry of the samples
+(:func:`cageless.simulation.models.spatial_geometry.race_geometry`). The trace's ``balls``, ``contacts``
+and ``inner_ring`` groups.
 """
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 import numpy.typing as npt
 
+from cageless.simulation import kernels
 from cageless.simulation.hertz import compliance, hertz_contact, race_curvatures
 from cageless.simulation.models import base as B
 from cageless.simulation.models import spatial as S
-from cageless.simulation.models.planar_reference import tangential_force
+from cageless.simulation.models.spatial_geometry import race_geometry
 from cageless.simulation.problem import Problem
 from cageless.simulation.scene import Scene
 from cageless.simulation.traction import film_coefficient
 
-__all__ = ["observables", "films"]
+__all__ = ["observables", "kernel_observables", "film_coefficients"]
 
 
-def observables(pr: Problem, y: npt.NDArray[np.float64], scene: Scene,
-                 film_on: bool) -> dict[str, dict[str, np.ndarray]]:
-    """Contact forces (elastic normal part and traction), films, positions and spins along the samples."""
+def observables(pr: Problem, t: npt.NDArray[np.float64], y: npt.NDArray[np.float64], scene: Scene,
+                film_on: bool) -> dict[str, dict[str, np.ndarray]]:
+    """Contact forces (elastic normal part and traction), films, positions and spins along the samples
+    (``t``, ``y``); samples with a non-finite state give NaN."""
     p = pr.params
     z = int(p[B.P_Z])
-    d, half = p[B.P_D], 0.5 * p[B.P_D]
-    r, th, rd, thd, om = (y[:, i * z:(i + 1) * z] for i in range(5))
-    cy, cz, cvy, cvz = (y[:, 5 * z + i][:, None] for i in range(4))
-    w_i = p[B.P_WI]
-    outer = p[B.P_KO] * np.clip(r + half - 0.5 * p[B.P_DO], 0, None) ** 1.5
-    sx, sz = r * np.cos(th) - cy, r * np.sin(th) - cz
-    ln = np.hypot(sx, sz)
-    inner = p[B.P_KI] * np.clip(0.5 * p[B.P_DI] + half - ln, 0, None) ** 1.5
+    trac = p[B.P_F_TRAC] > 0.5
+    fields = kernel_observables(pr, t, y, film_coefficients(scene) if film_on and trac else None)
+    names = ["inner_normal", "outer_normal", "ball_ball_normal"] + (["inner_traction", "outer_traction"] if trac
+                                                                     else [])
+    names += ["inner_film", "outer_film"] if film_on else []
+    contacts = {name: fields[:, B.OBSERVABLES.index(name)] for name in names}
+    r, om = y[:, :z], y[:, 4 * z:5 * z]
     spatial = pr.model_id == S.MODEL_ID
-    axial, axial_dot = ((y[:, S.SpatialLayout(z).slices()[k]] for k in ("axial", "axial_dot")) if spatial
-                        else (np.zeros_like(r), np.zeros_like(r)))
-    bb = p[B.P_KB] * np.clip(d - _centre_gap(r, th, axial), 0, None) ** 1.5
-    u_o = r * thd + half * om
-    ur_o = 0.5 * np.abs(u_o - p[B.P_DO] * thd)
-    vt = (rd * np.sin(th) + r * thd * np.cos(th) - cvz) * sx / ln - (rd * np.cos(th) - r * thd * np.sin(th) - cvy) * sz / ln
-    r_i = 0.5 * p[B.P_DI]
-    u_i = vt - half * om - w_i * r_i
-    ur_i = 0.5 * np.abs(vt * (1 - 2 * r_i / ln) - half * om + w_i * r_i)
-    contacts = {"inner_normal": inner, "outer_normal": outer, "ball_ball_normal": bb}
-    if p[B.P_F_TRAC] > 0.5:
-        contacts["inner_traction"] = -tangential_force(u_i, ur_i, inner, p)
-        contacts["outer_traction"] = -tangential_force(u_o, ur_o, outer, p)
-    if film_on:
-        contacts.update(films(scene, inner, outer, ur_i, ur_o))
+    axial = y[:, S.SpatialLayout(z).slices()["axial"]] if spatial else np.zeros_like(r)
     spin = np.zeros((len(y), z, 3))
     spin[:, :, 0] = om
-    ring = np.column_stack([np.zeros(len(y)), cy[:, 0], cz[:, 0]])
+    ring = np.column_stack([np.zeros(len(y)), y[:, 5 * z], y[:, 5 * z + 1]])
     tilt = np.zeros((len(y), 2))
     if spatial:
         tilt = y[:, -4:-2] + pr.params[[S.P_TILT_Y, S.P_TILT_Z]]  # about y and z: misalignment plus the free tilt
         sl = S.SpatialLayout(z).slices()
         spin[:, :, 1], spin[:, :, 2] = y[:, sl["spin_y"]], y[:, sl["spin_z"]]
         ring[:, 0] = y[:, sl["ring_axial"]][:, 0]
-        for race, (overlap, angle, point) in S.race_geometry(pr, y).items():
-            k_n = p[B.P_KI] if race == "inner" else p[B.P_KO]
-            contacts[f"{race}_normal"] = k_n * overlap**1.5
+        for race, (_, angle, point) in race_geometry(pr, y).items():
             contacts[f"{race}_angle"] = angle
             contacts[f"{race}_point"] = point
-    if p[B.P_F_TRAC] > 0.5:
-        contacts["ball_ball_traction"] = _ball_ball_traction(p, r, th, rd, thd, axial, axial_dot, spin, bb)
+    if trac:
+        contacts["ball_ball_traction"] = fields[:, B.OBS_BB_TRACTION]
     return {
         "balls": {"radius": r, "axial": axial, "spin": spin},
         "contacts": contacts,
@@ -73,33 +72,38 @@ def observables(pr: Problem, y: npt.NDArray[np.float64], scene: Scene,
     }
 
 
-def _centre_gap(r: np.ndarray, th: np.ndarray, axial: np.ndarray) -> np.ndarray:
-    """Distance (m) between the centres of ball j and ball j+1 (T, Z)."""
-    pos = np.stack([axial, r * np.cos(th), r * np.sin(th)], axis=-1)
-    return np.linalg.norm(np.roll(pos, -1, axis=1) - pos, axis=-1)
+def kernel_observables(pr: Problem, t: npt.NDArray[np.float64], y: npt.NDArray[np.float64],
+                       film: tuple[float, float] | None = None) -> npt.NDArray[np.float64]:
+    """The fields of :data:`cageless.simulation.models.base.OBSERVABLES` along samples (t, y), as (T, fields, Z),
+    written by the model's compiled force functions. ``film`` holds the outer and inner race's film coefficients
+    (:func:`film_coefficients`); without it the film fields are NaN. Non-finite states give NaN rows."""
+    z = pr.n_balls
+    log = pr.log.copy()
+    log[:z] = 0.0  # onset speeds are not kept per sample (they enter no field written: the elastic force does)
+    out = np.zeros((len(t), B.N_OBS, z))
+    c_outer, c_inner = film if film is not None else (np.nan, np.nan)
+    _observe(pr.model_id, np.ascontiguousarray(t, dtype=np.float64), np.ascontiguousarray(y, dtype=np.float64),
+             pr.params, log, c_outer, c_inner, out)
+    out[~np.all(np.isfinite(y), axis=1)] = np.nan
+    return out
 
 
-def _ball_ball_traction(p: np.ndarray, r: np.ndarray, th: np.ndarray, rd: np.ndarray, thd: np.ndarray,
-                        axial: np.ndarray, axial_dot: np.ndarray, spin: np.ndarray, normal: np.ndarray) -> np.ndarray:
-    """Magnitude (N) of the friction between ball j and ball j+1 (T, Z), from the sliding of their surfaces
-    along the contact plane, as in the models' pair forces (elastic normal force; 0 where apart)."""
-    z = r.shape[1]
-    half = 0.5 * p[B.P_D]
-    pos = np.stack([axial, r * np.cos(th), r * np.sin(th)], axis=-1)
-    vel = np.stack([axial_dot, rd * np.cos(th) - r * thd * np.sin(th), rd * np.sin(th) + r * thd * np.cos(th)], -1)
-    k = np.roll(np.arange(z), -1)
-    n = pos[:, k] - pos
-    n /= np.linalg.norm(n, axis=-1, keepdims=True)
-    u = vel - vel[:, k] + np.cross(spin + spin[:, k], half * n)  # surface of j against j+1
-    u -= np.sum(u * n, axis=-1, keepdims=True) * n
-    u_s = np.linalg.norm(u, axis=-1)
-    u_r = 0.5 * half * np.linalg.norm(np.cross(spin - spin[:, k], n), axis=-1)
-    return np.abs(tangential_force(u_s, u_r, normal, p))
+@numba.njit(cache=True)
+def _observe(model_id, ts, ys, p, log, c_outer, c_inner, out):  # pragma: no cover - compiled
+    """Every sample's observables (:func:`cageless.simulation.kernels.model_observe`), then the race films
+    h = c_h max(u_r, 1 um/s)^0.67 Q^-0.067 from the same pass (NaN where the contact is open)."""
+    for i in range(ts.shape[0]):
+        kernels.model_observe(model_id, ts[i], ys[i], p, log, out[i])
+        for j in range(out.shape[2]):
+            for f_q, f_u, f_h, c_h in ((B.OBS_OUTER_NORMAL, B.OBS_OUTER_ENTRAIN, B.OBS_OUTER_FILM, c_outer),
+                                       (B.OBS_INNER_NORMAL, B.OBS_INNER_ENTRAIN, B.OBS_INNER_FILM, c_inner)):
+                q = out[i, f_q, j]
+                out[i, f_h, j] = c_h * max(out[i, f_u, j], 1e-6) ** 0.67 * q ** -0.067 if q > 0.0 else np.nan
 
 
-def films(scene: Scene, inner: np.ndarray, outer: np.ndarray, ur_i: np.ndarray,
-           ur_o: np.ndarray) -> dict[str, np.ndarray]:
-    """Hamrock-Dowson central film (m) at the race contacts (NaN where a contact is open)."""
+def film_coefficients(scene: Scene) -> tuple[float, float]:
+    """c_h of the outer and inner race contact in the Hamrock-Dowson central film h = c_h u^0.67 Q^-0.067
+    (:func:`cageless.simulation.traction.film_coefficient`; SI units)."""
     b = scene.bearing
     g, lub = b.geometry, b.lubricant
     assert lub is not None
@@ -107,10 +111,6 @@ def films(scene: Scene, inner: np.ndarray, outer: np.ndarray, ur_i: np.ndarray,
     rc = race_curvatures(g)
     d = g.ball_diameter_m
     rx = {"inner": 1.0 / (2.0 / d + 2.0 / g.inner_race_diameter_m), "outer": 1.0 / (2.0 / d - 2.0 / g.outer_race_diameter_m)}
-    out = {}
-    for race, q, u in (("inner", inner, ur_i), ("outer", outer, ur_o)):
-        c_h = film_coefficient(hertz_contact(*rc[race], eta), rx[race], lub.dynamic_viscosity_pa_s,
-                               lub.pressure_viscosity_coefficient_1_pa, 2.0 / eta)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            out[f"{race}_film"] = np.where(q > 0, c_h * np.maximum(u, 1e-6) ** 0.67 * q ** -0.067, np.nan)
-    return out
+    outer, inner = (film_coefficient(hertz_contact(*rc[race], eta), rx[race], lub.dynamic_viscosity_pa_s,
+                                     lub.pressure_viscosity_coefficient_1_pa, 2.0 / eta) for race in ("outer", "inner"))
+    return outer, inner

@@ -35,12 +35,10 @@ peak force and duration, classed as rubbing when it lasts more than
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numba
 import numpy as np
 import numpy.typing as npt
-import pandas as pd
 
 from cageless.bearing import Bearing
 from cageless.errors import ParameterError
@@ -50,15 +48,22 @@ from cageless.simulation import effects as effects_table
 from cageless.simulation.effects import check_lubricant, effect_flags
 from cageless.simulation.parameters import ModelParameters
 from cageless.simulation.problem import Problem
-from cageless.simulation.models.base import (LAYOUT, P_CD, P_CHI, P_CHO, P_D, P_DI, P_DO, P_DRY, P_ETA0, P_FR,
+from cageless.simulation.models.base import (LAYOUT, OBS_BB_NORMAL, OBS_BB_TRACTION, OBS_INNER_ENTRAIN, OBS_INNER_NORMAL,
+                                             OBS_INNER_TRACTION, OBS_OUTER_ENTRAIN, OBS_OUTER_NORMAL, OBS_OUTER_TRACTION,
+                                             P_CD, P_CHI, P_CHO, P_D, P_DI, P_DO, P_DRY, P_ETA0, P_FR,
                                     P_F_BB, P_F_BBFILM, P_F_DRAG, P_F_GRAV, P_F_LUB, P_F_RACE, P_F_ROLL, P_F_TRAC, P_G, P_H0,
                                     P_I, P_KB, P_KI, P_KO, P_M, P_MR, P_RAMP, P_RHO_MIX, P_V_IN_MIN, P_WI, P_Z)
+from cageless.simulation.models.energy import planar_energy
+from cageless.simulation.models.planar_layout import PlanarLayout
+from cageless.simulation.models.contact_log import (EVENT_FIELDS, ONSET_RESOLUTION, RUBBING_FACTOR, contact_events,
+                                                     empty_log, log_size, planar_post)
 from cageless.simulation.models.contact_laws import RACE_LAWS, ball_churning, ball_drag, race_extra, tangential
 from cageless.simulation.models.rolling import race_rolling, rolling_slots
 
 __all__ = [
     "PlanarLayout", "planar_problem", "planar_energy", "packed_start", "contact_events", "DEFAULT_CHO_N_S_M",
-    "RUBBING_FACTOR", "planar_ring_share", "planar_ring_rows", "planar_gaps",
+    "RUBBING_FACTOR", "planar_observe", "planar_ring_share", "planar_ring_rows", "planar_gaps", "planar_post", "log_size", "EVENT_FIELDS",
+    "ONSET_RESOLUTION",
 ]
 
 #: Id of this model in :mod:`cageless.simulation.kernels`.
@@ -68,37 +73,27 @@ MODEL_ID = 0
 DEFAULT_CHO_N_S_M = ModelParameters().cho_n_s_m
 
 
-@dataclass(frozen=True)
-class PlanarLayout:
-    """Where each quantity sits in the state vector of ``n_balls`` balls."""
-
-    n_balls: int
-
-    @property
-    def size(self) -> int:
-        """Number of states, 5 Z + 6."""
-        return 5 * self.n_balls + 6
-
-    def slices(self) -> dict[str, slice]:
-        """Named slices: r, theta, r_dot, theta_dot, spin, ring (y, z, y', z'), input work, dissipated energy."""
-        z = self.n_balls
-        return {"r": slice(0, z), "theta": slice(z, 2 * z), "r_dot": slice(2 * z, 3 * z),
-                "theta_dot": slice(3 * z, 4 * z), "spin": slice(4 * z, 5 * z), "ring": slice(5 * z, 5 * z + 4),
-                "input_work": slice(5 * z + 4, 5 * z + 5), "dissipated": slice(5 * z + 5, 5 * z + 6)}
-
-
 @numba.njit(cache=True, fastmath=FASTMATH)
-def _race_forces(y, p, j, z, w_i, c, s):  # pragma: no cover - compiled
-    """Race forces on ball j: (f_y, f_z, spin torque, ring f_y, ring f_z, input power, dissipated power)."""
+def _race_forces(y, p, j, z, w_i, c, s, obs):  # pragma: no cover - compiled
+    """Race forces on ball j: (f_y, f_z, spin torque, ring f_y, ring f_z, input power, dissipated power); with
+    ``obs`` (an array, None in the right-hand side) its race observables are written there too."""
+    fy, fz, torque, p_diss = _outer_race(y, p, j, z, c, s, obs)
+    return _inner_race(y, p, j, z, w_i, c, s, fy, fz, torque, p_diss, obs)
+
+
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
+def _outer_race(y, p, j, z, c, s, obs):  # pragma: no cover - compiled
+    """Ball j against the fixed outer race: (f_y, f_z, spin torque, dissipated power)."""
     d = p[P_D]
     half = 0.5 * d
     r, rd, thd, om = y[j], y[2 * z + j], y[3 * z + j], y[4 * z + j]
-    cy, cz, cvy, cvz = y[5 * z], y[5 * z + 1], y[5 * z + 2], y[5 * z + 3]
-    fy = fz = torque = ry = rz = p_in = p_diss = 0.0
+    fy = fz = torque = p_diss = 0.0
     trac = p[P_F_TRAC] > 0.5
     d_o = r + half - 0.5 * p[P_DO]
     if d_o > 0.0:
         q = p[P_KO] * d_o * np.sqrt(d_o)
+        if obs is not None:
+            obs[OBS_OUTER_NORMAL] = q
         if p[P_F_LUB] > 0.5:
             q_d = max(q + p[P_CHO] * rd, 0.0)  # d(delta_o)/dt = r'; never tensile
             p_diss += (q_d - q) * rd
@@ -112,6 +107,9 @@ def _race_forces(y, p, j, z, w_i, c, s):  # pragma: no cover - compiled
             u = r * thd + half * om  # ball surface against the fixed outer race, along e_theta
             u_r = 0.5 * abs(r * thd + half * om - p[P_DO] * thd)
             f_t = -tangential(u, u_r, q, p)
+            if obs is not None:  # the law on the elastic normal force
+                obs[OBS_OUTER_TRACTION] = -tangential(u, u_r, obs[OBS_OUTER_NORMAL], p)
+                obs[OBS_OUTER_ENTRAIN] = u_r
             p_diss -= f_t * u
             torque += half * f_t
         if p[P_F_ROLL] > 0.5:  # rolling losses (models/rolling.py): pressure on the centre, shear at the surface
@@ -121,6 +119,19 @@ def _race_forces(y, p, j, z, w_i, c, s):  # pragma: no cover - compiled
             f_t += f_p + f_s
         fy += -q * c - f_t * s
         fz += -q * s + f_t * c
+    return fy, fz, torque, p_diss
+
+
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
+def _inner_race(y, p, j, z, w_i, c, s, fy, fz, torque, p_diss, obs):  # pragma: no cover - compiled
+    """Ball j against the driven inner ring, added to the outer race's (f_y, f_z, spin torque, dissipated
+    power): the race forces of :func:`_race_forces`."""
+    d = p[P_D]
+    half = 0.5 * d
+    r, rd, thd, om = y[j], y[2 * z + j], y[3 * z + j], y[4 * z + j]
+    cy, cz, cvy, cvz = y[5 * z], y[5 * z + 1], y[5 * z + 2], y[5 * z + 3]
+    ry = rz = p_in = 0.0
+    trac = p[P_F_TRAC] > 0.5
     sx, sz = r * c - cy, r * s - cz
     ln = np.sqrt(sx * sx + sz * sz)
     d_i = 0.5 * p[P_DI] + half - ln
@@ -130,6 +141,8 @@ def _race_forces(y, p, j, z, w_i, c, s):  # pragma: no cover - compiled
         vx = rd * c - r * thd * s - cvy
         vz = rd * s + r * thd * c - cvz
         q = p[P_KI] * d_i * np.sqrt(d_i)
+        if obs is not None:
+            obs[OBS_INNER_NORMAL] = q
         if p[P_F_LUB] > 0.5:
             ddot = -(vx * nx + vz * nz)
             q_d = max(q + p[P_CHO] * ddot, 0.0)
@@ -147,6 +160,9 @@ def _race_forces(y, p, j, z, w_i, c, s):  # pragma: no cover - compiled
             u = vt - half * om - w_i * r_i  # ball surface against the ring surface, along t
             u_r = 0.5 * abs(vt * (1.0 - 2.0 * r_i / ln) - half * om + w_i * r_i)
             f_t = -tangential(u, u_r, q, p)
+            if obs is not None:  # the law on the elastic normal force
+                obs[OBS_INNER_TRACTION] = -tangential(u, u_r, obs[OBS_INNER_NORMAL], p)
+                obs[OBS_INNER_ENTRAIN] = u_r
             p_diss -= f_t * u
             p_in += w_i * r_i * f_t
             torque -= half * f_t
@@ -166,8 +182,9 @@ def _race_forces(y, p, j, z, w_i, c, s):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, fastmath=FASTMATH)
-def _pair_forces(y, p, log, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
-    """Forces between balls j and k: (f_y on k, f_z on k, spin torque on both, dissipated power)."""
+def _pair_forces(y, p, log, j, k, z, cj, sj, ck, sk, obs):  # pragma: no cover - compiled
+    """Forces between balls j and k: (f_y on k, f_z on k, spin torque on both, dissipated power); with ``obs``
+    (None in the right-hand side) the pair's observables are written there too."""
     d = p[P_D]
     rj, rk = y[j], y[k]
     dx = rk * ck - rj * cj
@@ -194,7 +211,10 @@ def _pair_forces(y, p, log, j, k, z, cj, sj, ck, sk):  # pragma: no cover - comp
     # (floored: see ModelParameters.min_approach_speed_m_s)
     v_in = max(log[j] if log[j] > 0.0 else delta_dot, p[P_V_IN_MIN])
     f = hertz_damped(delta, delta_dot, v_in, p[P_KB], p[P_CHI])
-    p_diss = (f - p[P_KB] * delta * np.sqrt(delta)) * delta_dot
+    elastic = p[P_KB] * delta * np.sqrt(delta)
+    p_diss = (f - elastic) * delta_dot
+    if obs is not None:
+        obs[OBS_BB_NORMAL] = elastic
     f_t = torque = 0.0
     if p[P_F_TRAC] > 0.5:
         tx, tz = -nz, nx
@@ -202,6 +222,8 @@ def _pair_forces(y, p, log, j, k, z, cj, sj, ck, sk):  # pragma: no cover - comp
         u = (vjx - vkx) * tx + (vjz - vkz) * tz + 0.5 * d * (om_j + om_k)  # surface of j against k, along t
         u_r = 0.25 * d * abs(om_j - om_k)
         f_t = -tangential(u, u_r, f, p)  # on j, along t
+        if obs is not None:  # the law on the elastic normal force
+            obs[OBS_BB_TRACTION] = abs(tangential(u, u_r, elastic, p))
         p_diss -= f_t * u
         torque = 0.5 * d * f_t
         return f * nx - f_t * tx, f * nz - f_t * tz, torque, p_diss
@@ -211,13 +233,33 @@ def _pair_forces(y, p, log, j, k, z, cj, sj, ck, sk):  # pragma: no cover - comp
 @numba.njit(cache=True, fastmath=FASTMATH)
 def planar_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
     z = int(p[P_Z])
-    d, m, inertia, m_ring, g = p[P_D], p[P_M], p[P_I], p[P_MR], p[P_G]
+    m_ring, g = p[P_MR], p[P_G]
     grav_on = p[P_F_GRAV] > 0.5
     ramp = p[P_RAMP]
     w_i = p[P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
     power_in, power = 0.0, 0.0
     fy_ring, fz_ring = 0.0, -p[P_FR] - (m_ring * g if grav_on else 0.0)
     trig = log.shape[0] - 2 * z  # scratch: cos and sin of every ball's angle, computed once per call
+    _start(y, p, log, dydt, z, trig, grav_on)
+    if p[P_F_RACE] > 0.5:
+        fy_ring, fz_ring, power_in, power = _add_race(y, p, log, dydt, z, trig, w_i, fy_ring, fz_ring, power_in,
+                                                      power)
+    if p[P_F_BB] > 0.5:
+        power = _add_pairs(y, p, log, dydt, z, trig, power)
+    power = _ball_accelerations(y, p, log, dydt, z, trig, power)
+    dydt[5 * z] = y[5 * z + 2]
+    dydt[5 * z + 1] = y[5 * z + 3]
+    dydt[5 * z + 2] = fy_ring / m_ring
+    dydt[5 * z + 3] = fz_ring / m_ring
+    dydt[5 * z + 4] = power_in
+    dydt[5 * z + 5] = power
+
+
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
+def _start(y, p, log, dydt, z, trig, grav_on):  # pragma: no cover - compiled
+    """The trig scratch, the position rates, and the force and torque accumulators (held in the acceleration
+    and spin slots of ``dydt``) with the balls' weight."""
+    m, g = p[P_M], p[P_G]
     for j in range(z):
         log[trig + j] = np.cos(y[z + j])
         log[trig + z + j] = np.sin(y[z + j])
@@ -226,28 +268,45 @@ def planar_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
         dydt[2 * z + j] = 0.0  # force accumulators (Cartesian y, z) held in the acceleration slots for now
         dydt[3 * z + j] = -m * g if grav_on else 0.0
         dydt[4 * z + j] = 0.0  # torque accumulator
-    if p[P_F_RACE] > 0.5:
-        for j in range(z):
-            fy, fz, torque, ry, rz, p_in, p_diss = _race_forces(y, p, j, z, w_i, log[trig + j], log[trig + z + j])
-            dydt[2 * z + j] += fy
-            dydt[3 * z + j] += fz
-            dydt[4 * z + j] += torque
-            fy_ring += ry
-            fz_ring += rz
-            power_in += p_in
-            power += p_diss
-    if p[P_F_BB] > 0.5:
-        for j in range(z):
-            k = j + 1 if j + 1 < z else 0
-            fy, fz, torque, p_diss = _pair_forces(y, p, log, j, k, z, log[trig + j], log[trig + z + j], log[trig + k],
-                                                 log[trig + z + k])
-            dydt[2 * z + j] -= fy
-            dydt[3 * z + j] -= fz
-            dydt[2 * z + k] += fy
-            dydt[3 * z + k] += fz
-            dydt[4 * z + j] += torque
-            dydt[4 * z + k] += torque
-            power += p_diss
+
+
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
+def _add_race(y, p, log, dydt, z, trig, w_i, fy_ring, fz_ring, power_in, power):  # pragma: no cover - compiled
+    """Every ball's race forces into the accumulators; the ring's force and the powers, updated."""
+    for j in range(z):
+        fy, fz, torque, ry, rz, p_in, p_diss = _race_forces(y, p, j, z, w_i, log[trig + j], log[trig + z + j], None)
+        dydt[2 * z + j] += fy
+        dydt[3 * z + j] += fz
+        dydt[4 * z + j] += torque
+        fy_ring += ry
+        fz_ring += rz
+        power_in += p_in
+        power += p_diss
+    return fy_ring, fz_ring, power_in, power
+
+
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
+def _add_pairs(y, p, log, dydt, z, trig, power):  # pragma: no cover - compiled
+    """Every neighbour pair's forces into the accumulators; the dissipated power, updated."""
+    for j in range(z):
+        k = j + 1 if j + 1 < z else 0
+        fy, fz, torque, p_diss = _pair_forces(y, p, log, j, k, z, log[trig + j], log[trig + z + j], log[trig + k],
+                                             log[trig + z + k], None)
+        dydt[2 * z + j] -= fy
+        dydt[3 * z + j] -= fz
+        dydt[2 * z + k] += fy
+        dydt[3 * z + k] += fz
+        dydt[4 * z + j] += torque
+        dydt[4 * z + k] += torque
+        power += p_diss
+    return power
+
+
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
+def _ball_accelerations(y, p, log, dydt, z, trig, power):  # pragma: no cover - compiled
+    """The accumulated forces and torques (with the drag) to the balls' polar accelerations and spin rates;
+    the dissipated power, updated."""
+    m, inertia = p[P_M], p[P_I]
     drag = p[P_F_DRAG] > 0.5
     for j in range(z):
         r = y[j]
@@ -264,13 +323,7 @@ def planar_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
         dydt[2 * z + j] = f_rad / m + r * thd * thd
         dydt[3 * z + j] = (f_tan / m - 2.0 * rd * thd) / r
         dydt[4 * z + j] /= inertia
-    dydt[5 * z] = y[5 * z + 2]
-    dydt[5 * z + 1] = y[5 * z + 3]
-    dydt[5 * z + 2] = fy_ring / m_ring
-    dydt[5 * z + 3] = fz_ring / m_ring
-    dydt[5 * z + 4] = power_in
-    dydt[5 * z + 5] = power
-
+    return power
 
 
 @numba.njit(cache=True)
@@ -287,12 +340,12 @@ def planar_ring_share(t, y, p, log, j, out):  # pragma: no cover - compiled
     if p[P_F_RACE] > 0.5:
         ramp = p[P_RAMP]
         w_i = p[P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
-        _, _, _, ry, rz, p_in, p_diss = _race_forces(y, p, j, z, w_i, c, s)
+        _, _, _, ry, rz, p_in, p_diss = _race_forces(y, p, j, z, w_i, c, s, None)
         out[0], out[1], out[2], out[3] = ry / p[P_MR], rz / p[P_MR], p_in, p_diss
     if p[P_F_BB] > 0.5:
         for a, b in ((j - 1 if j > 0 else z - 1, j), (j, j + 1 if j + 1 < z else 0)):
             ca, sa, cb, sb = np.cos(y[z + a]), np.sin(y[z + a]), np.cos(y[z + b]), np.sin(y[z + b])
-            out[3] += _pair_forces(y, p, log, a, b, z, ca, sa, cb, sb)[3]
+            out[3] += _pair_forces(y, p, log, a, b, z, ca, sa, cb, sb, None)[3]
     if p[P_F_DRAG] > 0.5:
         v, om = y[j] * y[3 * z + j], y[4 * z + j]
         out[3] -= ball_drag(v, p) * v + ball_churning(om, p) * om
@@ -302,6 +355,23 @@ def planar_ring_rows(n_balls: int) -> list[int]:
     """State indices of the rows :func:`planar_ring_share` fills: the ring's y'' and z'', the input work
     and the dissipated energy."""
     return [5 * n_balls + 2, 5 * n_balls + 3, 5 * n_balls + 4, 5 * n_balls + 5]
+
+
+@numba.njit(cache=True)
+def planar_observe(t, y, p, log, out):  # pragma: no cover - compiled
+    """The observables of state ``y`` at time t from the right-hand side's own force functions: per ball j,
+    ``out[:, j]`` gets the fields of :data:`cageless.simulation.models.base.OBSERVABLES` (films excluded)."""
+    z = int(p[P_Z])
+    out[:, :] = 0.0
+    ramp = p[P_RAMP]
+    w_i = p[P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
+    for j in range(z):
+        k = j + 1 if j + 1 < z else 0
+        c, s = np.cos(y[z + j]), np.sin(y[z + j])
+        if p[P_F_RACE] > 0.5:
+            _race_forces(y, p, j, z, w_i, c, s, out[:, j])
+        if p[P_F_BB] > 0.5:
+            _pair_forces(y, p, log, j, k, z, c, s, np.cos(y[z + k]), np.sin(y[z + k]), out[:, j])
 
 
 @numba.njit(cache=True, inline="always")
@@ -345,78 +415,6 @@ def planar_gaps(y, p, out):  # pragma: no cover - compiled
     for j in range(z):
         out[j], out[z + j], pair = _overlaps(y, p, j, z)
         out[2 * z + j] = d - np.sqrt(d * d - pair)  # in metres, as the race overlaps, so they extrapolate alike
-
-
-# The contact log (a float array, ``Problem.log``): per pair j (between ball j and j+1):
-#   log[j]           approach speed recorded at contact onset (used by the damping term)
-#   log[Z + 4j + 0]  onset time (NaN when apart)
-#   log[Z + 4j + 1]  peak force so far
-#   log[Z + 4j + 2]  orbital angle of the pair's midpoint at the peak
-#   log[Z + 4j + 3]  approach speed at onset (kept for classification)
-# then the event count and EVENT_FIELDS values per logged episode.
-EVENT_FIELDS = 6  # time, pair, angle, peak_force, duration, kind (0 impact, 1 rubbing)
-#: An episode longer than this many Hertz impact durations (at its approach speed) is rubbing.
-RUBBING_FACTOR = 3.0
-#: Contact onsets are resolved to this fraction of the Hertz impact duration at 1 m/s approach.
-ONSET_RESOLUTION = 20.0
-
-
-def log_size(n_balls: int, capacity: int) -> int:
-    """Length of the contact log for ``capacity`` logged contact episodes."""
-    return 5 * n_balls + 1 + EVENT_FIELDS * capacity + 2 * n_balls  # last 2 Z: the RHS's trig scratch
-
-
-@numba.njit(cache=True)
-def planar_post(t, y, p, log):  # pragma: no cover - compiled
-    z = int(p[P_Z])
-    if p[P_F_BB] < 0.5:
-        return
-    d, k_b, m = p[P_D], p[P_KB], p[P_M]
-    base = 5 * z + 1
-    cap = (log.shape[0] - base - 2 * z) // EVENT_FIELDS
-    spatial = y.shape[0] > 5 * z + 6
-    for j in range(z):
-        k = j + 1 if j + 1 < z else 0
-        rj, tj, rk, tk = y[j], y[z + j], y[k], y[z + k]
-        dx = rk * np.cos(tk) - rj * np.cos(tj)
-        dz = rk * np.sin(tk) - rj * np.sin(tj)
-        da = dva = 0.0
-        if spatial:  # the spatial model appends axial positions and rates (simulation.models.spatial)
-            da, dva = y[5 * z + 6 + k] - y[5 * z + 6 + j], y[6 * z + 6 + k] - y[6 * z + 6 + j]
-        ln = np.sqrt(dx * dx + dz * dz + da * da)
-        delta = d - ln
-        slot = z + 4 * j
-        if delta > 0.0 and log[j] <= 0.0:
-            vx = y[2 * z + k] * np.cos(tk) - rk * y[3 * z + k] * np.sin(tk) - (
-                y[2 * z + j] * np.cos(tj) - rj * y[3 * z + j] * np.sin(tj))
-            vz = y[2 * z + k] * np.sin(tk) + rk * y[3 * z + k] * np.cos(tk) - (
-                y[2 * z + j] * np.sin(tj) + rj * y[3 * z + j] * np.cos(tj))
-            log[j] = max(-(vx * dx + vz * dz + dva * da) / ln, 1e-9)
-        elif delta <= 0.0:
-            log[j] = 0.0
-        if delta > 0.0:
-            f = k_b * delta**1.5
-            if np.isnan(log[slot]):
-                log[slot] = t
-                log[slot + 1] = 0.0
-                log[slot + 3] = log[j]
-            if f > log[slot + 1]:
-                log[slot + 1] = f
-                log[slot + 2] = 0.5 * (tj + tk + (2.0 * np.pi if k == 0 else 0.0))
-        elif not np.isnan(log[slot]):
-            n = int(log[base - 1])
-            if n < cap:
-                e = base + EVENT_FIELDS * n
-                duration = t - log[slot]
-                t_hertz = hertz_impact_duration(log[slot + 3], 0.5 * m, k_b)
-                log[e] = log[slot]
-                log[e + 1] = j
-                log[e + 2] = log[slot + 2] % (2.0 * np.pi)
-                log[e + 3] = log[slot + 1]
-                log[e + 4] = duration
-                log[e + 5] = 1.0 if duration > RUBBING_FACTOR * t_hertz else 0.0
-            log[base - 1] = n + 1
-            log[slot] = np.nan
 
 
 def _contact_params(bearing: Bearing) -> dict[str, float]:
@@ -531,11 +529,7 @@ def planar_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLi
     atol *= atol_scale
     p = _params(bearing, radial_load_n, gravity_m_s2, inner_speed_rad_s, effects or {}, par, speed_ramp_s,
                 oil_air_density_kg_m3)
-    log = np.zeros(log_size(g.n_balls, event_capacity))
-    log[g.n_balls:5 * g.n_balls] = np.nan  # no contact episode open
-    log[g.n_balls + 1:5 * g.n_balls:4] = 0.0
-    log[g.n_balls + 2:5 * g.n_balls:4] = 0.0
-    log[g.n_balls + 3:5 * g.n_balls:4] = 0.0
+    log = empty_log(g.n_balls, event_capacity)
     # An impact at 1 m/s approach lasts t_H; contact onsets are resolved to t_H / ONSET_RESOLUTION.
     onset = hertz_impact_duration(1.0, 0.5 * p[P_M], p[P_KB]) / ONSET_RESOLUTION
     on = frozenset(name for name, value in (effects or {}).items() if value)
@@ -555,63 +549,6 @@ def planar_jump_floor(p: npt.NDArray[np.float64], lay: PlanarLayout) -> npt.NDAr
     floor[sl["spin"]] = 0.5 * p[P_D] / p[P_I]
     floor[5 * z + 2:5 * z + 4] = 1.0 / p[P_MR]
     return floor
-
-
-def contact_events(problem: Problem, log: npt.NDArray[np.float64], t_end: float) -> pd.DataFrame:
-    """The ball-ball contact episodes as the trace's event table (``EVENT_COLUMNS``).
-
-    Episodes still open at ``t_end`` are closed there (their duration is a lower bound). If more
-    episodes happened than the capacity, the table holds the first ones and ``attrs["dropped"]``
-    counts the rest.
-    """
-    p = problem.params
-    z = int(p[P_Z])
-    base = 5 * z + 1
-    n = int(log[base - 1])
-    cap = (log.shape[0] - base - 2 * z) // EVENT_FIELDS
-    rows = log[base:base + EVENT_FIELDS * min(n, cap)].reshape(-1, EVENT_FIELDS)
-    still_open = []
-    for j in range(z):
-        slot = z + 4 * j
-        if not np.isnan(log[slot]):
-            t_hertz = hertz_impact_duration(log[slot + 3], 0.5 * p[P_M], p[P_KB])
-            duration = t_end - log[slot]
-            still_open.append([log[slot], j, log[slot + 2] % (2 * np.pi), log[slot + 1], duration,
-                               float(duration > RUBBING_FACTOR * t_hertz)])
-    if still_open:
-        rows = np.vstack([rows, np.array(still_open)])
-    table = pd.DataFrame({
-        "time": rows[:, 0], "pair": rows[:, 1].astype(np.int64), "angle": rows[:, 2], "peak_force": rows[:, 3],
-        "duration": rows[:, 4], "kind": np.where(rows[:, 5] > 0.5, "rubbing", "impact").astype(object),
-    })
-    table.attrs["dropped"] = max(0, n - cap)
-    return table
-
-
-def planar_energy(problem: Problem, y: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
-    """Total mechanical energy (J) along samples y (T, n): kinetic + Hertz + gravity + load potential.
-
-    Conserved when every active force is conservative; with damping on, this plus the dissipated
-    energy (the last state) is conserved.
-    """
-    p = problem.params
-    z = int(p[P_Z])
-    d, m, m_ring, g, f_r = p[P_D], p[P_M], p[P_MR], p[P_G], p[P_FR]
-    r, th, rd, thd = y[:, :z], y[:, z:2 * z], y[:, 2 * z:3 * z], y[:, 3 * z:4 * z]
-    cy, cz, cvy, cvz = (y[:, 5 * z + i] for i in range(4))
-    ke = 0.5 * m * np.sum(rd**2 + (r * thd) ** 2, axis=1) + 0.5 * m_ring * (cvy**2 + cvz**2)
-    ke += 0.5 * p[P_I] * np.sum(y[:, 4 * z:5 * z] ** 2, axis=1)
-    pe = m * g * np.sum(r * np.sin(th), axis=1) * (p[P_F_GRAV] > 0.5) + (m_ring * g * (p[P_F_GRAV] > 0.5) + f_r) * cz
-    if p[P_F_RACE] > 0.5:
-        d_o = np.clip(r + 0.5 * d - 0.5 * p[P_DO], 0, None)
-        ln = np.hypot(r * np.cos(th) - cy[:, None], r * np.sin(th) - cz[:, None])
-        d_i = np.clip(0.5 * p[P_DI] + 0.5 * d - ln, 0, None)
-        pe += 0.4 * (p[P_KO] * np.sum(d_o**2.5, axis=1) + p[P_KI] * np.sum(d_i**2.5, axis=1))
-    if p[P_F_BB] > 0.5:
-        x, zz = r * np.cos(th), r * np.sin(th)
-        gap = np.hypot(np.roll(x, -1, axis=1) - x, np.roll(zz, -1, axis=1) - zz)
-        pe += 0.4 * p[P_KB] * np.sum(np.clip(d - gap, 0, None) ** 2.5, axis=1)
-    return ke + pe
 
 
 def packed_start(bearing: Bearing, seed: int = 0, spread: float = 0.05) -> npt.NDArray[np.float64]:

@@ -30,59 +30,17 @@ def reference_rhs(t: float, y: npt.NDArray[np.float64], p: npt.NDArray[np.float6
                   log: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     """dy/dt of the planar model (numpy). ``log`` holds the ball-ball approach speeds recorded at onset."""
     z = int(p[B.P_Z])
-    d, m, m_ring = p[B.P_D], p[B.P_M], p[B.P_MR]
-    half = 0.5 * d
+    m, m_ring = p[B.P_M], p[B.P_MR]
     g = p[B.P_G] if p[B.P_F_GRAV] > 0.5 else 0.0
     w_i = p[B.P_WI] * (min(t / p[B.P_RAMP], 1.0) if p[B.P_RAMP] > 0 else 1.0)
-    trac = p[B.P_F_TRAC] > 0.5
-    r, th, rd, thd, om = y[:z], y[z:2 * z], y[2 * z:3 * z], y[3 * z:4 * z], y[4 * z:5 * z]
-    cy, cz, cvy, cvz = y[5 * z:5 * z + 4]
+    r, th, rd, thd = y[:z], y[z:2 * z], y[2 * z:3 * z], y[3 * z:4 * z]
+    cvy, cvz = y[5 * z + 2:5 * z + 4]
     c, s = np.cos(th), np.sin(th)
     fy = np.zeros(z)
     fz = np.full(z, -m * g)
     torque = np.zeros(z)
     ring = np.array([0.0, -p[B.P_FR] - m_ring * g])
-    power, power_in = 0.0, 0.0
-    lub, c_ho = p[B.P_F_LUB] > 0.5, p[B.P_CHO]
-    if p[B.P_F_RACE] > 0.5:
-        d_o = r + half - 0.5 * p[B.P_DO]
-        q = np.where(d_o > 0, p[B.P_KO] * np.clip(d_o, 0, None) ** 1.5, 0.0)
-        if lub:
-            qd = np.where(d_o > 0, np.maximum(q + c_ho * rd, 0.0), 0.0)
-            power += np.sum((qd - q) * rd)
-            q = qd
-        f_t = np.zeros(z)
-        if trac:
-            u = r * thd + half * om
-            f_t = -tangential_force(u, 0.5 * np.abs(u - p[B.P_DO] * thd), q, p)
-            power -= np.sum(f_t * u)
-            torque += half * f_t
-        fy += -q * c - f_t * s
-        fz += -q * s + f_t * c
-        sx, sz = r * c - cy, r * s - cz
-        ln = np.hypot(sx, sz)
-        d_i = 0.5 * p[B.P_DI] + half - ln
-        nx, nz = sx / ln, sz / ln
-        vx, vz = rd * c - r * thd * s - cvy, rd * s + r * thd * c - cvz
-        q = np.where(d_i > 0, p[B.P_KI] * np.clip(d_i, 0, None) ** 1.5, 0.0)
-        if lub:
-            ddot = -(vx * nx + vz * nz)
-            qd = np.where(d_i > 0, np.maximum(q + c_ho * ddot, 0.0), 0.0)
-            power += np.sum((qd - q) * ddot)
-            q = qd
-        f_t = np.zeros(z)
-        if trac:
-            r_i = 0.5 * p[B.P_DI]
-            vt = -vx * nz + vz * nx
-            u = vt - half * om - w_i * r_i
-            f_t = -tangential_force(u, 0.5 * np.abs(vt * (1 - 2 * r_i / ln) - half * om + w_i * r_i), q, p)
-            power -= np.sum(f_t * u)
-            power_in += np.sum(w_i * r_i * f_t)
-            torque -= half * f_t
-        gy, gz = q * nx - f_t * nz, q * nz + f_t * nx
-        fy += gy
-        fz += gz
-        ring -= [np.sum(gy), np.sum(gz)]
+    power, power_in = _races(y, p, w_i, c, s, fy, fz, torque, ring) if p[B.P_F_RACE] > 0.5 else (0.0, 0.0)
     if p[B.P_F_BB] > 0.5:
         power += _pairs(y, p, log, fy, fz, torque)
     f_rad, f_tan = fy * c + fz * s, -fy * s + fz * c
@@ -102,6 +60,58 @@ def reference_rhs(t: float, y: npt.NDArray[np.float64], p: npt.NDArray[np.float6
     out[5 * z + 4] = power_in
     out[5 * z + 5] = power
     return out
+
+
+def _races(y: np.ndarray, p: np.ndarray, w_i: float, c: np.ndarray, s: np.ndarray, fy: np.ndarray, fz: np.ndarray,
+           torque: np.ndarray, ring: np.ndarray) -> tuple[float, float]:
+    """The race contacts' forces into fy, fz, torque and ring (in place); returns the dissipated and the input
+    power."""
+    z = int(p[B.P_Z])
+    half = 0.5 * p[B.P_D]
+    trac = p[B.P_F_TRAC] > 0.5
+    r, rd, thd, om = y[:z], y[2 * z:3 * z], y[3 * z:4 * z], y[4 * z:5 * z]
+    cy, cz, cvy, cvz = y[5 * z:5 * z + 4]
+    power, power_in = 0.0, 0.0
+    lub, c_ho = p[B.P_F_LUB] > 0.5, p[B.P_CHO]
+    d_o = r + half - 0.5 * p[B.P_DO]
+    q = np.where(d_o > 0, p[B.P_KO] * np.clip(d_o, 0, None) ** 1.5, 0.0)
+    if lub:
+        qd = np.where(d_o > 0, np.maximum(q + c_ho * rd, 0.0), 0.0)
+        power += np.sum((qd - q) * rd)
+        q = qd
+    f_t = np.zeros(z)
+    if trac:
+        u = r * thd + half * om
+        f_t = -tangential_force(u, 0.5 * np.abs(u - p[B.P_DO] * thd), q, p)
+        power -= np.sum(f_t * u)
+        torque += half * f_t
+    fy += -q * c - f_t * s
+    fz += -q * s + f_t * c
+    sx, sz = r * c - cy, r * s - cz
+    ln = np.hypot(sx, sz)
+    d_i = 0.5 * p[B.P_DI] + half - ln
+    nx, nz = sx / ln, sz / ln
+    vx, vz = rd * c - r * thd * s - cvy, rd * s + r * thd * c - cvz
+    q = np.where(d_i > 0, p[B.P_KI] * np.clip(d_i, 0, None) ** 1.5, 0.0)
+    if lub:
+        ddot = -(vx * nx + vz * nz)
+        qd = np.where(d_i > 0, np.maximum(q + c_ho * ddot, 0.0), 0.0)
+        power += np.sum((qd - q) * ddot)
+        q = qd
+    f_t = np.zeros(z)
+    if trac:
+        r_i = 0.5 * p[B.P_DI]
+        vt = -vx * nz + vz * nx
+        u = vt - half * om - w_i * r_i
+        f_t = -tangential_force(u, 0.5 * np.abs(vt * (1 - 2 * r_i / ln) - half * om + w_i * r_i), q, p)
+        power -= np.sum(f_t * u)
+        power_in += np.sum(w_i * r_i * f_t)
+        torque -= half * f_t
+    gy, gz = q * nx - f_t * nz, q * nz + f_t * nx
+    fy += gy
+    fz += gz
+    ring -= [np.sum(gy), np.sum(gz)]
+    return power, power_in
 
 
 def _drag(v: np.ndarray, om: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

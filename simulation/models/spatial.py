@@ -47,96 +47,77 @@ from cageless.simulation.models import base as B
 from cageless.simulation.models import planar as P
 from cageless.simulation.models.contact_laws import RACE_LAWS, ball_churning, ball_drag, race_extra, tangential
 from cageless.simulation.models.rolling import spatial_rolling
+from cageless.simulation.models.spatial_layout import (LAYOUT, N_PARAMS, P_AI, P_AO, P_FA, P_GAX, P_IR, P_MY, P_RGI,
+                                                        P_RGO, P_STRIPS, P_TILT_Y, P_TILT_Z, SpatialLayout, _cross,
+                                                        _groove, _tilt, spatial_gaps, spatial_signature)
 from cageless.simulation.problem import Problem
 
-__all__ = ["MODEL_ID", "SpatialLayout", "spatial_problem", "spatial_rhs", "spatial_signature", "race_geometry",
-           "spatial_energy", "spatial_ring_share", "spatial_ring_rows", "spatial_gaps"]
+__all__ = ["MODEL_ID", "LAYOUT", "N_PARAMS", "SpatialLayout", "spatial_problem", "spatial_rhs", "spatial_signature",
+           "spatial_observe", "spatial_ring_share", "spatial_ring_rows", "spatial_gaps", "ring_tilt_inertia"]
 
 MODEL_ID = 4
-#: The planar slots, then the groove curvature radii, the axial load, the prescribed misalignment (about y and
-#: z), the strip count, the contact-ellipse coefficients a / Q^(1/3), the ring's tilt inertia, the moment load
-#: and gravity along the shaft.
-LAYOUT = B.LAYOUT.extend(("RGI", "RGO", "FA", "TILT_Y", "TILT_Z", "STRIPS", "AI", "AO", "IR", "MY", "GAX"))
-P_RGI, P_RGO, P_FA, P_TILT_Y, P_TILT_Z, P_STRIPS, P_AI, P_AO, P_IR, P_MY, P_GAX = LAYOUT.slots(
-    "RGI", "RGO", "FA", "TILT_Y", "TILT_Z", "STRIPS", "AI", "AO", "IR", "MY", "GAX")
-N_PARAMS = len(LAYOUT)
-
-
-class SpatialLayout(P.PlanarLayout):
-    """State layout: the planar one, then x, x', omega_y, omega_z per ball, the ring's (x, x') and its tilt
-    (beta_y, beta_z, beta_y', beta_z') about the prescribed misalignment."""
-
-    @property
-    def size(self) -> int:
-        """Number of states, 9 Z + 12."""
-        return 9 * self.n_balls + 12
-
-    def slices(self) -> dict[str, slice]:
-        """The planar slices plus axial, axial_dot, spin_y, spin_z, ring_axial and ring_tilt."""
-        z = self.n_balls
-        s = super().slices()
-        b = 5 * z + 6
-        s.update({"axial": slice(b, b + z), "axial_dot": slice(b + z, b + 2 * z), "spin_y": slice(b + 2 * z, b + 3 * z),
-                  "spin_z": slice(b + 3 * z, b + 4 * z), "ring_axial": slice(b + 4 * z, b + 4 * z + 2),
-                  "ring_tilt": slice(b + 4 * z + 2, b + 4 * z + 6)})
-        return s
-
-
-@numba.njit(cache=True, inline="always")
-def _cross(a0, a1, a2, b0, b1, b2):  # pragma: no cover - compiled
-    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
-
-
-@numba.njit(cache=True)
-def _tilt(y, p):  # pragma: no cover - compiled
-    """Rotation R = Rz(bz) Ry(by) of the inner ring, as 9 numbers (row-major): the prescribed misalignment
-    plus the ring's tilt states."""
-    t = y.shape[0] - 4
-    by, bz = p[P_TILT_Y] + y[t], p[P_TILT_Z] + y[t + 1]
-    cb, sb, cg, sg = math.cos(by), math.sin(by), math.cos(bz), math.sin(bz)
-    return (cg * cb, -sg, cg * sb, sg * cb, cg, sg * sb, -sb, 0.0, cb)
-
-
-@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
-def _groove(y, p, j, z, inner, rot, c, s):  # pragma: no cover - compiled
-    """Ball j against one race's groove: its centre in the ring frame (radius rq, direction cq, sq), the offset
-    (ex, er) from the groove's curvature centre, its length ln, the overlap, and the groove's rho and r_g."""
-    b = 5 * z + 6
-    r = y[j]
-    px, py, pz = y[b + j], r * c, r * s
-    if inner:
-        cx, cy, cz = y[b + 4 * z], y[5 * z], y[5 * z + 1]
-        rho, rg = 0.5 * p[B.P_DI] + p[P_RGI], p[P_RGI]
-        dx, dy, dz = px - cx, py - cy, pz - cz
-        # ball centre in the ring frame (R^T (P - C))
-        qx = rot[0] * dx + rot[3] * dy + rot[6] * dz
-        qy = rot[1] * dx + rot[4] * dy + rot[7] * dz
-        qz = rot[2] * dx + rot[5] * dy + rot[8] * dz
-    else:
-        rho, rg = 0.5 * p[B.P_DO] - p[P_RGO], p[P_RGO]
-        qx, qy, qz = px, py, pz
-    rq = math.sqrt(qy * qy + qz * qz)
-    ex, er = qx, rq - rho  # from the groove centre to the ball centre, in the (x, radial) plane of the ring
-    ln = math.sqrt(ex * ex + er * er)
-    return rq, qy / rq, qz / rq, ex, er, ln, ln - (rg - 0.5 * p[B.P_D]), rho, rg
 
 
 @numba.njit(cache=True, fastmath=FASTMATH)
-def _race(y, p, j, z, inner, w_i, rot, c, s, wt):  # pragma: no cover - compiled
-    """One race contact of ball j: force (3), torque (3) on the ball, input and dissipated power, overlap, and
-    the moment (3) on the inner ring about its centre. ``wt`` is the ring's tilting angular velocity (3)."""
-    d = p[B.P_D]
-    half = 0.5 * d
-    b = 5 * z + 6
+def _race(y, p, j, z, inner, w_i, rot, c, s, wt, obs):  # pragma: no cover - compiled
+    """One race contact of ball j, as ((force on the ball), (torque on the ball), input power, dissipated power,
+    overlap, (moment on the inner ring about its centre)), each bracket 3 components in the fixed frame.
+    ``wt`` is the ring's tilting angular velocity (3). With ``obs`` (an array, None in the right-hand side) the
+    contact's observables are written there too (:func:`spatial_observe`)."""
+    half = 0.5 * p[B.P_D]
     if not inner:
         rot = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
     rq, cq, sq, ex, er, ln, delta, rho, rg = _groove(y, p, j, z, inner, rot, c, s)
-    zero = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    zero = (0.0, 0.0, 0.0)
     if delta <= 0.0:
-        return zero
+        return zero, zero, 0.0, 0.0, 0.0, zero
+    b = 5 * z + 6
+    ox, oy, oz = y[4 * z + j], y[b + 2 * z + j], y[b + 3 * z + j]
+    n, t, xr, rv, r_c, k_n, a_c = _race_frame(y, p, j, z, inner, rot, c, s, wt, rq, cq, sq, ex, er, ln, rho, rg)
+    nx, ny, nz = n
+    xrx, xry, xrz = xr
+    q = k_n * delta * math.sqrt(delta)
+    side = 1 if inner else 0
+    if obs is not None:
+        obs[B.OBS_OUTER_NORMAL + side] = q
+    q, p_diss = _race_normal(p, q, delta, rv, n)
+    fx, fy, fz = -q * nx, -q * ny, -q * nz
+    mx = my = mz = 0.0
+    t2x = t2y = t2z = 0.0
+    p_in = 0.0
+    if p[B.P_F_TRAC] > 0.5 and q > 0.0:
+        (gsx, gsy, gsz), (t2x, t2y, t2z), (mx, my, mz), p_in, p_diss, _ = _race_traction(
+            p, inner, q, w_i, rot, wt, (ox, oy, oz), n, t, xr, rv, a_c, r_c, rq, half, p_diss)
+        fx, fy, fz = fx + gsx, fy + gsy, fz + gsz
+    if obs is not None and p[B.P_F_TRAC] > 0.5:  # the law on the elastic normal force, along t as the planar one's
+        g_el, _, _, _, _, u_r = _race_traction(p, inner, obs[B.OBS_OUTER_NORMAL + side], w_i, rot, wt, (ox, oy, oz), n,
+                                               t, xr, rv, a_c, r_c, rq, half, 0.0)
+        obs[B.OBS_OUTER_TRACTION + side] = g_el[0] * t[0] + g_el[1] * t[1] + g_el[2] * t[2]
+        obs[B.OBS_OUTER_ENTRAIN + side] = u_r
+    rmx = rmy = rmz = 0.0
+    if inner:  # reaction on the ring: -F at the contact point, and -t2
+        rmx, rmy, rmz = _cross(xrx, xry, xrz, -fx, -fy, -fz)
+        rmx, rmy, rmz = rmx - t2x, rmy - t2y, rmz - t2z
+    if p[B.P_F_ROLL] > 0.5 and q > 0.0:  # rolling losses (models/rolling.py); the ring takes its own reaction
+        w = (w_i * rot[0], w_i * rot[3], w_i * rot[6]) if inner else (0.0, 0.0, 0.0)
+        gx, gy, gz, hx, hy, hz, pin, pd, qx, qy, qz = spatial_rolling(
+            p, inner, q, rv, n, t, (ox, oy, oz), w, (xrx, xry, xrz),
+            (rot[0], rot[3], rot[6]), wt if inner else (0.0, 0.0, 0.0), r_c, rq)
+        fx, fy, fz, mx, my, mz = fx + gx, fy + gy, fz + gz, mx + hx, my + hy, mz + hz
+        p_in, p_diss = p_in + pin, p_diss + pd
+        if inner:
+            rmx, rmy, rmz = rmx + qx, rmy + qy, rmz + qz
+    return (fx, fy, fz), (mx, my, mz), p_in, p_diss, delta, (rmx, rmy, rmz)
+
+
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
+def _race_frame(y, p, j, z, inner, rot, c, s, wt, rq, cq, sq, ex, er, ln, rho, rg):  # pragma: no cover - compiled
+    """The contact frame of ball j at one race (fixed frame): the normal n and rolling direction t, the race
+    surface point xr along the normal (from the ring centre) and its radius r_c, the ball centre's velocity
+    relative to the race surface's motion rv, and the race's Hertz stiffness and ellipse coefficient."""
+    b = 5 * z + 6
     r, rd, thd = y[j], y[2 * z + j], y[3 * z + j]
     vx, vy, vz = y[b + z + j], rd * c - r * thd * s, rd * s + r * thd * c
-    ox, oy, oz = y[4 * z + j], y[b + 2 * z + j], y[b + 3 * z + j]
     if inner:
         vcx, vcy, vcz = y[b + 4 * z + 1], y[5 * z + 2], y[5 * z + 3]
         k_n, a_c = p[B.P_KI], p[P_AI]
@@ -152,7 +133,6 @@ def _race(y, p, j, z, inner, w_i, rot, c, s, wt):  # pragma: no cover - compiled
     tx = rot[1] * -sq + rot[2] * cq
     ty = rot[4] * -sq + rot[5] * cq
     tz = rot[7] * -sq + rot[8] * cq
-    q = k_n * delta * math.sqrt(delta)
     # race surface point along the normal (relative to the ring centre, fixed frame) and its radius
     r_c = rho + rg * nrr
     xrx = (rot[0] * rg * nrx + rot[1] * r_c * cq + rot[2] * r_c * sq)
@@ -161,7 +141,16 @@ def _race(y, p, j, z, inner, w_i, rot, c, s, wt):  # pragma: no cover - compiled
     if inner:  # the ring's surface moves with its centre and its tilting
         ttx, tty, ttz = _cross(wt[0], wt[1], wt[2], xrx, xry, xrz)
         vcx, vcy, vcz = vcx + ttx, vcy + tty, vcz + ttz
-    rvx, rvy, rvz = vx - vcx, vy - vcy, vz - vcz
+    rv = (vx - vcx, vy - vcy, vz - vcz)
+    return (nx, ny, nz), (tx, ty, tz), (xrx, xry, xrz), rv, r_c, k_n, a_c
+
+
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
+def _race_normal(p, q, delta, rv, n):  # pragma: no cover - compiled
+    """The normal force of a race contact of overlap ``delta`` and Hertz force ``q``, with the lubricant damping
+    and the registered extra laws, and the power it dissipates."""
+    rvx, rvy, rvz = rv
+    nx, ny, nz = n
     p_diss = 0.0
     if p[B.P_F_LUB] > 0.5:
         ddot = rvx * nx + rvy * ny + rvz * nz
@@ -173,79 +162,82 @@ def _race(y, p, j, z, inner, w_i, rot, c, s, wt):  # pragma: no cover - compiled
         f_x = race_extra(delta, ddot, q, p)
         p_diss += f_x * ddot
         q += f_x
-    fx, fy, fz = -q * nx, -q * ny, -q * nz
-    mx = my = mz = 0.0
-    t2x = t2y = t2z = 0.0
+    return q, p_diss
+
+
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
+def _race_traction(p, inner, q, w_i, rot, wt, o, n, t, xr, rv, a_c, r_c, rq, half, p_diss):  # pragma: no cover
+    """Race traction integrated over the strips of the contact ellipse: the force on the ball (3), the moment
+    of its spread along the major axis (3), the whole moment on the ball (3), the drive's input power, and the
+    dissipated power with the traction's share added; and the entrainment speed u_r."""
+    ox, oy, oz = o
+    nx, ny, nz = n
+    tx, ty, tz = t
+    xrx, xry, xrz = xr
+    rvx, rvy, rvz = rv
+    # the ring's spin vector (the drive), and its whole angular velocity
+    wx, wy, wz = (w_i * rot[0], w_i * rot[3], w_i * rot[6]) if inner else (0.0, 0.0, 0.0)
+    awx, awy, awz = (wx + wt[0], wy + wt[1], wz + wt[2]) if inner else (0.0, 0.0, 0.0)
+    # major axis of the ellipse: across the rolling direction, in the contact plane
+    ax_, ay_, az_ = _cross(nx, ny, nz, tx, ty, tz)
+    a = a_c * np.cbrt(q)
+    bsx, bsy, bsz = _cross(ox, oy, oz, half * nx, half * ny, half * nz)
+    rsx, rsy, rsz = _cross(wx, wy, wz, xrx, xry, xrz)
+    vt = rvx * tx + rvy * ty + rvz * tz
+    u_r = 0.5 * abs(vt * (1.0 - 2.0 * r_c / rq) + bsx * tx + bsy * ty + bsz * tz + rsx * tx + rsy * ty + rsz * tz)
+    # relative spin across the strips: slip grows linearly with the strip's offset xi along the major axis
+    wax, way, waz = _cross(ox - awx, oy - awy, oz - awz, ax_, ay_, az_)
+    u0x, u0y, u0z = rvx + bsx - rsx, rvy + bsy - rsy, rvz + bsz - rsz
+    # A strip at offset xi slides at u0 + xi wa, projected on the contact plane. The projection is linear, so
+    # u0 and wa are projected once, |u|^2 is a quadratic in xi, and the strip forces -f_k u_k sum through
+    # the moments S_j = sum f_k xi_k^j (f_k: traction per unit sliding speed of strip k).
+    un = u0x * nx + u0y * ny + u0z * nz
+    u0x, u0y, u0z = u0x - un * nx, u0y - un * ny, u0z - un * nz
+    wn = wax * nx + way * ny + waz * nz
+    wax, way, waz = wax - wn * nx, way - wn * ny, waz - wn * nz
+    c0 = u0x * u0x + u0y * u0y + u0z * u0z
+    c1 = 2.0 * (u0x * wax + u0y * way + u0z * waz)
+    c2 = wax * wax + way * way + waz * waz
+    s0, s1, s2, p_diss = _strip_sums(p, q, a, u_r, c0, c1, c2, p_diss)
+    # traction on the ball, and its first moment along the major axis (sum of xi g)
+    gsx, gsy, gsz = -(s0 * u0x + s1 * wax), -(s0 * u0y + s1 * way), -(s0 * u0z + s1 * waz)
+    hx, hy, hz = -(s1 * u0x + s2 * wax), -(s1 * u0y + s2 * way), -(s1 * u0z + s2 * waz)
+    t1x, t1y, t1z = _cross(half * nx, half * ny, half * nz, gsx, gsy, gsz)
+    t2x, t2y, t2z = _cross(ax_, ay_, az_, hx, hy, hz)
     p_in = 0.0
-    if p[B.P_F_TRAC] > 0.5 and q > 0.0:
-        # the ring's spin vector (the drive), and its whole angular velocity
-        wx, wy, wz = (w_i * rot[0], w_i * rot[3], w_i * rot[6]) if inner else (0.0, 0.0, 0.0)
-        awx, awy, awz = (wx + wt[0], wy + wt[1], wz + wt[2]) if inner else (0.0, 0.0, 0.0)
-        # major axis of the ellipse: across the rolling direction, in the contact plane
-        ax_, ay_, az_ = _cross(nx, ny, nz, tx, ty, tz)
-        a = a_c * np.cbrt(q)
-        bsx, bsy, bsz = _cross(ox, oy, oz, half * nx, half * ny, half * nz)
-        rsx, rsy, rsz = _cross(wx, wy, wz, xrx, xry, xrz)
-        vt = rvx * tx + rvy * ty + rvz * tz
-        u_r = 0.5 * abs(vt * (1.0 - 2.0 * r_c / rq) + bsx * tx + bsy * ty + bsz * tz + rsx * tx + rsy * ty + rsz * tz)
-        # relative spin across the strips: slip grows linearly with the strip's offset xi along the major axis
-        wax, way, waz = _cross(ox - awx, oy - awy, oz - awz, ax_, ay_, az_)
-        u0x, u0y, u0z = rvx + bsx - rsx, rvy + bsy - rsy, rvz + bsz - rsz
-        # A strip at offset xi slides at u0 + xi wa, projected on the contact plane. The projection is linear, so
-        # u0 and wa are projected once, |u|^2 is a quadratic in xi, and the strip forces -f_k u_k sum through
-        # the moments S_j = sum f_k xi_k^j (f_k: traction per unit sliding speed of strip k).
-        un = u0x * nx + u0y * ny + u0z * nz
-        u0x, u0y, u0z = u0x - un * nx, u0y - un * ny, u0z - un * nz
-        wn = wax * nx + way * ny + waz * nz
-        wax, way, waz = wax - wn * nx, way - wn * ny, waz - wn * nz
-        c0 = u0x * u0x + u0y * u0y + u0z * u0z
-        c1 = 2.0 * (u0x * wax + u0y * way + u0z * waz)
-        c2 = wax * wax + way * way + waz * waz
-        s0 = s1 = s2 = 0.0
-        m = int(p[P_STRIPS])
-        for k in range(m):
-            xi0, xi1 = -1.0 + 2.0 * k / m, -1.0 + 2.0 * (k + 1) / m
-            w = 0.75 * ((xi1 - xi1**3 / 3.0) - (xi0 - xi0**3 / 3.0))  # share of the Hertz load on the strip
-            xi = 0.5 * (xi0 + xi1) * a
-            us2 = c0 + xi * (c1 + xi * c2)
-            if us2 <= 0.0:
-                continue
-            us = math.sqrt(us2)
-            f = tangential(us, u_r, w * q, p) / us
-            s0 += f
-            s1 += f * xi
-            s2 += f * xi * xi
-            p_diss += f * us2
-        # traction on the ball, and its first moment along the major axis (sum of xi g)
-        gsx, gsy, gsz = -(s0 * u0x + s1 * wax), -(s0 * u0y + s1 * way), -(s0 * u0z + s1 * waz)
-        hx, hy, hz = -(s1 * u0x + s2 * wax), -(s1 * u0y + s2 * way), -(s1 * u0z + s2 * waz)
-        fx, fy, fz = fx + gsx, fy + gsy, fz + gsz
-        t1x, t1y, t1z = _cross(half * nx, half * ny, half * nz, gsx, gsy, gsz)
-        t2x, t2y, t2z = _cross(ax_, ay_, az_, hx, hy, hz)
-        mx, my, mz = t1x + t2x, t1y + t2y, t1z + t2z
-        if inner:
-            # drive power: the ring's spin times the moment of the ball's traction on it
-            c1x, c1y, c1z = _cross(xrx, xry, xrz, gsx, gsy, gsz)
-            p_in = (c1x + t2x) * wx + (c1y + t2y) * wy + (c1z + t2z) * wz
-    rmx = rmy = rmz = 0.0
-    if inner:  # reaction on the ring: -F at the contact point, and -t2
-        rmx, rmy, rmz = _cross(xrx, xry, xrz, -fx, -fy, -fz)
-        rmx, rmy, rmz = rmx - t2x, rmy - t2y, rmz - t2z
-    if p[B.P_F_ROLL] > 0.5 and q > 0.0:  # rolling losses (models/rolling.py); the ring takes its own reaction
-        w = (w_i * rot[0], w_i * rot[3], w_i * rot[6]) if inner else (0.0, 0.0, 0.0)
-        gx, gy, gz, hx, hy, hz, pin, pd, qx, qy, qz = spatial_rolling(
-            p, inner, q, (rvx, rvy, rvz), (nx, ny, nz), (tx, ty, tz), (ox, oy, oz), w, (xrx, xry, xrz),
-            (rot[0], rot[3], rot[6]), wt if inner else (0.0, 0.0, 0.0), r_c, rq)
-        fx, fy, fz, mx, my, mz = fx + gx, fy + gy, fz + gz, mx + hx, my + hy, mz + hz
-        p_in, p_diss = p_in + pin, p_diss + pd
-        if inner:
-            rmx, rmy, rmz = rmx + qx, rmy + qy, rmz + qz
-    return fx, fy, fz, mx, my, mz, p_in, p_diss, delta, rmx, rmy, rmz
+    if inner:
+        # drive power: the ring's spin times the moment of the ball's traction on it
+        c1x, c1y, c1z = _cross(xrx, xry, xrz, gsx, gsy, gsz)
+        p_in = (c1x + t2x) * wx + (c1y + t2y) * wy + (c1z + t2z) * wz
+    return (gsx, gsy, gsz), (t2x, t2y, t2z), (t1x + t2x, t1y + t2y, t1z + t2z), p_in, p_diss, u_r
+
+
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
+def _strip_sums(p, q, a, u_r, c0, c1, c2, p_diss):  # pragma: no cover - compiled
+    """The moments S_0, S_1, S_2 of the strips' traction per unit sliding speed over their offsets, where a strip
+    at offset xi slides at sqrt(c0 + c1 xi + c2 xi^2); the dissipated power with the strips' share added."""
+    s0 = s1 = s2 = 0.0
+    m = int(p[P_STRIPS])
+    for k in range(m):
+        xi0, xi1 = -1.0 + 2.0 * k / m, -1.0 + 2.0 * (k + 1) / m
+        w = 0.75 * ((xi1 - xi1**3 / 3.0) - (xi0 - xi0**3 / 3.0))  # share of the Hertz load on the strip
+        xi = 0.5 * (xi0 + xi1) * a
+        us2 = c0 + xi * (c1 + xi * c2)
+        if us2 <= 0.0:
+            continue
+        us = math.sqrt(us2)
+        f = tangential(us, u_r, w * q, p) / us
+        s0 += f
+        s1 += f * xi
+        s2 += f * xi * xi
+        p_diss += f * us2
+    return s0, s1, s2, p_diss
 
 
 @numba.njit(cache=True, fastmath=FASTMATH)
-def _pair(y, p, log, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
-    """Ball j against ball k along the 3-D line of centres: force on k (3), moment on both (3), dissipated power."""
+def _pair(y, p, log, j, k, z, cj, sj, ck, sk, obs):  # pragma: no cover - compiled
+    """Ball j against ball k along the 3-D line of centres: force on k (3), moment on both (3), dissipated power;
+    with ``obs`` (None in the right-hand side) the pair's observables are written there too."""
     d = p[B.P_D]
     half = 0.5 * d
     b = 5 * z + 6
@@ -273,7 +265,10 @@ def _pair(y, p, log, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
         return zero
     v_in = max(log[j] if log[j] > 0.0 else ddot, p[B.P_V_IN_MIN])
     f = hertz_damped(delta, ddot, v_in, p[B.P_KB], p[B.P_CHI])
-    p_diss = (f - p[B.P_KB] * delta * math.sqrt(delta)) * ddot
+    elastic = p[B.P_KB] * delta * math.sqrt(delta)
+    p_diss = (f - elastic) * ddot
+    if obs is not None:
+        obs[B.OBS_BB_NORMAL] = elastic
     fx, fy, fz = f * nx, f * ny, f * nz
     mx = my = mz = 0.0
     if p[B.P_F_TRAC] > 0.5:
@@ -288,6 +283,8 @@ def _pair(y, p, log, j, k, z, cj, sj, ck, sk):  # pragma: no cover - compiled
             rx, ry, rz = _cross(ojx - okx, ojy - oky, ojz - okz, nx, ny, nz)
             u_r = 0.25 * d * math.sqrt(rx * rx + ry * ry + rz * rz)
             g = tangential(us, u_r, f, p) / us  # friction on j is -g u
+            if obs is not None:  # the law on the elastic normal force
+                obs[B.OBS_BB_TRACTION] = abs(tangential(us, u_r, elastic, p))
             p_diss += g * us * us
             fx, fy, fz = fx + g * ux, fy + g * uy, fz + g * uz  # on k: +g u
             mx, my, mz = _cross(half * nx, half * ny, half * nz, -g * ux, -g * uy, -g * uz)
@@ -315,58 +312,107 @@ def _churn(y, p, j, z, dydt):  # pragma: no cover - compiled
 def spatial_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
     z = int(p[B.P_Z])
     b = 5 * z + 6
-    d, m, inertia, m_ring, g = p[B.P_D], p[B.P_M], p[B.P_I], p[B.P_MR], p[B.P_G]
-    grav = g if p[B.P_F_GRAV] > 0.5 else 0.0
+    m_ring = p[B.P_MR]
+    grav = p[B.P_G] if p[B.P_F_GRAV] > 0.5 else 0.0
     ramp = p[B.P_RAMP]
     w_i = p[B.P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
     rot = _tilt(y, p)
     tb = y.shape[0] - 4  # tilt states: beta_y, beta_z, their rates
     s_bz, c_bz = math.sin(p[P_TILT_Z] + y[tb + 1]), math.cos(p[P_TILT_Z] + y[tb + 1])
     wt = (-s_bz * y[tb + 2], c_bz * y[tb + 2], y[tb + 3])  # angular velocity of the tilting: bz' z + by' Rz y
-    rmx = rmy = rmz = 0.0
+    rm = (0.0, 0.0, 0.0)
     trig = log.shape[0] - 2 * z  # scratch: cos and sin of every ball's angle, once per call
+    _start(y, p, log, dydt, z, trig, grav)
+    rf = (p[P_FA] - m_ring * p[P_GAX], 0.0, -p[B.P_FR] - m_ring * grav)
+    power_in = power = 0.0
+    if p[B.P_F_RACE] > 0.5:
+        rf, rm, power_in, power = _add_race(y, p, log, dydt, z, trig, w_i, rot, wt, rf, rm, power_in, power)
+    if p[B.P_F_BB] > 0.5:
+        power = _add_pairs(y, p, log, dydt, z, trig, power)
+    power = _ball_accelerations(y, p, log, dydt, z, trig, power)
+    rfx, rfy, rfz = rf
+    rmx, rmy, rmz = rm
+    dydt[5 * z], dydt[5 * z + 1] = y[5 * z + 2], y[5 * z + 3]
+    dydt[5 * z + 2], dydt[5 * z + 3] = rfy / m_ring, rfz / m_ring
+    dydt[5 * z + 4], dydt[5 * z + 5] = power_in, power
+    dydt[b + 4 * z], dydt[b + 4 * z + 1] = y[b + 4 * z + 1], rfx / m_ring
+    # tilt (Lagrange, kinetic energy I_r (by'^2 + bz'^2) / 2): generalised moments M . d(omega)/d(beta'),
+    # the moment load acting on beta_y (the paper's I_r theta_ry'' = sum M_y, I_r theta_rz'' = sum M_z)
+    dydt[tb], dydt[tb + 1] = y[tb + 2], y[tb + 3]
+    dydt[tb + 2] = (-s_bz * rmx + c_bz * rmy + p[P_MY]) / p[P_IR]
+    dydt[tb + 3] = rmz / p[P_IR]
+
+
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
+def _start(y, p, log, dydt, z, trig, grav):  # pragma: no cover - compiled
+    """Zero ``dydt``, fill the trig scratch, and start the force accumulators (x in the axial slot, y and z in
+    the planar acceleration slots; moments in the spin slots) with the balls' weight."""
+    b = 5 * z + 6
+    m = p[B.P_M]
     for i in range(dydt.shape[0]):
         dydt[i] = 0.0
     for j in range(z):
         log[trig + j] = math.cos(y[z + j])
         log[trig + z + j] = math.sin(y[z + j])
-    # accumulators: force (x in the axial slot, y and z in the planar acceleration slots), moments in spin slots
     for j in range(z):
         dydt[3 * z + j] = -m * grav
         dydt[b + z + j] = -m * p[P_GAX]  # gravity along the shaft (vertical shaft)
-    rfx, rfy, rfz = p[P_FA] - m_ring * p[P_GAX], 0.0, -p[B.P_FR] - m_ring * grav
-    power_in = power = 0.0
-    if p[B.P_F_RACE] > 0.5:
-        for j in range(z):
-            for inner in (False, True):
-                fx, fy, fz, mx, my, mz, pin, pd, _, qx, qy, qz = _race(y, p, j, z, inner, w_i, rot, log[trig + j],
-                                                                       log[trig + z + j], wt)
-                dydt[b + z + j] += fx
-                dydt[2 * z + j] += fy
-                dydt[3 * z + j] += fz
-                dydt[4 * z + j] += mx
-                dydt[b + 2 * z + j] += my
-                dydt[b + 3 * z + j] += mz
-                if inner:
-                    rfx, rfy, rfz = rfx - fx, rfy - fy, rfz - fz
-                    rmx, rmy, rmz = rmx + qx, rmy + qy, rmz + qz
-                power_in += pin
-                power += pd
-    if p[B.P_F_BB] > 0.5:
-        for j in range(z):
-            k = j + 1 if j + 1 < z else 0
-            fx, fy, fz, mx, my, mz, pd = _pair(y, p, log, j, k, z, log[trig + j], log[trig + z + j], log[trig + k],
-                                               log[trig + z + k])
-            dydt[b + z + j] -= fx
-            dydt[2 * z + j] -= fy
-            dydt[3 * z + j] -= fz
-            dydt[b + z + k] += fx
-            dydt[2 * z + k] += fy
-            dydt[3 * z + k] += fz
-            for o, mo in ((4 * z, mx), (b + 2 * z, my), (b + 3 * z, mz)):
-                dydt[o + j] += mo
-                dydt[o + k] += mo
+
+
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
+def _add_race(y, p, log, dydt, z, trig, w_i, rot, wt, rf, rm, power_in, power):  # pragma: no cover - compiled
+    """Both race contacts of every ball into the accumulators; the ring's force and moment and the powers,
+    updated."""
+    b = 5 * z + 6
+    rfx, rfy, rfz = rf
+    rmx, rmy, rmz = rm
+    for j in range(z):
+        for inner in (False, True):
+            f, mo, pin, pd, _, qm = _race(y, p, j, z, inner, w_i, rot, log[trig + j], log[trig + z + j], wt, None)
+            fx, fy, fz = f
+            mx, my, mz = mo
+            qx, qy, qz = qm
+            dydt[b + z + j] += fx
+            dydt[2 * z + j] += fy
+            dydt[3 * z + j] += fz
+            dydt[4 * z + j] += mx
+            dydt[b + 2 * z + j] += my
+            dydt[b + 3 * z + j] += mz
+            if inner:
+                rfx, rfy, rfz = rfx - fx, rfy - fy, rfz - fz
+                rmx, rmy, rmz = rmx + qx, rmy + qy, rmz + qz
+            power_in += pin
             power += pd
+    return (rfx, rfy, rfz), (rmx, rmy, rmz), power_in, power
+
+
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
+def _add_pairs(y, p, log, dydt, z, trig, power):  # pragma: no cover - compiled
+    """Every neighbour pair's forces and moments into the accumulators; the dissipated power, updated."""
+    b = 5 * z + 6
+    for j in range(z):
+        k = j + 1 if j + 1 < z else 0
+        fx, fy, fz, mx, my, mz, pd = _pair(y, p, log, j, k, z, log[trig + j], log[trig + z + j], log[trig + k],
+                                           log[trig + z + k], None)
+        dydt[b + z + j] -= fx
+        dydt[2 * z + j] -= fy
+        dydt[3 * z + j] -= fz
+        dydt[b + z + k] += fx
+        dydt[2 * z + k] += fy
+        dydt[3 * z + k] += fz
+        for o, mo in ((4 * z, mx), (b + 2 * z, my), (b + 3 * z, mz)):
+            dydt[o + j] += mo
+            dydt[o + k] += mo
+        power += pd
+    return power
+
+
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
+def _ball_accelerations(y, p, log, dydt, z, trig, power):  # pragma: no cover - compiled
+    """The accumulated forces and moments (with the drag and churning) to the balls' accelerations and spin
+    rates, and their position rates; the dissipated power, updated."""
+    b = 5 * z + 6
+    m, inertia = p[B.P_M], p[B.P_I]
     drag = p[B.P_F_DRAG] > 0.5
     for j in range(z):
         r, rd, thd = y[j], y[2 * z + j], y[3 * z + j]
@@ -384,16 +430,7 @@ def spatial_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
         dydt[b + z + j] /= m
         for o in (4 * z, b + 2 * z, b + 3 * z):
             dydt[o + j] /= inertia
-    dydt[5 * z], dydt[5 * z + 1] = y[5 * z + 2], y[5 * z + 3]
-    dydt[5 * z + 2], dydt[5 * z + 3] = rfy / m_ring, rfz / m_ring
-    dydt[5 * z + 4], dydt[5 * z + 5] = power_in, power
-    dydt[b + 4 * z], dydt[b + 4 * z + 1] = y[b + 4 * z + 1], rfx / m_ring
-    # tilt (Lagrange, kinetic energy I_r (by'^2 + bz'^2) / 2): generalised moments M . d(omega)/d(beta'),
-    # the moment load acting on beta_y (the paper's I_r theta_ry'' = sum M_y, I_r theta_rz'' = sum M_z)
-    dydt[tb], dydt[tb + 1] = y[tb + 2], y[tb + 3]
-    dydt[tb + 2] = (-s_bz * rmx + c_bz * rmy + p[P_MY]) / p[P_IR]
-    dydt[tb + 3] = rmz / p[P_IR]
-
+    return power
 
 
 @numba.njit(cache=True)
@@ -414,21 +451,44 @@ def spatial_ring_share(t, y, p, log, j, out):  # pragma: no cover - compiled
         s_bz, c_bz = math.sin(p[P_TILT_Z] + y[tb + 1]), math.cos(p[P_TILT_Z] + y[tb + 1])
         wt = (-s_bz * y[tb + 2], c_bz * y[tb + 2], y[tb + 3])
         rot = _tilt(y, p)
-        fx, fy, fz, _, _, _, pin, pd, _, qx, qy, qz = _race(y, p, j, z, True, w_i, rot, c, s, wt)
+        (fx, fy, fz), _, pin, pd, _, (qx, qy, qz) = _race(y, p, j, z, True, w_i, rot, c, s, wt, None)
         m_ring = p[B.P_MR]
         out[0], out[1], out[2] = -fy / m_ring, -fz / m_ring, -fx / m_ring
         out[3], out[4] = (-s_bz * qx + c_bz * qy) / p[P_IR], qz / p[P_IR]
         out[5], out[6] = pin, pd
-        pin_o, pd_o = _race(y, p, j, z, False, w_i, rot, c, s, wt)[6:8]
+        pin_o, pd_o = _race(y, p, j, z, False, w_i, rot, c, s, wt, None)[2:4]
         out[5] += pin_o
         out[6] += pd_o
     if p[B.P_F_BB] > 0.5:
         for a, b in ((j - 1 if j > 0 else z - 1, j), (j, j + 1 if j + 1 < z else 0)):
             ca, sa, cb, sb = math.cos(y[z + a]), math.sin(y[z + a]), math.cos(y[z + b]), math.sin(y[z + b])
-            out[6] += _pair(y, p, log, a, b, z, ca, sa, cb, sb)[6]
+            out[6] += _pair(y, p, log, a, b, z, ca, sa, cb, sb, None)[6]
     if p[B.P_F_DRAG] > 0.5:
         v = y[j] * y[3 * z + j]
         out[6] -= ball_drag(v, p) * v + _churn(y, p, j, z, None)
+
+
+@numba.njit(cache=True)
+def spatial_observe(t, y, p, log, out):  # pragma: no cover - compiled
+    """The observables of state ``y`` at time t from the right-hand side's own force functions, as
+    :func:`cageless.simulation.models.planar.planar_observe` writes them (traction: its component along the
+    rolling direction)."""
+    z = int(p[B.P_Z])
+    out[:, :] = 0.0
+    ramp = p[B.P_RAMP]
+    w_i = p[B.P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
+    rot = _tilt(y, p)
+    tb = y.shape[0] - 4
+    s_bz, c_bz = math.sin(p[P_TILT_Z] + y[tb + 1]), math.cos(p[P_TILT_Z] + y[tb + 1])
+    wt = (-s_bz * y[tb + 2], c_bz * y[tb + 2], y[tb + 3])
+    for j in range(z):
+        k = j + 1 if j + 1 < z else 0
+        c, s = math.cos(y[z + j]), math.sin(y[z + j])
+        if p[B.P_F_RACE] > 0.5:
+            for inner in (False, True):
+                _race(y, p, j, z, inner, w_i, rot, c, s, wt, out[:, j])
+        if p[B.P_F_BB] > 0.5:
+            _pair(y, p, log, j, k, z, c, s, math.cos(y[z + k]), math.sin(y[z + k]), out[:, j])
 
 
 def spatial_ring_rows(n_balls: int) -> list[int]:
@@ -437,48 +497,6 @@ def spatial_ring_rows(n_balls: int) -> list[int]:
     b = 5 * n_balls + 6
     return [5 * n_balls + 2, 5 * n_balls + 3, b + 4 * n_balls + 1, b + 4 * n_balls + 4, b + 4 * n_balls + 5,
             5 * n_balls + 4, 5 * n_balls + 5]
-
-
-@numba.njit(cache=True, inline="always")
-def _overlaps(y, p, j, z, rot):  # pragma: no cover - compiled
-    """Ball j's contacts in three dimensions, as :func:`cageless.simulation.models.planar._overlaps` returns them."""
-    b = 5 * z + 6
-    c, s = math.cos(y[z + j]), math.sin(y[z + j])
-    k = j + 1 if j + 1 < z else 0
-    dx = y[b + k] - y[b + j]
-    dy = y[k] * math.cos(y[z + k]) - y[j] * c
-    dz = y[k] * math.sin(y[z + k]) - y[j] * s
-    return (_groove(y, p, j, z, False, rot, c, s)[6], _groove(y, p, j, z, True, rot, c, s)[6],
-            p[B.P_D] ** 2 - (dx * dx + dy * dy + dz * dz))
-
-
-@numba.njit(cache=True)
-def spatial_signature(y, p):  # pragma: no cover - compiled
-    """Which contacts are closed, as a number (see :func:`cageless.simulation.models.planar.planar_signature`)."""
-    z = int(p[B.P_Z])
-    rot = _tilt(y, p)
-    sig = 0.0
-    for j in range(z):
-        outer, inner, pair = _overlaps(y, p, j, z, rot)
-        if outer > 0.0:
-            sig += 1.0 + j
-        if inner > 0.0:
-            sig += 1.0 + z + j
-        if pair > 0.0:
-            sig += 1.0 + 2 * z + j
-    return sig * (sig + 1.0)
-
-
-@numba.njit(cache=True)
-def spatial_gaps(y, p, out):  # pragma: no cover - compiled
-    """Every contact's overlap (m), as :func:`cageless.simulation.models.planar.planar_gaps` orders them, in three
-    dimensions (the quantities :func:`spatial_signature` tests)."""
-    z = int(p[B.P_Z])
-    rot = _tilt(y, p)
-    d = p[B.P_D]
-    for j in range(z):
-        out[j], out[z + j], pair = _overlaps(y, p, j, z, rot)
-        out[2 * z + j] = d - math.sqrt(d * d - pair)
 
 
 def spatial_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLike, ring0: tuple[float, float],
@@ -542,69 +560,3 @@ def ring_tilt_inertia(bearing: Bearing) -> float:
     at the inner race radius, m (D_i / 2)^2 / 2 (the paper's I_r, whose value it does not print; its
     tilt equations, §3.1, carry the inner ring alone, not the shaft)."""
     return 0.5 * bearing.masses.inner_ring_mass_kg * (0.5 * bearing.geometry.inner_race_diameter_m) ** 2
-
-
-def race_geometry(problem: Problem,
-                  y: npt.NDArray[np.float64]) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
-    """(overlap in m, contact angle in rad, contact point) of the inner and outer race contacts along samples
-    y (T, n).
-
-    The contact angle is atan(axial / radial component of the normal), in the frame of the race (the inner
-    ring's frame carries its prescribed tilt). The contact point (T, Z, 3: axial x, y, z in m, bearing frame)
-    lies on the raceway, the groove radius from its curvature centre along the line through the ball centre:
-    its path is the contact trajectory of the paper's figure 13.
-    """
-    p = problem.params
-    z = int(p[B.P_Z])
-    b = 5 * z + 6
-    r, th, ax = y[:, :z], y[:, z:2 * z], y[:, b:b + z]
-    half = 0.5 * p[B.P_D]
-    out = {}
-    ball = np.stack([ax, r * np.cos(th), r * np.sin(th)], axis=-1)  # (T, Z, 3) in the fixed frame
-    for race, rho, rg, centre, frame in (
-            ("outer", 0.5 * p[B.P_DO] - p[P_RGO], p[P_RGO], np.zeros((len(y), 1, 3)), np.broadcast_to(np.eye(3), (len(y), 3, 3))),
-            ("inner", 0.5 * p[B.P_DI] + p[P_RGI], p[P_RGI],
-             np.stack([y[:, b + 4 * z], y[:, 5 * z], y[:, 5 * z + 1]], axis=-1)[:, None, :], ring_rotations(problem, y))):
-        q = np.einsum("tzi,tij->tzj", ball - centre, frame)  # R^T (P - C): the ball centre in the race's frame
-        rq = np.hypot(q[..., 1], q[..., 2])
-        ex, er = q[..., 0], rq - rho
-        length = np.hypot(ex, er)
-        radial = rho + rg * er / length  # distance of the contact point from the ring's axis
-        local = np.stack([rg * ex / length, radial * q[..., 1] / rq, radial * q[..., 2] / rq], axis=-1)
-        out[race] = (np.clip(length - (rg - half), 0.0, None), np.arctan2(ex, np.abs(er)),
-                     centre + np.einsum("tzj,tij->tzi", local, frame))
-    return out
-
-
-def ring_rotations(problem: Problem, y: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
-    """The inner ring's rotation matrices R = Rz(beta_z) Ry(beta_y) along samples y (T, 3, 3): the prescribed
-    misalignment plus the tilt states."""
-    return np.array([_tilt(row, problem.params) for row in y]).reshape(-1, 3, 3)
-
-
-def spatial_energy(problem: Problem, y: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
-    """Total mechanical energy (J) along samples y (T, n): kinetic (translation and spin), Hertz, gravity and
-    load potentials, the ring's tilt. With the dissipated energy added and the drive's input work taken away it
-    is conserved."""
-    p = problem.params
-    z = int(p[B.P_Z])
-    b = 5 * z + 6
-    m, m_ring, g, d = p[B.P_M], p[B.P_MR], p[B.P_G] * (p[B.P_F_GRAV] > 0.5), p[B.P_D]
-    r, th, rd, thd = y[:, :z], y[:, z:2 * z], y[:, 2 * z:3 * z], y[:, 3 * z:4 * z]
-    ax, axd = y[:, b:b + z], y[:, b + z:b + 2 * z]
-    spin2 = y[:, 4 * z:5 * z] ** 2 + y[:, b + 2 * z:b + 3 * z] ** 2 + y[:, b + 3 * z:b + 4 * z] ** 2
-    cvy, cvz, cvx = y[:, 5 * z + 2], y[:, 5 * z + 3], y[:, b + 4 * z + 1]
-    ke = (0.5 * m * np.sum(rd**2 + (r * thd) ** 2 + axd**2, axis=1) + 0.5 * p[B.P_I] * np.sum(spin2, axis=1)
-          + 0.5 * m_ring * (cvx**2 + cvy**2 + cvz**2) + 0.5 * p[P_IR] * (y[:, -2] ** 2 + y[:, -1] ** 2))
-    pe = m * g * np.sum(r * np.sin(th), axis=1) + (m_ring * g + p[B.P_FR]) * y[:, 5 * z + 1] - p[P_FA] * y[:, b + 4 * z]
-    pe -= p[P_MY] * y[:, -4]  # the moment load's work on the tilt beta_y
-    pe += p[P_GAX] * (m * np.sum(ax, axis=1) + m_ring * y[:, b + 4 * z])  # gravity along the shaft
-    if p[B.P_F_RACE] > 0.5:
-        for race, (overlap, _, _) in race_geometry(problem, y).items():
-            pe += 0.4 * (p[B.P_KI] if race == "inner" else p[B.P_KO]) * np.sum(overlap**2.5, axis=1)
-    if p[B.P_F_BB] > 0.5:
-        x, zz = r * np.cos(th), r * np.sin(th)
-        gap = np.sqrt((np.roll(x, -1, axis=1) - x) ** 2 + (np.roll(zz, -1, axis=1) - zz) ** 2
-                      + (np.roll(ax, -1, axis=1) - ax) ** 2)
-        pe += 0.4 * p[B.P_KB] * np.sum(np.clip(d - gap, 0, None) ** 2.5, axis=1)
-    return ke + pe

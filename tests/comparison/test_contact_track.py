@@ -14,7 +14,7 @@ import pytest
 from cageless.conditions import OperatingConditions
 from cageless.comparison.report.describe import contact_track
 from cageless.simulation.effects import choose_model
-from cageless.simulation.models.spatial import ring_rotations
+from cageless.simulation.models.spatial_geometry import ring_rotations
 from cageless.simulation.run import simulate
 from cageless.simulation.scene import Scene
 
