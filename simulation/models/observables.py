@@ -14,6 +14,7 @@ from cageless.simulation.hertz import compliance, hertz_contact, race_curvatures
 from cageless.simulation.models import base as B
 from cageless.simulation.models import spatial as S
 from cageless.simulation.models.planar_reference import tangential_force
+from cageless.simulation.models.regime import P_F_FTRAC, race_tangential_array
 from cageless.simulation.problem import Problem
 from cageless.simulation.scene import Scene
 from cageless.simulation.traction import film_coefficient
@@ -45,7 +46,10 @@ def observables(pr: Problem, y: npt.NDArray[np.float64], scene: Scene,
     u_i = vt - half * om - w_i * r_i
     ur_i = 0.5 * np.abs(vt * (1 - 2 * r_i / ln) - half * om + w_i * r_i)
     contacts = {"inner_normal": inner, "outer_normal": outer, "ball_ball_normal": bb}
-    if p[B.P_F_TRAC] > 0.5:
+    if p[B.P_F_TRAC] > 0.5 and p[P_F_FTRAC] > 0.5:  # traction by film regime (models/regime.py)
+        contacts["inner_traction"] = -race_tangential_array(u_i, ur_i, inner, True, p)
+        contacts["outer_traction"] = -race_tangential_array(u_o, ur_o, outer, False, p)
+    elif p[B.P_F_TRAC] > 0.5:
         contacts["inner_traction"] = -tangential_force(u_i, ur_i, inner, p)
         contacts["outer_traction"] = -tangential_force(u_o, ur_o, outer, p)
     if film_on:

@@ -54,6 +54,7 @@ from cageless.simulation.models.base import (LAYOUT, P_CD, P_CHI, P_CHO, P_D, P_
                                     P_F_BB, P_F_BBFILM, P_F_DRAG, P_F_GRAV, P_F_LUB, P_F_RACE, P_F_ROLL, P_F_TRAC, P_G, P_H0,
                                     P_I, P_KB, P_KI, P_KO, P_M, P_MR, P_RAMP, P_RHO_MIX, P_V_IN_MIN, P_WI, P_Z)
 from cageless.simulation.models.contact_laws import RACE_LAWS, ball_churning, ball_drag, race_extra, tangential
+from cageless.simulation.models.regime import oil_viscosity as par_viscosity, race_tangential, regime_slots
 from cageless.simulation.models.rolling import race_rolling, rolling_slots
 
 __all__ = [
@@ -111,7 +112,7 @@ def _race_forces(y, p, j, z, w_i, c, s):  # pragma: no cover - compiled
         if trac:
             u = r * thd + half * om  # ball surface against the fixed outer race, along e_theta
             u_r = 0.5 * abs(r * thd + half * om - p[P_DO] * thd)
-            f_t = -tangential(u, u_r, q, p)
+            f_t = -race_tangential(u, u_r, q, False, p)
             p_diss -= f_t * u
             torque += half * f_t
         if p[P_F_ROLL] > 0.5:  # rolling losses (models/rolling.py): pressure on the centre, shear at the surface
@@ -146,7 +147,7 @@ def _race_forces(y, p, j, z, w_i, c, s):  # pragma: no cover - compiled
             vt = vx * tx + vz * tz
             u = vt - half * om - w_i * r_i  # ball surface against the ring surface, along t
             u_r = 0.5 * abs(vt * (1.0 - 2.0 * r_i / ln) - half * om + w_i * r_i)
-            f_t = -tangential(u, u_r, q, p)
+            f_t = -race_tangential(u, u_r, q, True, p)
             p_diss -= f_t * u
             p_in += w_i * r_i * f_t
             torque -= half * f_t
@@ -466,6 +467,10 @@ def _params(bearing: Bearing, radial_load_n: float, gravity_m_s2: float, inner_s
         p[P_DRY] = 0.0  # no friction law is evaluated: nothing to switch
     if p[P_F_ROLL]:
         LAYOUT.fill(p, rolling_slots(bearing, par))
+    if lubricated:  # the oil at its temperature; the regime traction's constants (models/regime.py)
+        LAYOUT.fill(p, {"ETA0": par_viscosity(bearing, par)})
+        if p[LAYOUT.index("F_FTRAC")]:
+            LAYOUT.fill(p, regime_slots(bearing, par))
     if p[P_F_DRAG]:
         if oil_air_density_kg_m3 is None and lubricated:  # the default mixture of a lubricated scene
             from cageless.simulation.physics.drag import mixture_density

@@ -46,6 +46,7 @@ from cageless.simulation.hertz import compliance, hertz_contact, race_curvatures
 from cageless.simulation.models import base as B
 from cageless.simulation.models import planar as P
 from cageless.simulation.models.contact_laws import RACE_LAWS, ball_churning, ball_drag, race_extra, tangential
+from cageless.simulation.models.regime import race_regime, strip_tangential
 from cageless.simulation.models.rolling import spatial_rolling
 from cageless.simulation.problem import Problem
 
@@ -203,6 +204,7 @@ def _race(y, p, j, z, inner, w_i, rot, c, s, wt):  # pragma: no cover - compiled
         c2 = wax * wax + way * way + waz * waz
         s0 = s1 = s2 = 0.0
         m = int(p[P_STRIPS])
+        rw, ul = race_regime(u_r, q, inner, p)  # the film regime, once per contact (models/regime.py)
         for k in range(m):
             xi0, xi1 = -1.0 + 2.0 * k / m, -1.0 + 2.0 * (k + 1) / m
             w = 0.75 * ((xi1 - xi1**3 / 3.0) - (xi0 - xi0**3 / 3.0))  # share of the Hertz load on the strip
@@ -211,7 +213,7 @@ def _race(y, p, j, z, inner, w_i, rot, c, s, wt):  # pragma: no cover - compiled
             if us2 <= 0.0:
                 continue
             us = math.sqrt(us2)
-            f = tangential(us, u_r, w * q, p) / us
+            f = strip_tangential(us, u_r, w * q, rw, ul, p) / us
             s0 += f
             s1 += f * xi
             s2 += f * xi * xi
