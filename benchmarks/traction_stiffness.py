@@ -16,6 +16,16 @@ pressure), and the slope at u_s = 0 of
   stiff case: Barus viscosity at contact pressure is orders of magnitude higher).
 
 The ratio column divides the floored slope by today's, both computed in this run. No timing is involved.
+
+``--cost`` measures what the law costs in the models, with the ``film_traction`` effect on against off
+(the traction curve), everything else at the defaults, same run, interleaved, best of N:
+
+* the right-hand side alone, at a state of the running bearing (after 20 ms at 3000 rpm, 500 N), planar and
+  spatial (400 N axial, 5 strips);
+* a short planar run (``--run-ms``, default 30 ms, 3000 rpm, 500 N): its accepted steps, right-hand side
+  calls and wall time, which show the stiffness the law adds (an explicit method's steps) or not.
+
+    python benchmarks/traction_stiffness.py --cost [--run-ms 30]
 """
 
 from __future__ import annotations
@@ -65,8 +75,9 @@ def rows(sigma: float, u_min: float) -> list[tuple]:
             h_m = ft.hd_minimum_film(lub.dynamic_viscosity_pa_s, lub.pressure_viscosity_coefficient_1_pa, e_red, u, q,
                                      rx[race], hc.kappa)
             eta_e = roelands(lub.dynamic_viscosity_pa_s, lub.pressure_viscosity_coefficient_1_pa, q / area)
-            args = (q, area, h_m, h_c, sigma, eta_e, ft.DEFAULT_LSS_COEFFICIENT)
-            tail = (ft.DEFAULT_BOUNDARY_COEFFICIENT, par.slip_regularisation_m_s, ft.LAMBDA_BOUNDARY, ft.LAMBDA_FULL)
+            args = (q, area, h_m, h_c, sigma, eta_e, par.limiting_shear_coefficient)
+            tail = (par.boundary_friction_coefficient, par.boundary_slip_speed_m_s, ft.LAMBDA_BOUNDARY,
+                    ft.LAMBDA_FULL)
             floored = ft.film_traction_slope(*args, u_min, *tail)
             physical = ft.film_traction_slope(*args, 1e-300, *tail)
             eta_b = barus(lub.dynamic_viscosity_pa_s, lub.pressure_viscosity_coefficient_1_pa, q / area)
@@ -77,14 +88,81 @@ def rows(sigma: float, u_min: float) -> list[tuple]:
     return out
 
 
+def _problems():
+    """(label, problem with film_traction on, problem with it off, state of the running bearing)."""
+
+    import numpy as np
+
+    from cageless.conditions import OperatingConditions
+    from cageless.simulation.effects import choose_model
+    from cageless.simulation.run import build_problem
+    from cageless.simulation.scene import Scene
+    from cageless.simulation.solve import solve
+
+    out = []
+    for label, cond in (("planar", OperatingConditions(3000.0, 500.0)),
+                        ("spatial, 5 strips", OperatingConditions(3000.0, 500.0, 400.0))):
+        scene = Scene(conditions=cond)
+        on = build_problem(scene, choose_model(scene), ModelParameters())
+        off = build_problem(scene, choose_model(scene, effects={"film_traction": False}, force=True),
+                            ModelParameters())
+        sol = solve(on, np.array([0.0, 0.02]), rtol=1e-6)
+        out.append((label, on, off, sol.y[-1]))
+    return out
+
+
+def cost(run_ms: float, repeats: int = 5, calls: int = 2000) -> None:
+    """Print the right-hand side's and a short run's cost with the regime law on and off (same run)."""
+    import time
+
+    from cageless.conditions import OperatingConditions
+    from cageless.simulation.effects import choose_model
+    from cageless.simulation.run import simulate
+    from cageless.simulation.scene import Scene
+
+    print("| model | RHS on (us) | RHS off (us) | ratio on/off |\n|---|---|---|---|")
+    for label, on, off, y in _problems():
+        best = {"on": math.inf, "off": math.inf}
+        for _ in range(repeats):
+            for key, pr in (("on", on), ("off", off)):
+                pr.rhs(0.02, y)  # compiled, warm
+                t0 = time.perf_counter()
+                for _ in range(calls):
+                    pr.rhs(0.02, y, pr.log)
+                best[key] = min(best[key], (time.perf_counter() - t0) / calls)
+        print(f"| {label} | {best['on'] * 1e6:.1f} | {best['off'] * 1e6:.1f} | {best['on'] / best['off']:.2f} |")
+    scene = Scene(conditions=OperatingConditions(3000.0, 500.0), duration_s=run_ms * 1e-3)
+    rows = {}
+    for _ in range(2):
+        for key, eff in (("on", {}), ("off", {"film_traction": False})):
+            t0 = time.perf_counter()
+            res = simulate(scene, choose_model(scene, effects=eff, force=True), progress=False)
+            wall = time.perf_counter() - t0
+            old = rows.get(key)
+            rows[key] = (res.solution.n_steps, res.solution.n_rhs, min(wall, old[2]) if old else wall)
+    print(f"\n{run_ms:g} ms planar run at 3000 rpm, 500 N (best of 2 walls, interleaved)\n")
+    print("| film_traction | steps | RHS calls | wall (s) |\n|---|---|---|---|")
+    for key in ("on", "off"):
+        print(f"| {key} | {rows[key][0]} | {rows[key][1]} | {rows[key][2]:.1f} |")
+    print(f"\nratio on/off: steps {rows['on'][0] / rows['off'][0]:.2f}, RHS calls {rows['on'][1] / rows['off'][1]:.2f}, "
+          f"wall {rows['on'][2] / rows['off'][2]:.2f}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--roughness-um", type=float, default=ft.DEFAULT_ROUGHNESS_M * 1e6,
+    ap.add_argument("--roughness-um", type=float, default=ModelParameters().surface_roughness_m * 1e6,
                     help="composite rms roughness sigma (um)")
     ap.add_argument("--u-min", type=float, default=ft.DEFAULT_MIN_SLIP_SPEED_M_S, help="floor u_min (m/s)")
+    ap.add_argument("--cost", action="store_true", help="time the right-hand side and a short run, law on/off")
+    ap.add_argument("--run-ms", type=float, default=30.0, help="length of the timed run with --cost (ms)")
     args = ap.parse_args()
+    if args.cost:
+        cost(args.run_ms)
+        return
+    par = ModelParameters()
     print(f"sigma = {args.roughness_um:g} um, u_min = {args.u_min:g} m/s, Lambda_LSS = "
-          f"{ft.DEFAULT_LSS_COEFFICIENT:g}, mu_b = {ft.DEFAULT_BOUNDARY_COEFFICIENT:g}; slopes in N s/m\n")
+          f"{par.limiting_shear_coefficient:g}, mu_b = {par.boundary_friction_coefficient:g}, v_reg = "
+          f"{par.boundary_slip_speed_m_s:g} m/s; slopes in N s/m\n")
     print("| rpm | contact | Q (N) | u (m/s) | h_c (um) | Lambda | eta_e (Pa s) | today | new | "
           "new, no floor | new, Barus eta_e | ratio new/today |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")

@@ -88,6 +88,12 @@ EFFECTS: tuple[EffectSpec, ...] = (
                _always("traction drives the balls"), flag="F_TRAC", slots=("TA", "TB", "TC", "TD", "U_FLOOR")),
     EffectSpec("ehl_film", "Hamrock-Dowson central and minimum film at race contacts", _lubricated,
                needs_lubricant=True, flag="F_FILM"),
+    EffectSpec("film_traction", "race traction by lubrication regime from Lambda = h_min / sigma: boundary "
+               "friction, mixed, full film limited by the Bair-Winer limiting shear stress; the film's viscosity "
+               "from Roelands at the mean Hertz pressure and the oil temperature", _lubricated,
+               needs_lubricant=True, flag="F_FTRAC",
+               slots=("SIGMA", "LSS", "MU_B", "V_REG_B", "U_MIN", "LAM_B", "LAM_F", "ETA_T", "ROE_LN", "ROE_Z",
+                      "LHC_I", "LHM_I", "AB_I", "LHC_O", "LHM_O", "AB_O")),
     EffectSpec("rolling_losses", "hydrodynamic rolling force on the ball centre and moment about it at both race "
                "contacts, from the film and the entrainment speed, with inlet starvation (Chiu 1974)", _lubricated,
                needs_lubricant=True, flag="F_ROLL",

@@ -36,6 +36,17 @@ Sources
   that scales the ball-ball hysteresis damping (a choice: impacts in these runs
   close at 0.1-1 m/s; slower contacts rebound more elastically, as measured
   steel impacts do at low speed, Goldsmith 1960).
+* ``surface_roughness_m``, ``limiting_shear_coefficient``, ``boundary_friction_coefficient``,
+  ``boundary_slip_speed_m_s``: the race traction by lubrication regime (the ``film_traction`` effect,
+  :mod:`cageless.simulation.physics.film_traction`, which cites each: composite rms roughness 0.1 um, a
+  ground race against a finished ball, range 0.02-0.3 um; limiting shear stress over pressure 0.07 inside
+  the 0.04-0.1 of mineral oils, Bair & Winer 1979; boundary friction 0.1 of lubricated steel, Harris &
+  Kotzalas ch. 4; 5 mm/s, a numerical regularisation of the boundary friction's sign that keeps its slope
+  near the traction curve's, docs/physics/lubricant.md).
+* ``oil_temperature_c``: 20 degC, the paper's reference temperature (Table 1), at which its viscosity
+  0.04 Pa s holds; the oil's viscosity follows eta_0 exp[-beta (T - T_0)] with the paper's beta = 0.027 1/K
+  (:mod:`cageless.simulation.physics.viscosity`). Accepted range -20 to 150 degC (mineral oils stay liquid and
+  below their flash points there; Harris & Kotzalas ch. 4 list bearing oils used up to about 150 degC).
 * ``dry_friction_coefficient``: no default. A dry scene has no film, and the
   Coulomb friction of the bare steel contact must be given (``--set
   dry_friction_coefficient=...``).
@@ -107,6 +118,19 @@ class ModelParameters:
         more elastically than R, as real steel impacts do as the speed falls (Goldsmith, *Impact*,
         1960, ch. 6); without the floor the damping of a contact that closes at rest is unbounded
         and the step collapses to nanoseconds.
+    surface_roughness_m
+        Composite rms roughness sigma (m) of the race contacts, in the film parameter Lambda = h_min / sigma
+        (``film_traction`` effect), > 0.
+    limiting_shear_coefficient
+        Limiting shear stress over pressure, Lambda_LSS, of the full film, in (0, 1).
+    boundary_friction_coefficient
+        Friction coefficient mu_b of boundary lubrication (Lambda below 1), in (0, 1).
+    boundary_slip_speed_m_s
+        Sliding speed (m/s), > 0, over which boundary friction reaches mu_b (tanh regularisation).
+    oil_temperature_c
+        Oil temperature (degC), in [-20, 150]: the viscosity at ambient pressure is
+        eta_0 exp[-beta (T - T_0)] (the lubricant's beta and T_0), in the film, the traction, the rolling losses
+        and the ball-ball squeeze film.
     meniscus_distance_m
         Inlet meniscus distance r_s (m) of the hydrodynamic rolling force at the race contacts (the
         ``rolling_losses`` effect, :mod:`cageless.simulation.physics.rolling_force`): how far upstream of the
@@ -128,7 +152,12 @@ class ModelParameters:
     min_entrainment_m_s: float = 0.1
     min_approach_speed_m_s: float = 0.01
     strips: int = 5
-    meniscus_distance_m: float = 0.2652306786928945e-3  # fitted: simulation/parameter_sets.py
+    meniscus_distance_m: float = 0.2313082303752839e-3  # fitted: simulation/parameter_sets.py
+    surface_roughness_m: float = 0.1e-6
+    limiting_shear_coefficient: float = 0.07
+    boundary_friction_coefficient: float = 0.1
+    boundary_slip_speed_m_s: float = 5e-3
+    oil_temperature_c: float = 20.0
 
     def __post_init__(self) -> None:
         rules = {
@@ -143,6 +172,11 @@ class ModelParameters:
             "min_entrainment_m_s": (lambda v: v > 0, "must be > 0"),
             "min_approach_speed_m_s": (lambda v: v > 0, "must be > 0"),
             "meniscus_distance_m": (lambda v: 0 < v <= 0.01, "must lie in (0, 10 mm]"),
+            "surface_roughness_m": (lambda v: 0 < v < 1e-5, "must lie in (0, 10 um)"),
+            "limiting_shear_coefficient": (lambda v: 0 < v < 1, "must lie in (0, 1)"),
+            "boundary_friction_coefficient": (lambda v: 0 < v < 1, "must lie in (0, 1)"),
+            "boundary_slip_speed_m_s": (lambda v: v > 0, "must be > 0"),
+            "oil_temperature_c": (lambda v: -20 <= v <= 150, "must lie in [-20, 150] degC"),
         }
         for name, (ok, rule) in rules.items():
             value = getattr(self, name)

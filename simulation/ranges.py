@@ -49,6 +49,13 @@ DOCUMENTED_RANGES: dict[str, DocumentedRange] = {
     "meniscus_distance_m": DocumentedRange(0.05e-3, 2.0e-3, "from a starved inlet of the order of the contact "
                                            "semi-axes to a flooded one limited by the groove (Chiu 1974 fit; see "
                                            "docs/physics/lubricant.md)"),
+    "surface_roughness_m": DocumentedRange(0.02e-6, 0.3e-6, "a finished ball on a ground or honed race, composite "
+                                           "rms (docs/physics/lubricant.md)"),
+    "limiting_shear_coefficient": DocumentedRange(0.04, 0.1, "limiting shear stress over pressure of mineral oils "
+                                                  "(Bair & Winer 1979; Evans & Johnson 1986)"),
+    "boundary_friction_coefficient": DocumentedRange(0.05, 0.15, "boundary friction of lubricated bearing steel "
+                                                     "about 0.1 (Harris & Kotzalas ch. 4), +-50 %"),
+    "oil_temperature_c": DocumentedRange(-20.0, 150.0, "liquid mineral oil below its flash point"),
     "lubricant.dynamic_viscosity_pa_s": DocumentedRange(0.005, 0.5, "about 6-600 mm^2/s, inside the ISO 3448 "
                                                                     "grade span"),
 }

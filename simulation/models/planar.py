@@ -58,6 +58,7 @@ from cageless.simulation.models.planar_layout import PlanarLayout
 from cageless.simulation.models.contact_log import (EVENT_FIELDS, ONSET_RESOLUTION, RUBBING_FACTOR, contact_events,
                                                      empty_log, log_size, planar_post)
 from cageless.simulation.models.contact_laws import RACE_LAWS, ball_churning, ball_drag, race_extra, tangential
+from cageless.simulation.models.regime import oil_viscosity as par_viscosity, race_tangential, regime_slots
 from cageless.simulation.models.rolling import race_rolling, rolling_slots
 
 __all__ = [
@@ -106,9 +107,9 @@ def _outer_race(y, p, j, z, c, s, obs):  # pragma: no cover - compiled
         if trac:
             u = r * thd + half * om  # ball surface against the fixed outer race, along e_theta
             u_r = 0.5 * abs(r * thd + half * om - p[P_DO] * thd)
-            f_t = -tangential(u, u_r, q, p)
+            f_t = -race_tangential(u, u_r, q, False, p)
             if obs is not None:  # the law on the elastic normal force
-                obs[OBS_OUTER_TRACTION] = -tangential(u, u_r, obs[OBS_OUTER_NORMAL], p)
+                obs[OBS_OUTER_TRACTION] = -race_tangential(u, u_r, obs[OBS_OUTER_NORMAL], False, p)
                 obs[OBS_OUTER_ENTRAIN] = u_r
             p_diss -= f_t * u
             torque += half * f_t
@@ -159,9 +160,9 @@ def _inner_race(y, p, j, z, w_i, c, s, fy, fz, torque, p_diss, obs):  # pragma: 
             vt = vx * tx + vz * tz
             u = vt - half * om - w_i * r_i  # ball surface against the ring surface, along t
             u_r = 0.5 * abs(vt * (1.0 - 2.0 * r_i / ln) - half * om + w_i * r_i)
-            f_t = -tangential(u, u_r, q, p)
+            f_t = -race_tangential(u, u_r, q, True, p)
             if obs is not None:  # the law on the elastic normal force
-                obs[OBS_INNER_TRACTION] = -tangential(u, u_r, obs[OBS_INNER_NORMAL], p)
+                obs[OBS_INNER_TRACTION] = -race_tangential(u, u_r, obs[OBS_INNER_NORMAL], True, p)
                 obs[OBS_INNER_ENTRAIN] = u_r
             p_diss -= f_t * u
             p_in += w_i * r_i * f_t
@@ -464,6 +465,10 @@ def _params(bearing: Bearing, radial_load_n: float, gravity_m_s2: float, inner_s
         p[P_DRY] = 0.0  # no friction law is evaluated: nothing to switch
     if p[P_F_ROLL]:
         LAYOUT.fill(p, rolling_slots(bearing, par))
+    if lubricated:  # the oil at its temperature; the regime traction's constants (models/regime.py)
+        LAYOUT.fill(p, {"ETA0": par_viscosity(bearing, par)})
+        if p[LAYOUT.index("F_FTRAC")]:
+            LAYOUT.fill(p, regime_slots(bearing, par))
     if p[P_F_DRAG]:
         if oil_air_density_kg_m3 is None and lubricated:  # the default mixture of a lubricated scene
             from cageless.simulation.physics.drag import mixture_density

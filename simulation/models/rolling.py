@@ -121,7 +121,10 @@ def rolling_slots(bearing, parameters) -> dict[str, float]:  # type: ignore[no-u
     rc = race_curvatures(g)
     eta_c = compliance(mat)
     e_red = mat.youngs_modulus_pa / (1.0 - mat.poisson_ratio ** 2)
-    eta, alpha, r_s = lub.dynamic_viscosity_pa_s, lub.pressure_viscosity_coefficient_1_pa, parameters.meniscus_distance_m
+    from cageless.simulation.models.regime import oil_viscosity
+
+    eta, alpha, r_s = oil_viscosity(bearing, parameters), lub.pressure_viscosity_coefficient_1_pa, \
+        parameters.meniscus_distance_m
     out = {}
     for tag, r_x, f, race in (("I", 0.5 * d * (dm - d) / dm, g.inner_curvature_factor, "inner"),
                               ("O", 0.5 * d * (dm + d) / dm, g.outer_curvature_factor, "outer")):

@@ -46,6 +46,7 @@ from cageless.simulation.hertz import compliance, hertz_contact, race_curvatures
 from cageless.simulation.models import base as B
 from cageless.simulation.models import planar as P
 from cageless.simulation.models.contact_laws import RACE_LAWS, ball_churning, ball_drag, race_extra, tangential
+from cageless.simulation.models.regime import race_regime, strip_tangential
 from cageless.simulation.models.rolling import spatial_rolling
 from cageless.simulation.models.spatial_layout import (LAYOUT, N_PARAMS, P_AI, P_AO, P_FA, P_GAX, P_IR, P_MY, P_RGI,
                                                         P_RGO, P_STRIPS, P_TILT_Y, P_TILT_Z, SpatialLayout, _cross,
@@ -198,7 +199,7 @@ def _race_traction(p, inner, q, w_i, rot, wt, o, n, t, xr, rv, a_c, r_c, rq, hal
     c0 = u0x * u0x + u0y * u0y + u0z * u0z
     c1 = 2.0 * (u0x * wax + u0y * way + u0z * waz)
     c2 = wax * wax + way * way + waz * waz
-    s0, s1, s2, p_diss = _strip_sums(p, q, a, u_r, c0, c1, c2, p_diss)
+    s0, s1, s2, p_diss = _strip_sums(p, q, a, u_r, inner, c0, c1, c2, p_diss)
     # traction on the ball, and its first moment along the major axis (sum of xi g)
     gsx, gsy, gsz = -(s0 * u0x + s1 * wax), -(s0 * u0y + s1 * way), -(s0 * u0z + s1 * waz)
     hx, hy, hz = -(s1 * u0x + s2 * wax), -(s1 * u0y + s2 * way), -(s1 * u0z + s2 * waz)
@@ -213,11 +214,12 @@ def _race_traction(p, inner, q, w_i, rot, wt, o, n, t, xr, rv, a_c, r_c, rq, hal
 
 
 @numba.njit(cache=True, fastmath=FASTMATH, inline="always")
-def _strip_sums(p, q, a, u_r, c0, c1, c2, p_diss):  # pragma: no cover - compiled
+def _strip_sums(p, q, a, u_r, inner, c0, c1, c2, p_diss):  # pragma: no cover - compiled
     """The moments S_0, S_1, S_2 of the strips' traction per unit sliding speed over their offsets, where a strip
     at offset xi slides at sqrt(c0 + c1 xi + c2 xi^2); the dissipated power with the strips' share added."""
     s0 = s1 = s2 = 0.0
     m = int(p[P_STRIPS])
+    rw, ul = race_regime(u_r, q, inner, p)  # the film regime, once per contact (models/regime.py)
     for k in range(m):
         xi0, xi1 = -1.0 + 2.0 * k / m, -1.0 + 2.0 * (k + 1) / m
         w = 0.75 * ((xi1 - xi1**3 / 3.0) - (xi0 - xi0**3 / 3.0))  # share of the Hertz load on the strip
@@ -226,7 +228,7 @@ def _strip_sums(p, q, a, u_r, c0, c1, c2, p_diss):  # pragma: no cover - compile
         if us2 <= 0.0:
             continue
         us = math.sqrt(us2)
-        f = tangential(us, u_r, w * q, p) / us
+        f = strip_tangential(us, u_r, w * q, rw, ul, p) / us
         s0 += f
         s1 += f * xi
         s2 += f * xi * xi

@@ -12,5 +12,7 @@ spatial) can call them from its right-hand side:
 * :mod:`cageless.simulation.physics.drag`: Reynolds-dependent sphere drag (Schiller-Naumann) and the churning moment on a
   spinning ball, with the oil-air mixture density.
 
-The equations, parameters, ranges and sources are gathered in ``docs/physics/lubricant.md``.
+The models join them to their state in :mod:`cageless.simulation.models.rolling` (the ``rolling_losses`` effect)
+and :mod:`cageless.simulation.models.regime` (the ``film_traction`` effect). The equations, parameters, ranges and
+sources are gathered in ``docs/physics/lubricant.md``.
 """

@@ -23,8 +23,8 @@ def scene(**kw):
 def test_radial_lubricated_scene():
     c = choose_model(scene())
     assert c.level == "planar"
-    assert c.active == ("race_contact", "lubricant_damping", "race_traction", "ehl_film", "rolling_losses",
-                        "ball_ball_contact", "ball_ball_film", "gravity", "drag")
+    assert c.active == ("race_contact", "lubricant_damping", "race_traction", "ehl_film", "film_traction",
+                        "rolling_losses", "ball_ball_contact", "ball_ball_film", "gravity", "drag")
     # drag is on by default in a lubricated scene, in the 5 % oil-air mixture: 0.05 x 826 + 0.95 x 1.204 = 42.44
     assert {e.name: e.reason for e in c.effects}["drag"].startswith("lubricated: oil-air mixture of 42.4 kg/m^3")
     off = choose_model(scene(oil_air_density_kg_m3=0.0))
@@ -92,7 +92,7 @@ def test_the_parameter_layout_comes_from_the_table():
 
 
 def test_every_effect_has_a_rule_and_physics():
-    assert len({e.name for e in EFFECTS}) == len(EFFECTS) == 10
+    assert len({e.name for e in EFFECTS}) == len(EFFECTS) == 11
     for e in EFFECTS:
         on, reason = e.rule(scene())
         assert isinstance(on, bool) and reason and e.physics
@@ -102,7 +102,7 @@ def test_simulate_explain_cli(capsys):
     assert main(["simulate", "--speed-rpm", "3000", "--radial-load-n", "500", "--axial-load-n", "400",
                  "--explain", "--json"]) == 0
     d = json.loads(capsys.readouterr().out)
-    assert d["level"] == "spatial" and len(d["effects"]) == 10
+    assert d["level"] == "spatial" and len(d["effects"]) == 11
     assert main(["simulate", "--speed-rpm", "3000", "--effect", "drag=maybe", "--explain"]) == 2
     assert "write NAME=on or NAME=off" in capsys.readouterr().err
     assert main(["simulate", "--speed-rpm", "3000", "--set", "cho_n_s=1"]) == 2

@@ -88,10 +88,11 @@ def static_deflection(scene: Scene) -> float:
 
 
 def impact_overlap(scene: Scene, k_b: float) -> float:
-    """Largest Hertz overlap (m) of two balls closing head-on at half the pure-rolling orbital speed v:
+    """Largest Hertz overlap (m) of two balls closing head-on at the pure-rolling orbital speed v (a ball
+    driven up to it meeting one still at rest after the packed start):
     delta = (5 m_eff v^2 / (4 K))^(2/5), m_eff = m / 2 (Johnson, *Contact Mechanics*, 1985, §11.4)."""
     g = scene.bearing.geometry
-    v = 0.5 * 0.5 * g.pitch_diameter_m * theoretical_cage_speed(g, scene.conditions.speed_rad_s)
+    v = 0.5 * g.pitch_diameter_m * theoretical_cage_speed(g, scene.conditions.speed_rad_s)
     return float((5 * 0.5 * scene.bearing.masses.ball_mass_kg * v * v / (4 * k_b)) ** 0.4)
 
 
@@ -110,9 +111,11 @@ def test_hard_case_is_stable(name, level):
     c = tr.groups["contacts"]
     overlap = max(np.nanmax(c["inner_normal"] / k_i) ** (2 / 3), np.nanmax(c["outer_normal"] / k_o) ** (2 / 3))
     assert overlap < max(OVERLAP_FACTOR * static_deflection(scene), 2e-6), (overlap, static_deflection(scene))
-    # ball-ball: the same, or the Hertz overlap of a head-on impact closing at half the orbital speed, whichever
+    # ball-ball: the same, or the Hertz overlap of a head-on impact closing at the orbital speed, whichever
     # is larger. With the rolling losses (issue 16) balls leave the loaded zone slowed, and at 12000 rpm the
     # start-up has a 33 um impact (measured; 17 um without the losses): 4.6 m/s closing, 0.4 of the orbital speed.
+    # With the traction by film regime the balls slide more while the film builds in the start-up: 35.7 um at
+    # 6000 rpm (measured, planar and spatial), closing at 0.88 of the orbital speed; the bound was half of it.
     bb = np.nanmax(c["ball_ball_normal"] / k_b) ** (2 / 3)
     assert bb < max(OVERLAP_FACTOR * static_deflection(scene), 2e-6, impact_overlap(scene, k_b)), bb
     # energy balance
