@@ -42,8 +42,9 @@ import numba
 import numpy as np
 
 from cageless.simulation.integrators.dp5 import (STATUS_MAX_STEPS, STATUS_NONFINITE, STATUS_OK,
-                                                 STATUS_STEP_UNDERFLOW, _force_jumped, _hermite)
-from cageless.simulation.kernels import model_post, model_rhs, model_ring_share, model_signature
+                                                 STATUS_STEP_UNDERFLOW, _accept, _controls)
+from cageless.simulation.jacobian import grouped_fd
+from cageless.simulation.kernels import model_rhs, model_signature
 
 __all__ = ["rosw_integrate", "JAC_EVERY", "GAMMA", "transformed_tableau"]
 
@@ -82,55 +83,6 @@ def transformed_tableau() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarra
 
 
 _A, _C, _M, _E, _ALPHA_T = transformed_tableau()
-
-
-@numba.njit(cache=True)
-def _fd_blocks(model_id, t, y, p, log, f0, cols, groups, jb, y_work, f1, floor, ring_rows, js, share0,
-               share1):  # pragma: no cover - compiled
-    """Grouped difference quotients of the blocks: ``jb[b, 0, r, f]`` = d f[cols[r, b]] / d y[cols[f, b]], and
-    with three blocks or more (a ring of balls) ``jb[b, 1]`` and ``jb[b, 2]``, the same against the states of
-    blocks b - 1 and b + 1 (ball-ball contacts join neighbours only). Blocks of one group are at least three
-    apart (:func:`cageless.simulation.jacobian.ball_colours`), so they share no row, and one right-hand side
-    per (field, group) serves them all. The
-    increment of state i is sqrt(eps) max(|y_i|, floor_i), as in CVODE's difference quotients. With
-    ``ring_rows`` (the rows every ball reaches: the ring's accelerations, the energy counters), each
-    perturbed ball's own share of them (:func:`cageless.simulation.kernels.model_ring_share`) gives
-    ``js[b, q, f]`` = d f[ring_rows[q]] / d y[cols[f, b]]."""
-    n_fields, n_ring, nb = cols.shape[0], ring_rows.shape[0], cols.shape[1]
-    srur = np.sqrt(np.finfo(np.float64).eps)
-    for i in range(y.shape[0]):
-        y_work[i] = y[i]
-    if n_ring > 0:
-        for b in range(cols.shape[1]):
-            model_ring_share(model_id, t, y, p, log, b, share0[b])
-    for f in range(n_fields):
-        for g in range(groups.shape[0]):
-            for m in range(groups.shape[1]):
-                b = groups[g, m]
-                if b < 0:
-                    break
-                col = cols[f, b]
-                y_work[col] = y[col] + srur * max(abs(y[col]), floor[col])
-            model_rhs(model_id, t, y_work, p, log, f1)
-            for m in range(groups.shape[1]):
-                b = groups[g, m]
-                if b < 0:
-                    break
-                col = cols[f, b]
-                dh = y_work[col] - y[col]
-                for r in range(n_fields):
-                    jb[b, 0, r, f] = (f1[cols[r, b]] - f0[cols[r, b]]) / dh
-                if nb >= 3:  # the neighbours' rows: ball b is the lower neighbour of b + 1, the upper of b - 1
-                    up, down = (b + 1) % nb, (b - 1 + nb) % nb
-                    for r in range(n_fields):
-                        jb[up, 1, r, f] = (f1[cols[r, up]] - f0[cols[r, up]]) / dh
-                        jb[down, 2, r, f] = (f1[cols[r, down]] - f0[cols[r, down]]) / dh
-                if n_ring > 0:
-                    model_ring_share(model_id, t, y_work, p, log, b, share1)
-                    for q in range(n_ring):
-                        js[b, q, f] = (share1[q] - share0[b, q]) / dh
-                y_work[col] = y[col]
-    return n_fields * groups.shape[0]
 
 
 @numba.njit(cache=True)
@@ -329,24 +281,15 @@ def _solve(st, wk, hg, rhs, out):  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def _jacobian(model_id, t, y, p, log, f0, st, wk, y_work, f1, floor):  # pragma: no cover - compiled
-    """Evaluate W: the ball blocks (grouped) with their coupling to the shared rows, and the ring's columns
-    (one at a time, every row: the ring's own block, the balls' rows E and the counters' rows); returns
-    the right-hand sides used."""
+    """Evaluate W by the grouped difference quotients of :func:`cageless.simulation.jacobian.grouped_fd` in the
+    block layout: the ball blocks with their coupling to the shared rows, and the ring's columns (every row:
+    the ring's own block, the balls' rows E and the counters' rows); returns the right-hand sides used."""
     cols, groups, ring_cols, explicit, ring_rows = st
     jb, lu, piv, jr, lur, pivr, js, share0, share1, x, g, yy, fy, fz, pm, order = wk
-    n_rhs = _fd_blocks(model_id, t, y, p, log, f0, cols, groups, jb, y_work, f1, floor, ring_rows, js, share0,
-                       share1)
+    n_rhs = grouped_fd(model_id, t, y, p, log, f0, cols, groups, ring_rows, ring_cols, floor, y_work, f1, share0,
+                       share1, False, jr[0], jb, js, g)
     _cut(jb, order)
-    srur = np.sqrt(np.finfo(np.float64).eps)
-    for c in range(ring_cols.shape[0]):
-        col = ring_cols[c, 0]
-        y_work[col] = y[col] + srur * max(abs(y[col]), floor[col])
-        model_rhs(model_id, t, y_work, p, log, f1)
-        dh = y_work[col] - y[col]
-        for i in range(y.shape[0]):
-            g[c, i] = (f1[i] - f0[i]) / dh
-        y_work[col] = y[col]
-    return n_rhs + ring_cols.shape[0]
+    return n_rhs
 
 
 @numba.njit(cache=True)
@@ -390,40 +333,8 @@ def _error_norm(y, ynew, err_w, atol, rtol):  # pragma: no cover - compiled
     return np.sqrt(err / n)
 
 
-@numba.njit(cache=True)
-def _controls(model_id, y_new, p, sig, h, h_onset, k1, k7, jump_floor, force_jump):  # pragma: no cover
-    """The contact-onset and force-jump tests of an error-accepted step: (verdict, new signature), verdict
-    0 accept, 1 retry at the onset step (a contact changed in a long step), 2 retry at half the length
-    (a force jumped), 3 accept with a contact change."""
-    verdict = 0
-    sig_new = sig
-    if h_onset > 0.0:
-        sig_new = model_signature(model_id, y_new, p)
-        if sig_new != sig:
-            if h > h_onset:
-                return 1, sig
-            verdict = 3
-    if force_jump > 0.0 and h > h_onset and _force_jumped(k1, k7, jump_floor, force_jump):
-        return 2, sig
-    return verdict, sig_new
-
-
 # Counters of the loop, kept in one integer array so the helpers can update them.
 _STEPS, _REJ, _RHS, _ONSET, _CHANGES, _JUMPS, _JACS = 0, 1, 2, 3, 4, 5, 6
-
-
-@numba.njit(cache=True)
-def _accept(model_id, t, h, y, ynew, k1, k7, p, log, t_out, out, k):  # pragma: no cover - compiled
-    """Write the samples inside (t, t + h], move to the step's end, run the bookkeeping; next sample index."""
-    t_new = t + h
-    while k < t_out.shape[0] and t_out[k] <= t_new:
-        _hermite(t, h, y, ynew, k1, k7, t_out[k], out[k])
-        k += 1
-    for i in range(y.shape[0]):
-        y[i] = ynew[i]
-        k1[i] = k7[i]
-    model_post(model_id, t_new, y, p, log)
-    return k
 
 
 @numba.njit(cache=True)
