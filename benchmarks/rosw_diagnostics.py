@@ -15,7 +15,11 @@ instrumented copy of the method's loop, built here from the method's own compile
   in the last step (by kind: outer race, inner race, ball-ball), two rejections in a row;
 * the cost split: right-hand sides, Jacobian difference quotients (their right-hand sides), block LU
   (``_prepare``), block solves, and the rest (loop, controls, dense output, bookkeeping), from per-call
-  times measured in the same process, multiplied by the counts, against the measured wall time.
+  times measured in the same process, multiplied by the counts, against the run's time.
+
+Times are the process's CPU time (``time.process_time``), steadier than wall time on a shared machine; they
+are still noisy there (the per-call times are measured separately from the run, so the split's rest can
+come out negative).
 
 The instrumented loop lives here, not in the method: the method's hot loop keeps no counters beyond its
 statistics.
@@ -48,12 +52,13 @@ W_NONE, W_AGE, W_CONTACT, W_REJECT = 0, 1, 2, 3
 
 @numba.njit(cache=False)
 def _traced(model_id, p, log_, y0, t0, t_end, rtol, atol, h0, h_max, max_att, h_onset, jump_floor, force_jump, st,
-            jac_every, rec, kinds, n_gaps):  # pragma: no cover - compiled
+            jac_every, lu_ratio, rec, kinds, n_gaps, counts):  # pragma: no cover - compiled
     """The loop of :func:`rw.rosw_integrate` (no samples) recording per attempt: t, h, err, outcome, W reason.
     ``kinds`` counts the contacts that changed in accepted steps by gap index."""
     vec, u, wk = rw._workspace(y0.shape[0], st[0], st[2], st[4])
     y, k1, k7, ynew = vec[0], vec[1], vec[2], vec[5]
-    cnt = np.zeros(7, dtype=np.int64)
+    cnt = np.zeros(8, dtype=np.int64)
+    lu_at = np.zeros(1)
     t_out = np.array([t_end])
     out = np.zeros((1, y0.shape[0]))
     rw._start(model_id, t0, y0, p, log_, t_out, out, atol, rtol, vec)
@@ -67,7 +72,7 @@ def _traced(model_id, p, log_, y0, t0, t_end, rtol, atol, h0, h_max, max_att, h_
     while t < t_end and n < max_att:
         h = min(h, h_max, t_end - t)
         fresh = 0 < jac_every <= age
-        err = rw._step(model_id, t, h, p, log_, atol, rtol, vec, u, st, wk, fresh, cnt)
+        err = rw._step(model_id, t, h, p, log_, atol, rtol, vec, u, st, wk, fresh, cnt, lu_at, lu_ratio)
         rec[n, 0], rec[n, 1], rec[n, 2], rec[n, 4] = t, h, err, reason if fresh else W_NONE
         if fresh:
             age = 0
@@ -104,6 +109,7 @@ def _traced(model_id, p, log_, y0, t0, t_end, rtol, atol, h0, h_max, max_att, h_
         rw._accept(model_id, t, h, y, ynew, k1, k7, p, log_, t_out, out, 0)
         t += h
         h *= min(grow, max(0.2, 0.9 * max(err, 1e-10) ** (-1.0 / 3.0)))
+    counts[:] = cnt
     return n
 
 
@@ -114,33 +120,34 @@ def _time_pieces(model_id, t, y, p, log_, atol, rtol, st, h, reps, out):  # prag
     rw._start(model_id, t, y, p, log_, np.array([t + 1.0]), np.zeros((1, y.shape[0])), atol, rtol, vec)
     f = np.zeros(y.shape[0])
     with numba.objmode(a="f8"):
-        a = time.perf_counter()
+        a = time.process_time()
     for _ in range(reps):
         model_rhs(model_id, t, vec[0], p, log_, f)
     with numba.objmode(b="f8"):
-        b = time.perf_counter()
+        b = time.process_time()
     out[0] = (b - a) / reps
     n_rhs = 0
     for _ in range(reps // 20 + 1):
         n_rhs = rw._jacobian(model_id, t, vec[0], p, log_, vec[1], st, wk, vec[7], vec[8], vec[9])
     with numba.objmode(c="f8"):
-        c = time.perf_counter()
+        c = time.process_time()
     out[1] = (c - b) / (reps // 20 + 1)
     out[5] = n_rhs
     for _ in range(reps):
         rw._prepare(st, wk, 1.0 / (h * rw.GAMMA))
     with numba.objmode(d="f8"):
-        d = time.perf_counter()
+        d = time.process_time()
     out[2] = (d - c) / reps
     for _ in range(reps):
         vec[4, :] = vec[1]
         rw._solve(st, wk, h * rw.GAMMA, vec[4], vec[6])
     with numba.objmode(e="f8"):
-        e = time.perf_counter()
+        e = time.process_time()
     out[3] = (e - d) / reps
 
 
-def diagnose(level: str, window: float, rtol: float, jac_every: int, trace: Path | None = None) -> dict[str, Any]:
+def diagnose(level: str, window: float, rtol: float, jac_every: int, lu_ratio: float = rw.LU_RATIO,
+             trace: Path | None = None) -> dict[str, Any]:
     """Run the instrumented loop over ``window`` and return the numbers (see the module text)."""
     pr, _ = _settled_problem(3000, 500, 0.03, axial_n=400 if level == "spatial" else 0.0, level=level, strips=5)
     atol = pr.atol.astype(np.float64) * (ROSW_ATOL_FACTOR * rtol / 1e-6)
@@ -156,11 +163,13 @@ def diagnose(level: str, window: float, rtol: float, jac_every: int, trace: Path
     for attempt in range(2):  # the first call compiles
         rec = np.zeros((max_att, 5))
         kinds = np.zeros(n_gaps, dtype=np.int64)
+        counts = np.zeros(8, dtype=np.int64)
         logc = pr.log.copy()
-        start = time.perf_counter()
+        start = time.process_time()
         n = _traced(pr.model_id, pr.params, logc, pr.y0.astype(np.float64), 0.0, window, rtol, atol, window * 1e-3,
-                    cap, max_att, float(pr.onset_step), floor, FORCE_JUMP, st, jac_every, rec, kinds, n_gaps)
-        results = {"wall": time.perf_counter() - start, "rec": rec[:n].copy(), "kinds": kinds}
+                    cap, max_att, float(pr.onset_step), floor, FORCE_JUMP, st, jac_every, lu_ratio, rec, kinds, n_gaps,
+                    counts)
+        results = {"wall": time.process_time() - start, "rec": rec[:n].copy(), "kinds": kinds, "n_lu": int(counts[7])}
     rec, wall = results["rec"], results["wall"]
     pieces = np.zeros(6)
     acc = rec[:, 3] == ACCEPT
@@ -186,7 +195,7 @@ def diagnose(level: str, window: float, rtol: float, jac_every: int, trace: Path
     solves_per_attempt = 4 + int(rw.FILTER_ERROR)
     cost = {"right-hand sides (stages, step ends)": n_rhs_stage * t_rhs,
             "W evaluations (difference quotients)": n_w * t_jac,
-            "block LU (per attempt)": n_att * t_lu,
+            "block LU": results["n_lu"] * t_lu,
             "block solves": n_att * solves_per_attempt * t_solve}
     cost["rest (loop, controls, dense output, bookkeeping)"] = wall - sum(cost.values())
     edges = np.array([0, 0.25, 0.5, 1, 2, 3, 4, 5, 6, 8, 10.001]) * 1e-6
@@ -194,7 +203,8 @@ def diagnose(level: str, window: float, rtol: float, jac_every: int, trace: Path
     if trace is not None:
         np.save(trace, rec)
     return {"level": level, "window_s": window, "rtol": rtol, "jac_every": jac_every, "wall_s": wall,
-            "wall_s_per_sim_s": wall / window, "attempts": n_att, "accepted": n_acc,
+            "wall_s_per_sim_s": wall / window, "attempts": n_att, "factorisations": results["n_lu"],
+            "lu_ratio": lu_ratio, "accepted": n_acc,
             "onset_step_us": pr.onset_step * 1e6, "median_h_us": h_med * 1e6,
             "mean_h_us": float(rec[acc, 1].mean() * 1e6), "outcomes": outcomes, "w_evaluations": n_w,
             "w_reasons": w_reasons, "contact_changes": changes,
@@ -207,15 +217,15 @@ def diagnose(level: str, window: float, rtol: float, jac_every: int, trace: Path
 def format_report(d: dict[str, Any]) -> str:
     """The numbers as text tables."""
     lines = [f"rosw, {d['level']}, 3000 rpm, 500 N, {d['window_s'] * 1e3:g} ms, rtol {d['rtol']:g}, "
-             f"jac_every {d['jac_every']}: {d['wall_s_per_sim_s']:.2f} wall s / sim s",
+             f"jac_every {d['jac_every']}, lu_ratio {d['lu_ratio']:g}: {d['wall_s_per_sim_s']:.2f} CPU s / sim s",
              f"attempts {d['attempts']}, accepted {d['accepted']}, mean h {d['mean_h_us']:.2f} us, "
              f"median h {d['median_h_us']:.2f} us, onset step {d['onset_step_us']:.2f} us",
              "outcomes: " + ", ".join(f"{k} {v}" for k, v in d["outcomes"].items()),
-             f"W evaluations {d['w_evaluations']}: " + ", ".join(f"{k} {v}" for k, v in d["w_reasons"].items()),
+             f"factorisations {d['factorisations']}, W evaluations {d['w_evaluations']}: " + ", ".join(f"{k} {v}" for k, v in d["w_reasons"].items()),
              "contact changes in accepted steps: " + ", ".join(f"{k} {v}" for k, v in d["contact_changes"].items()),
              "per call (us): " + ", ".join(f"{k} {v:.3g}" for k, v in d["per_call_us"].items()),
              "accepted step lengths (us): " + ", ".join(f"{k}: {v}" for k, v in d["h_hist_us"].items()),
-             "| cost | wall s | share |", "|---|---|---|"]
+             "| cost | CPU s | share |", "|---|---|---|"]
     for k, v in d["cost_s"].items():
         lines.append(f"| {k} | {v:.3f} | {100 * v / d['wall_s']:.0f} % |")
     return "\n".join(lines)
@@ -227,11 +237,12 @@ def main() -> None:
     ap.add_argument("--level", default="planar", choices=("planar", "spatial"))
     ap.add_argument("--rtol", type=float, default=1e-7)
     ap.add_argument("--jac-every", type=int, default=rw.JAC_EVERY)
+    ap.add_argument("--lu-ratio", type=float, default=rw.LU_RATIO)
     ap.add_argument("--json", type=Path)
     ap.add_argument("--trace", type=Path, help="save every attempt (t, h, err, outcome, W reason) as .npy")
     args = ap.parse_args()
     logging.basicConfig(level=logging.INFO, format="%(message)s")
-    d = diagnose(args.level, args.window, args.rtol, args.jac_every, args.trace)
+    d = diagnose(args.level, args.window, args.rtol, args.jac_every, args.lu_ratio, args.trace)
     print(format_report(d))
     if args.json:
         tmp = args.json.with_suffix(".tmp")
