@@ -120,11 +120,13 @@ def _compiled(name: str, integrate: Callable[..., int]) -> Callable[..., Solutio
     return run
 
 
-def _rosw_blocks(pr: Problem, ring_implicit: bool = True) -> tuple[npt.NDArray[np.int64], ...]:
+def _rosw_blocks(pr: Problem, ring_implicit: bool = True,
+                 ring_coupling: bool = True) -> tuple[npt.NDArray[np.int64], ...]:
     """The blocks the Rosenbrock-W method treats implicitly, from the problem's Jacobian structure
     (:class:`~cageless.simulation.jacobian.JacobianStructure`): each ball's states (grouped by colour), the
-    ring's states (explicit with ``ring_implicit`` False), the rows every ball reaches, and the rest explicit.
-    A model without a structure is one dense block."""
+    ring's states (explicit with ``ring_implicit`` False), the rows every ball reaches (none with
+    ``ring_coupling`` False: W then keeps the balls' blocks and the ring's own block, without their coupling),
+    and the rest explicit. A model without a structure is one dense block."""
     structure = JacobianStructure.for_problem(pr)
     n = len(pr.y0)
     none = np.zeros(0, dtype=np.int64)
@@ -135,8 +137,9 @@ def _rosw_blocks(pr: Problem, ring_implicit: bool = True) -> tuple[npt.NDArray[n
     if not ring_implicit:
         ring = ring[:0]
     explicit = np.setdiff1d(np.arange(n), np.concatenate([structure.ball_cols.ravel(), ring.ravel()]))
+    ring_rows = structure.ring_rows.astype(np.int64) if ring_coupling else none
     return (structure.ball_cols.astype(np.int64), structure.groups.astype(np.int64), ring, explicit.astype(np.int64),
-            structure.ring_rows.astype(np.int64))
+            ring_rows)
 
 
 #: The Rosenbrock-W method's absolute tolerances: the problem's times this factor times rtol / 1e-6, so one rtol
@@ -149,12 +152,12 @@ ROSW_ATOL_FACTOR = 1e-2
 
 def _rosw(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float, first_step: float | None,
           max_steps: int, force_jump: float, jac_every: int = JAC_EVERY, lu_ratio: float = LU_RATIO,
-          ring_implicit: bool = True) -> Solution:
+          ring_implicit: bool = True, ring_coupling: bool = True) -> Solution:
     """The compiled Rosenbrock-W method (:mod:`cageless.simulation.integrators.rosw`), with absolute tolerances
     scaled by :data:`ROSW_ATOL_FACTOR` and rtol."""
     atol = pr.atol.astype(np.float64) * (ROSW_ATOL_FACTOR * rtol / 1e-6)
     sol, stats = _run_compiled("rosw", rosw_integrate, pr, t_eval, rtol, atol, max_step, first_step, max_steps,
-                               force_jump, 10, _rosw_blocks(pr, ring_implicit), int(jac_every), float(lu_ratio))
+                               force_jump, 10, _rosw_blocks(pr, ring_implicit, ring_coupling), int(jac_every), float(lu_ratio))
     sol.extra["n_jacobians"] = int(stats[8])
     sol.extra["n_factorisations"] = int(stats[9])
     return sol

@@ -246,14 +246,17 @@ def _block_solve(lu, piv, cols, rhs, out, x):  # pragma: no cover - compiled
 def _prepare(st, wk, inv_hg):  # pragma: no cover - compiled
     """Factorise I / (h gamma) - W for a step: the ball blocks, then the Schur complement on the ring's states,
     S = I / (h gamma) - R - F Y with Y = (I / (h gamma) - B)^-1 E (E: the balls' rows in the ring's columns,
-    F: the ring's rows in the balls' columns)."""
+    F: the ring's rows in the balls' columns). Without shared rows (``ring_rows`` empty: W without the
+    coupling of balls and ring, see :func:`cageless.simulation.solve._rosw_blocks`) E is left out too: Y = 0,
+    S = I / (h gamma) - R."""
     cols, groups, ring_cols, explicit, ring_rows = st
     jb, lu, piv, jr, lur, pivr, js, share0, share1, x, g, yy, fy, fz, pm, order, nz = wk
     _ball_factor(jb, inv_hg, lu, piv, pm, order, x, nz)
     nr = ring_cols.shape[0]
     for c in range(nr):
         yy[c, :] = 0.0
-        _ball_solve(lu, piv, pm, jb, order, cols, g[c], yy[c], x, nz)
+        if ring_rows.shape[0] > 0:
+            _ball_solve(lu, piv, pm, jb, order, cols, g[c], yy[c], x, nz)
         fy[c, :] = 0.0
         for q in range(ring_rows.shape[0]):
             acc = 0.0
@@ -288,7 +291,7 @@ def _solve(st, wk, hg, rhs, out):  # pragma: no cover - compiled
         for r in range(nr):
             rhs[ring_cols[r, 0]] += fz[ring_cols[r, 0]]
         _block_solve(lur, pivr, ring_cols, rhs, out, x)
-        for c in range(nr):
+        for c in range(nr if ring_rows.shape[0] > 0 else 0):  # Y = 0 without shared rows
             ur = out[ring_cols[c, 0]]
             for b in range(cols.shape[1]):
                 for f in range(cols.shape[0]):
