@@ -145,8 +145,10 @@ def _rosw_blocks(pr: Problem, ring_implicit: bool = True,
 #: The Rosenbrock-W method's absolute tolerances: the problem's times this factor times rtol / 1e-6, so one rtol
 #: moves both. Its steps are set by its error test, and at the problem's own atol (which the explicit DP5 runs
 #: far below, held by stability) that test admits 0.036 pp of slip error over 5 ms at 3000 rpm, 500 N
-#: (planar, from a settled state); at this factor 0.036 pp at rtol 1e-6, 2.5e-3 pp at 1e-7, 2.2e-4 pp at 1e-8
-#: (benchmarks/solver_speed.py).
+#: (planar, from a settled state); at this factor, with the error filter (see
+#: :data:`cageless.simulation.integrators.rosw.FILTER_ERROR`), 0.036 pp at rtol 1e-6, 2.5e-3 pp at 1e-7, 2.2e-4 pp
+#: at 1e-8 (benchmarks/solver_speed.py); on today's physics without the filter 2.3e-3 pp at 1e-6, 9.6e-4 pp at
+#: 3e-7, 4.5e-4 pp at 1e-7.
 ROSW_ATOL_FACTOR = 1e-2
 
 
