@@ -40,7 +40,7 @@ from cageless.simulation.kernels import PLANAR, SPATIAL, model_rhs, model_ring_s
 from cageless.simulation.models import planar, spatial
 from cageless.simulation.problem import Problem
 
-__all__ = ["JacobianStructure", "ball_colours", "dense_fd_jacobian"]
+__all__ = ["JacobianStructure", "ball_colours", "dense_fd_jacobian", "grouped_fd"]
 
 IntArray = npt.NDArray[np.int64]
 FloatArray = npt.NDArray[np.float64]
@@ -67,15 +67,28 @@ def ball_colours(n_balls: int) -> IntArray:
 
 
 @numba.njit(cache=True)
-def _structured_fd(model_id, t, y, p, log, ball_cols, groups, ring_rows, other_cols, floor, jac,
-                   y_work, f0, f1, share0, share1):  # pragma: no cover - compiled
-    """Fill ``jac`` (n x n, dense storage) with the grouped difference quotients."""
+def grouped_fd(model_id, t, y, p, log, f0, ball_cols, groups, ring_rows, ring_cols, floor, y_work, f1, share0,
+               share1, dense, jac, jb, js, g):  # pragma: no cover - compiled
+    """The grouped difference quotients at (t, y), f0 = f(t, y), written in one of two layouts; returns the
+    right-hand sides used (one per (field, colour) and one per ring state; f0 and the shares not counted).
+
+    The increment of state i is sqrt(eps) max(|y_i|, floor_i), as in CVODE's difference quotients.
+    Columns of ball j (``ball_cols[:, j]``) reach the rows of balls j - 1, j, j + 1 and, through ball j's own
+    share (:func:`cageless.simulation.kernels.model_ring_share`), the ``ring_rows``; the ring's columns
+    (``ring_cols[:, 0]``) are estimated one at a time and reach every row.
+
+    ``dense``: into ``jac`` (n x n; entries outside the structure are left as they are). Otherwise the
+    Rosenbrock-W method's blocks (:mod:`cageless.simulation.integrators.rosw`): ``jb[j, 0, r, f]`` = d f[ball_cols[r,
+    j]] / d y[ball_cols[f, j]], and with three balls or more ``jb[j, 1]`` and ``jb[j, 2]``, the same against the
+    states of balls j - 1 and j + 1; ``js[j, q, f]`` = d f[ring_rows[q]] / d y[ball_cols[f, j]];
+    ``g[c, i]`` = d f[i] / d y[ring_cols[c, 0]]. The unused layout's arrays may be any size.
+    """
     n, n_fields, z, n_ring = y.shape[0], ball_cols.shape[0], ball_cols.shape[1], ring_rows.shape[0]
-    jac[:, :] = 0.0
-    model_rhs(model_id, t, y, p, log, f0)
-    for j in range(z):
-        model_ring_share(model_id, t, y, p, log, j, share0[j])
-    y_work[:] = y
+    for i in range(n):
+        y_work[i] = y[i]
+    if n_ring > 0:
+        for j in range(z):
+            model_ring_share(model_id, t, y, p, log, j, share0[j])
     for f in range(n_fields):
         for c in range(groups.shape[0]):
             for m in range(groups.shape[1]):
@@ -91,23 +104,60 @@ def _structured_fd(model_id, t, y, p, log, ball_cols, groups, ring_rows, other_c
                     break
                 col = ball_cols[f, j]
                 h = y_work[col] - y[col]  # the increment as stored, so the quotient is exact in it
-                for dj in (-1, 0, 1):
-                    jj = (j + dj + z) % z
-                    for ff in range(n_fields):
-                        row = ball_cols[ff, jj]
-                        jac[row, col] = (f1[row] - f0[row]) / h
-                model_ring_share(model_id, t, y_work, p, log, j, share1)
-                for q in range(n_ring):
-                    jac[ring_rows[q], col] = (share1[q] - share0[j, q]) / h
+                _ball_columns(ball_cols, f0, f1, j, f, h, dense, jac, jb)
+                if n_ring > 0:
+                    model_ring_share(model_id, t, y_work, p, log, j, share1)
+                    for q in range(n_ring):
+                        d = (share1[q] - share0[j, q]) / h
+                        if dense:
+                            jac[ring_rows[q], col] = d
+                        else:
+                            js[j, q, f] = d
                 y_work[col] = y[col]
-    for k in range(other_cols.shape[0]):
-        col = other_cols[k]
+    for c in range(ring_cols.shape[0]):
+        col = ring_cols[c, 0]
         y_work[col] = y[col] + _SRUR * max(abs(y[col]), floor[col])
         h = y_work[col] - y[col]
         model_rhs(model_id, t, y_work, p, log, f1)
         for i in range(n):
-            jac[i, col] = (f1[i] - f0[i]) / h
+            d = (f1[i] - f0[i]) / h
+            if dense:
+                jac[i, col] = d
+            else:
+                g[c, i] = d
         y_work[col] = y[col]
+    return n_fields * groups.shape[0] + ring_cols.shape[0]
+
+
+@numba.njit(cache=True, inline="always")
+def _ball_columns(ball_cols, f0, f1, j, f, h, dense, jac, jb):  # pragma: no cover - compiled
+    """Field f of ball j's column: the rows of balls j - 1, j and j + 1 (see :func:`grouped_fd`)."""
+    n_fields, z = ball_cols.shape[0], ball_cols.shape[1]
+    col = ball_cols[f, j]
+    if dense:
+        for dj in (-1, 0, 1):
+            jj = (j + dj + z) % z
+            for ff in range(n_fields):
+                row = ball_cols[ff, jj]
+                jac[row, col] = (f1[row] - f0[row]) / h
+        return
+    for r in range(n_fields):
+        jb[j, 0, r, f] = (f1[ball_cols[r, j]] - f0[ball_cols[r, j]]) / h
+    if z >= 3:  # the neighbours' rows: ball j is the lower neighbour of j + 1, the upper of j - 1
+        up, down = (j + 1) % z, (j - 1 + z) % z
+        for r in range(n_fields):
+            jb[up, 1, r, f] = (f1[ball_cols[r, up]] - f0[ball_cols[r, up]]) / h
+            jb[down, 2, r, f] = (f1[ball_cols[r, down]] - f0[ball_cols[r, down]]) / h
+
+
+@numba.njit(cache=True)
+def _structured_fd(model_id, t, y, p, log, ball_cols, groups, ring_rows, ring_cols, floor, jac,
+                   y_work, f0, f1, share0, share1, unused):  # pragma: no cover - compiled
+    """Fill ``jac`` (n x n, dense storage) with the grouped difference quotients (zero outside the structure)."""
+    jac[:, :] = 0.0
+    model_rhs(model_id, t, y, p, log, f0)
+    grouped_fd(model_id, t, y, p, log, f0, ball_cols, groups, ring_rows, ring_cols, floor, y_work, f1, share0,
+               share1, True, jac, unused[0], unused[1], unused[2])
 
 
 @dataclass(frozen=True)
@@ -177,12 +227,13 @@ class JacobianStructure:
         work = [np.empty(n) for _ in range(4)]  # y copy (CVODE's y is read-only), perturbed y, f0, f1
         share0, share1 = np.empty((self.ball_cols.shape[1], g)), np.empty(g)
         floor = np.ascontiguousarray(floor, dtype=np.float64)
+        ring_cols = np.ascontiguousarray(self.other_cols.reshape(-1, 1))
+        unused = (np.zeros((1, 1, 1, 1)), np.zeros((1, 1, 1)), np.zeros((1, 1)))  # the block layout's arrays
 
         def evaluate(t: float, y: FloatArray, jac: FloatArray) -> None:
             work[3][:] = y
             _structured_fd(problem.model_id, float(t), work[3], problem.params, log, self.ball_cols, self.groups,
-                           self.ring_rows, self.other_cols, floor, jac, work[0], work[1], work[2],
-                           share0, share1)
+                           self.ring_rows, ring_cols, floor, jac, work[0], work[1], work[2], share0, share1, unused)
 
         return evaluate
 

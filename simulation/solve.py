@@ -43,7 +43,7 @@ from scipy.integrate import BDF, DOP853, LSODA, RK45, Radau
 
 from cageless.errors import ParameterError, suggest
 from cageless.simulation.integrators.dp5 import STATUS_OK, dp5_integrate
-from cageless.simulation.integrators.rosw import JAC_EVERY, rosw_integrate
+from cageless.simulation.integrators.rosw import JAC_EVERY, LU_RATIO, rosw_integrate
 from cageless.simulation.jacobian import JacobianStructure
 from cageless.simulation.kernels import model_gaps, model_post, model_rhs
 from cageless.simulation.problem import Problem
@@ -120,11 +120,13 @@ def _compiled(name: str, integrate: Callable[..., int]) -> Callable[..., Solutio
     return run
 
 
-def _rosw_blocks(pr: Problem) -> tuple[npt.NDArray[np.int64], ...]:
+def _rosw_blocks(pr: Problem, ring_implicit: bool = True,
+                 ring_coupling: bool = True) -> tuple[npt.NDArray[np.int64], ...]:
     """The blocks the Rosenbrock-W method treats implicitly, from the problem's Jacobian structure
     (:class:`~cageless.simulation.jacobian.JacobianStructure`): each ball's states (grouped by colour), the
-    ring's states, the rows every ball reaches, and the rest explicit. A model without a structure is one
-    dense block."""
+    ring's states (explicit with ``ring_implicit`` False), the rows every ball reaches (none with
+    ``ring_coupling`` False: W then keeps the balls' blocks and the ring's own block, without their coupling),
+    and the rest explicit. A model without a structure is one dense block."""
     structure = JacobianStructure.for_problem(pr)
     n = len(pr.y0)
     none = np.zeros(0, dtype=np.int64)
@@ -132,27 +134,34 @@ def _rosw_blocks(pr: Problem) -> tuple[npt.NDArray[np.int64], ...]:
         return (np.arange(n, dtype=np.int64).reshape(n, 1), np.zeros((1, 1), dtype=np.int64),
                 np.zeros((0, 1), dtype=np.int64), none, none)
     ring = structure.other_cols.reshape(-1, 1).astype(np.int64)
+    if not ring_implicit:
+        ring = ring[:0]
     explicit = np.setdiff1d(np.arange(n), np.concatenate([structure.ball_cols.ravel(), ring.ravel()]))
+    ring_rows = structure.ring_rows.astype(np.int64) if ring_coupling else none
     return (structure.ball_cols.astype(np.int64), structure.groups.astype(np.int64), ring, explicit.astype(np.int64),
-            structure.ring_rows.astype(np.int64))
+            ring_rows)
 
 
 #: The Rosenbrock-W method's absolute tolerances: the problem's times this factor times rtol / 1e-6, so one rtol
 #: moves both. Its steps are set by its error test, and at the problem's own atol (which the explicit DP5 runs
 #: far below, held by stability) that test admits 0.036 pp of slip error over 5 ms at 3000 rpm, 500 N
-#: (planar, from a settled state); at this factor 0.036 pp at rtol 1e-6, 2.5e-3 pp at 1e-7, 2.2e-4 pp at 1e-8
-#: (benchmarks/solver_speed.py).
+#: (planar, from a settled state); at this factor, with the error filter (see
+#: :data:`cageless.simulation.integrators.rosw.FILTER_ERROR`), 0.036 pp at rtol 1e-6, 2.5e-3 pp at 1e-7, 2.2e-4 pp
+#: at 1e-8 (benchmarks/solver_speed.py); on today's physics without the filter 2.3e-3 pp at 1e-6, 9.6e-4 pp at
+#: 3e-7, 4.5e-4 pp at 1e-7.
 ROSW_ATOL_FACTOR = 1e-2
 
 
 def _rosw(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float, first_step: float | None,
-          max_steps: int, force_jump: float, jac_every: int = JAC_EVERY) -> Solution:
+          max_steps: int, force_jump: float, jac_every: int = JAC_EVERY, lu_ratio: float = LU_RATIO,
+          ring_implicit: bool = True, ring_coupling: bool = True) -> Solution:
     """The compiled Rosenbrock-W method (:mod:`cageless.simulation.integrators.rosw`), with absolute tolerances
     scaled by :data:`ROSW_ATOL_FACTOR` and rtol."""
     atol = pr.atol.astype(np.float64) * (ROSW_ATOL_FACTOR * rtol / 1e-6)
     sol, stats = _run_compiled("rosw", rosw_integrate, pr, t_eval, rtol, atol, max_step, first_step, max_steps,
-                               force_jump, 9, _rosw_blocks(pr), int(jac_every))
+                               force_jump, 10, _rosw_blocks(pr, ring_implicit, ring_coupling), int(jac_every), float(lu_ratio))
     sol.extra["n_jacobians"] = int(stats[8])
+    sol.extra["n_factorisations"] = int(stats[9])
     return sol
 
 

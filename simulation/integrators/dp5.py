@@ -43,6 +43,10 @@ B1, B3, B4, B5, B6 = 35 / 384, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84
 E1, E3, E4, E5, E6, E7 = 71 / 57600, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40
 
 
+# Counters of the loop, kept in one integer array so the helpers can update them; their order is ``stats``'.
+_STEPS, _REJ, _RHS, _ONSET, _CHANGES, _JUMPS, _STIFF = 0, 1, 2, 4, 5, 6, 7
+
+
 @numba.njit(cache=True)
 def dp5_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_steps, out, stats, h_onset,
                   jump_floor, force_jump):
@@ -62,133 +66,166 @@ def dp5_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_st
     """  # noqa: D401
     n = y0.shape[0]
     y = y0.copy()
-    k1 = np.empty(n)
-    k2 = np.empty(n)
-    k3 = np.empty(n)
-    k4 = np.empty(n)
-    k5 = np.empty(n)
-    k6 = np.empty(n)
-    k7 = np.empty(n)
+    ks = np.empty((7, n))  # the stages k1 .. k7
     yt = np.empty(n)
     ynew = np.empty(n)
+    cnt = np.zeros(8, dtype=np.int64)
     t = t0
-    model_rhs(model_id, t, y, p, log, k1)
+    model_rhs(model_id, t, y, p, log, ks[0])
+    cnt[_RHS] = 1
     sig = model_signature(model_id, y, p) if h_onset > 0.0 else 0.0
-    n_onset = 0
-    n_jumps = 0
-    n_stiff = 0
-    n_changes = 0
-    n_rhs = 1
-    n_steps = 0
-    n_rej = 0
     h = h0
     err_old = 1e-4
-    k = 0
-    while k < t_out.shape[0] and t_out[k] <= t:
-        out[k, :] = y
-        k += 1
+    k = _samples_before(t_out, t, y, out)
     status = STATUS_OK
     t_end = t_out[t_out.shape[0] - 1]
     tiny = 1e-13 * max(abs(t_end), t_end - t0)  # round-off scale of the time axis
     while k < t_out.shape[0]:
-        if n_steps + n_rej >= max_steps:
+        if cnt[_STEPS] + cnt[_REJ] >= max_steps:
             status = STATUS_MAX_STEPS
             break
         if t_end - t <= tiny:  # only round-off left: the remaining samples are the current state
-            while k < t_out.shape[0]:
-                out[k, :] = y
-                k += 1
+            out[k:, :] = y
             break
         h = min(h, h_max, t_end - t)
         if h < tiny:
             status = STATUS_STEP_UNDERFLOW
             break
-        for i in range(n):
-            yt[i] = y[i] + h * A21 * k1[i]
-        model_rhs(model_id, t + C2 * h, yt, p, log, k2)
-        for i in range(n):
-            yt[i] = y[i] + h * (A31 * k1[i] + A32 * k2[i])
-        model_rhs(model_id, t + C3 * h, yt, p, log, k3)
-        for i in range(n):
-            yt[i] = y[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
-        model_rhs(model_id, t + C4 * h, yt, p, log, k4)
-        for i in range(n):
-            yt[i] = y[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
-        model_rhs(model_id, t + C5 * h, yt, p, log, k5)
-        for i in range(n):
-            yt[i] = y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i])
-        model_rhs(model_id, t + h, yt, p, log, k6)
-        for i in range(n):
-            ynew[i] = y[i] + h * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
-        model_rhs(model_id, t + h, ynew, p, log, k7)
-        n_rhs += 6
-        err = 0.0
-        finite = True
-        for i in range(n):
-            e = h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i])
-            sc = atol[i] + rtol * max(abs(y[i]), abs(ynew[i]))
-            err += (e / sc) ** 2
-            if not np.isfinite(ynew[i]):
-                finite = False
-        err = np.sqrt(err / n)
-        if not finite or not np.isfinite(err):
+        _dp5_stages(model_id, t, h, y, p, log, ks, yt, ynew)
+        cnt[_RHS] += 6
+        err = _dp5_error(h, y, ynew, ks, atol, rtol)
+        if not np.isfinite(err):
             h *= 0.25
-            n_rej += 1
+            cnt[_REJ] += 1
             if h < tiny:
                 status = STATUS_NONFINITE
                 break
             continue
         fac11 = err ** 0.17  # 0.2 - 0.75 beta, beta = 0.04
-        if err <= 1.0 and h_onset > 0.0:
-            sig_new = model_signature(model_id, ynew, p)
-            if sig_new != sig:
-                if h > h_onset:
-                    n_onset += 1
-                    n_rej += 1
-                    h = h_onset
-                    continue
-                n_changes += 1
-                sig = sig_new
-        if err <= 1.0 and force_jump > 0.0 and h > h_onset:
-            if _force_jumped(k1, k7, jump_floor, force_jump):
-                n_jumps += 1
-                n_rej += 1
-                h = max(0.5 * h, h_onset)
-                continue
-        if err <= 1.0:
-            num = 0.0
-            den = 0.0
-            for i in range(n):
-                num += (k7[i] - k6[i]) ** 2
-                den += (ynew[i] - yt[i]) ** 2
-            if den > 0.0 and h * h * num > 3.25 * 3.25 * den:
-                n_stiff += 1
-            fac = fac11 / err_old ** 0.04
-            fac = max(0.1, min(5.0, fac / 0.9))
-            t_new = t + h
-            while k < t_out.shape[0] and t_out[k] <= t_new:
-                _hermite(t, h, y, ynew, k1, k7, t_out[k], out[k])
-                k += 1
-            err_old = max(err, 1e-4)
-            t = t_new
-            for i in range(n):
-                y[i] = ynew[i]
-                k1[i] = k7[i]
-            n_steps += 1
-            model_post(model_id, t, y, p, log)
-            h = h / fac
-        else:
-            n_rej += 1
+        if err > 1.0:
+            cnt[_REJ] += 1
             h = h / min(5.0, fac11 / 0.9)
-    stats[0] = n_steps
-    stats[1] = n_rej
-    stats[2] = n_rhs
-    stats[3] = h
-    stats[4] = n_onset
-    stats[5] = n_changes
-    stats[6] = n_jumps
-    stats[7] = n_stiff
+            continue
+        verdict, sig = _controls(model_id, ynew, p, sig, h, h_onset, ks[0], ks[6], jump_floor, force_jump)
+        if verdict == 1 or verdict == 2:  # a contact changed in a long step, or a force jumped
+            cnt[_REJ] += 1
+            cnt[_ONSET if verdict == 1 else _JUMPS] += 1
+            h = h_onset if verdict == 1 else max(0.5 * h, h_onset)
+            continue
+        cnt[_CHANGES] += verdict == 3
+        cnt[_STIFF] += _stiff(h, ks, ynew, yt)
+        fac = fac11 / err_old ** 0.04
+        fac = max(0.1, min(5.0, fac / 0.9))
+        err_old = max(err, 1e-4)
+        k = _accept(model_id, t, h, y, ynew, ks[0], ks[6], p, log, t_out, out, k)
+        t = t + h
+        cnt[_STEPS] += 1
+        h = h / fac
+    _write_stats(stats, cnt, h)
     return status
+
+
+@numba.njit(cache=True)
+def _samples_before(t_out, t, y, out):  # pragma: no cover - compiled
+    """Write the samples at or before ``t`` (the start) as ``y``; the next sample index."""
+    k = 0
+    while k < t_out.shape[0] and t_out[k] <= t:
+        out[k, :] = y
+        k += 1
+    return k
+
+
+@numba.njit(cache=True)
+def _dp5_stages(model_id, t, h, y, p, log, ks, yt, ynew):  # pragma: no cover - compiled
+    """The stages k2 .. k7 of one step of length h from (t, y) with ks[0] = f(y): the new state into ``ynew``,
+    its derivative into ks[6] (FSAL); ``yt`` is left holding the sixth stage's state."""
+    n = y.shape[0]
+    for i in range(n):
+        yt[i] = y[i] + h * A21 * ks[0, i]
+    model_rhs(model_id, t + C2 * h, yt, p, log, ks[1])
+    for i in range(n):
+        yt[i] = y[i] + h * (A31 * ks[0, i] + A32 * ks[1, i])
+    model_rhs(model_id, t + C3 * h, yt, p, log, ks[2])
+    for i in range(n):
+        yt[i] = y[i] + h * (A41 * ks[0, i] + A42 * ks[1, i] + A43 * ks[2, i])
+    model_rhs(model_id, t + C4 * h, yt, p, log, ks[3])
+    for i in range(n):
+        yt[i] = y[i] + h * (A51 * ks[0, i] + A52 * ks[1, i] + A53 * ks[2, i] + A54 * ks[3, i])
+    model_rhs(model_id, t + C5 * h, yt, p, log, ks[4])
+    for i in range(n):
+        yt[i] = y[i] + h * (A61 * ks[0, i] + A62 * ks[1, i] + A63 * ks[2, i] + A64 * ks[3, i] + A65 * ks[4, i])
+    model_rhs(model_id, t + h, yt, p, log, ks[5])
+    for i in range(n):
+        ynew[i] = y[i] + h * (B1 * ks[0, i] + B3 * ks[2, i] + B4 * ks[3, i] + B5 * ks[4, i] + B6 * ks[5, i])
+    model_rhs(model_id, t + h, ynew, p, log, ks[6])
+
+
+@numba.njit(cache=True)
+def _dp5_error(h, y, ynew, ks, atol, rtol):  # pragma: no cover - compiled
+    """The RMS of err_i / (atol_i + rtol max(|y_i|, |ynew_i|)) of the embedded 4th-order estimate; inf when the
+    new state is not finite."""
+    n = y.shape[0]
+    err = 0.0
+    finite = True
+    for i in range(n):
+        e = h * (E1 * ks[0, i] + E3 * ks[2, i] + E4 * ks[3, i] + E5 * ks[4, i] + E6 * ks[5, i] + E7 * ks[6, i])
+        sc = atol[i] + rtol * max(abs(y[i]), abs(ynew[i]))
+        err += (e / sc) ** 2
+        if not np.isfinite(ynew[i]):
+            finite = False
+    err = np.sqrt(err / n)
+    return err if finite else np.inf
+
+
+@numba.njit(cache=True)
+def _stiff(h, ks, ynew, yt):  # pragma: no cover - compiled
+    """Whether an accepted step sits at the stability edge: h |lambda| > 3.25 (see :func:`dp5_integrate`)."""
+    num = 0.0
+    den = 0.0
+    for i in range(ynew.shape[0]):
+        num += (ks[6, i] - ks[5, i]) ** 2
+        den += (ynew[i] - yt[i]) ** 2
+    return 1 if den > 0.0 and h * h * num > 3.25 * 3.25 * den else 0
+
+
+@numba.njit(cache=True)
+def _controls(model_id, y_new, p, sig, h, h_onset, k1, k7, jump_floor, force_jump):  # pragma: no cover
+    """The contact-onset and force-jump tests of an error-accepted step: (verdict, new signature), verdict
+    0 accept, 1 retry at the onset step (a contact changed in a long step), 2 retry at half the length
+    (a force jumped), 3 accept with a contact change. (A contact change is accepted only at most ``h_onset``
+    long, and a force jump is tested only above it, so no step is both.)"""
+    verdict = 0
+    sig_new = sig
+    if h_onset > 0.0:
+        sig_new = model_signature(model_id, y_new, p)
+        if sig_new != sig:
+            if h > h_onset:
+                return 1, sig
+            verdict = 3
+    if force_jump > 0.0 and h > h_onset and _force_jumped(k1, k7, jump_floor, force_jump):
+        return 2, sig
+    return verdict, sig_new
+
+
+@numba.njit(cache=True)
+def _accept(model_id, t, h, y, ynew, k1, k7, p, log, t_out, out, k):  # pragma: no cover - compiled
+    """Write the samples inside (t, t + h], move to the step's end, run the bookkeeping; next sample index."""
+    t_new = t + h
+    while k < t_out.shape[0] and t_out[k] <= t_new:
+        _hermite(t, h, y, ynew, k1, k7, t_out[k], out[k])
+        k += 1
+    for i in range(y.shape[0]):
+        y[i] = ynew[i]
+        k1[i] = k7[i]
+    model_post(model_id, t_new, y, p, log)
+    return k
+
+
+@numba.njit(cache=True)
+def _write_stats(stats, cnt, h):  # pragma: no cover - compiled
+    for i in range(cnt.shape[0]):
+        stats[i] = cnt[i]
+    stats[3] = h
 
 
 @numba.njit(cache=True, inline="always")

@@ -22,7 +22,9 @@ W is block diagonal: ball j's states (the problem's Jacobian structure names the
 indexes the model's parameters) form one block, estimated by grouped difference quotients (balls of one
 colour are perturbed together, :func:`cageless.simulation.jacobian.ball_colours`); the ring's states form
 another, estimated one column at a time; every other state (the energy counters) is explicit. Each
-block is LU-factorised once per step. A model without a Jacobian structure (the textbook test models)
+block is LU-factorised once per step; the coupling blocks of balls apart are exact zeros, and the block
+elimination skips them (the same numbers; 3000 rpm, 500 N, planar, settled: the balls' block LU costs about
+one right-hand side instead of four, and the whole run 15 % less CPU time; benchmarks/rosw_diagnostics.py). A model without a Jacobian structure (the textbook test models)
 is one dense block.
 
 W is re-evaluated when a step is rejected (if it is not fresh), when a contact opened or closed in the
@@ -42,19 +44,33 @@ import numba
 import numpy as np
 
 from cageless.simulation.integrators.dp5 import (STATUS_MAX_STEPS, STATUS_NONFINITE, STATUS_OK,
-                                                 STATUS_STEP_UNDERFLOW, _force_jumped, _hermite)
-from cageless.simulation.kernels import model_post, model_rhs, model_ring_share, model_signature
+                                                 STATUS_STEP_UNDERFLOW, _accept, _controls)
+from cageless.simulation.jacobian import grouped_fd
+from cageless.simulation.kernels import model_rhs, model_signature
 
-__all__ = ["rosw_integrate", "JAC_EVERY", "GAMMA", "transformed_tableau"]
+__all__ = ["rosw_integrate", "JAC_EVERY", "LU_RATIO", "GAMMA", "transformed_tableau"]
 
 #: Accepted steps after which W is re-evaluated even if no contact changed. Measured at 3000 rpm, 500 N,
-#: planar, 5 ms from a settled state (see benchmarks/rosw_speed.py): every step costs 1.8 times
+#: planar, 5 ms from a settled state (benchmarks/rosw_diagnostics.py --jac-every): every step costs 1.8 times
 #: the wall time of every 20 steps, with the same slip error.
 JAC_EVERY = 20
 
+#: Largest relative change of the step length for which the factors of the last step are kept (see
+#: :func:`rosw_integrate`); 0 factorises every step. Kept at 0: measured at 3000 rpm, 500 N, planar, 5 ms from a
+#: settled state, rtol 1e-7 (benchmarks/rosw_diagnostics.py, interleaved, loaded machine), 0.2 and 0.5 took
+#: 1.5 and 1.7 times the wall time of 0: the shifted W rejected 4 to 5 times as many steps (1581 and 1929
+#: against 397), which cost more than the 18 % of factorisations saved.
+LU_RATIO = 0.0
+
 #: Pass the error estimate through (I - h gamma W)^-1 before its norm (Shampine's filter, Hairer & Wanner II,
-#: sect. IV.8, eq. (8.20)), so the fast-decaying components that the method damps do not reject steps.
-FILTER_ERROR = True
+#: sect. IV.8, eq. (8.20)), so the fast-decaying components that the method damps do not reject steps. Off:
+#: the filter costs a fifth block solve per step and, by letting the estimate of the slow components through
+#: damped too, admits more slip error per step. Measured at 3000 rpm, 500 N, planar, 5 ms settled, CPU time,
+#: interleaved best of 3 against ``auto`` in the same run: filter on, rtol 1e-6 / 3e-7 / 1e-7: 0.78 / 0.67 /
+#: 0.58 times auto's speed at 0.011 / 0.0026 / 0.0010 pp of slip error, 611 / 564 / 397 rejections; off:
+#: 0.83 / 0.66 / 0.53 at 0.0023 / 0.00096 / 0.00045 pp, 400 / 423 / 409 rejections: at equal error
+#: about a fifth faster.
+FILTER_ERROR = False
 
 # ROS34PW2 (Rang & Angermann 2005, Table 4.2): alpha (the propagation table), gamma (the stage table,
 # diagonal GAMMA), b (order 3) and b_hat (the embedded order 2).
@@ -82,55 +98,6 @@ def transformed_tableau() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarra
 
 
 _A, _C, _M, _E, _ALPHA_T = transformed_tableau()
-
-
-@numba.njit(cache=True)
-def _fd_blocks(model_id, t, y, p, log, f0, cols, groups, jb, y_work, f1, floor, ring_rows, js, share0,
-               share1):  # pragma: no cover - compiled
-    """Grouped difference quotients of the blocks: ``jb[b, 0, r, f]`` = d f[cols[r, b]] / d y[cols[f, b]], and
-    with three blocks or more (a ring of balls) ``jb[b, 1]`` and ``jb[b, 2]``, the same against the states of
-    blocks b - 1 and b + 1 (ball-ball contacts join neighbours only). Blocks of one group are at least three
-    apart (:func:`cageless.simulation.jacobian.ball_colours`), so they share no row, and one right-hand side
-    per (field, group) serves them all. The
-    increment of state i is sqrt(eps) max(|y_i|, floor_i), as in CVODE's difference quotients. With
-    ``ring_rows`` (the rows every ball reaches: the ring's accelerations, the energy counters), each
-    perturbed ball's own share of them (:func:`cageless.simulation.kernels.model_ring_share`) gives
-    ``js[b, q, f]`` = d f[ring_rows[q]] / d y[cols[f, b]]."""
-    n_fields, n_ring, nb = cols.shape[0], ring_rows.shape[0], cols.shape[1]
-    srur = np.sqrt(np.finfo(np.float64).eps)
-    for i in range(y.shape[0]):
-        y_work[i] = y[i]
-    if n_ring > 0:
-        for b in range(cols.shape[1]):
-            model_ring_share(model_id, t, y, p, log, b, share0[b])
-    for f in range(n_fields):
-        for g in range(groups.shape[0]):
-            for m in range(groups.shape[1]):
-                b = groups[g, m]
-                if b < 0:
-                    break
-                col = cols[f, b]
-                y_work[col] = y[col] + srur * max(abs(y[col]), floor[col])
-            model_rhs(model_id, t, y_work, p, log, f1)
-            for m in range(groups.shape[1]):
-                b = groups[g, m]
-                if b < 0:
-                    break
-                col = cols[f, b]
-                dh = y_work[col] - y[col]
-                for r in range(n_fields):
-                    jb[b, 0, r, f] = (f1[cols[r, b]] - f0[cols[r, b]]) / dh
-                if nb >= 3:  # the neighbours' rows: ball b is the lower neighbour of b + 1, the upper of b - 1
-                    up, down = (b + 1) % nb, (b - 1 + nb) % nb
-                    for r in range(n_fields):
-                        jb[up, 1, r, f] = (f1[cols[r, up]] - f0[cols[r, up]]) / dh
-                        jb[down, 2, r, f] = (f1[cols[r, down]] - f0[cols[r, down]]) / dh
-                if n_ring > 0:
-                    model_ring_share(model_id, t, y_work, p, log, b, share1)
-                    for q in range(n_ring):
-                        js[b, q, f] = (share1[q] - share0[b, q]) / dh
-                y_work[col] = y[col]
-    return n_fields * groups.shape[0]
 
 
 @numba.njit(cache=True)
@@ -184,23 +151,26 @@ def _factor(jb, inv_hg, lu, piv):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _ball_factor(jb, inv_hg, lu, piv, pm, order, x):  # pragma: no cover - compiled
+def _ball_factor(jb, inv_hg, lu, piv, pm, order, x, nz):  # pragma: no cover - compiled
     """Block LU of the balls' part of I / (h gamma) - W, block tridiagonal in the ring order ``order`` (the ring
     cut where its neighbours' coupling is weakest, :func:`_cut`): D'_i = D_i - L_i P_i, P_{i+1} = D'_i^-1 U_i,
-    with D, L, U the diagonal, lower and upper blocks (block Thomas algorithm). ``pm[order[i]]`` holds P_i."""
+    with D, L, U the diagonal, lower and upper blocks (block Thomas algorithm). ``pm[order[i]]`` holds P_i.
+    Products with a coupling block that is zero (balls apart, ``nz`` from :func:`_cut`) are skipped, and so
+    is P_{i+1} when U_i is zero (it is then never read): the same factors, at a fraction of the work."""
     nb, k = jb.shape[0], jb.shape[2]
     for i in range(nb):
         b = order[i]
+        couple = i > 0 and nz[b, 0] != 0 and nz[order[i - 1], 1] != 0
         for r in range(k):
             for c in range(k):
                 acc = -jb[b, 0, r, c]
-                if i > 0:
+                if couple:
                     for q in range(k):
                         acc += jb[b, 1, r, q] * pm[b, q, c]  # L = -W_lower
                 lu[b, r, c] = acc
             lu[b, r, r] += inv_hg
         _lu(lu, piv, b)
-        if i + 1 < nb:
+        if i + 1 < nb and nz[b, 1] != 0:
             nxt = order[i + 1]
             for c in range(k):
                 for r in range(k):
@@ -211,14 +181,15 @@ def _ball_factor(jb, inv_hg, lu, piv, pm, order, x):  # pragma: no cover - compi
 
 
 @numba.njit(cache=True)
-def _ball_solve(lu, piv, pm, jb, order, cols, rhs, out, x):  # pragma: no cover - compiled
-    """out[balls] = (balls' part of I / (h gamma) - W)^-1 rhs[balls], by :func:`_ball_factor`'s factors."""
+def _ball_solve(lu, piv, pm, jb, order, cols, rhs, out, x, nz):  # pragma: no cover - compiled
+    """out[balls] = (balls' part of I / (h gamma) - W)^-1 rhs[balls], by :func:`_ball_factor`'s factors (zero
+    coupling blocks skipped)."""
     nb, k = lu.shape[0], lu.shape[1]
     for i in range(nb):
         b = order[i]
         for r in range(k):
             acc = rhs[cols[r, b]]
-            if i > 0:
+            if i > 0 and nz[b, 0] != 0:
                 prev = order[i - 1]
                 for q in range(k):
                     acc += jb[b, 1, r, q] * out[cols[q, prev]]
@@ -228,6 +199,8 @@ def _ball_solve(lu, piv, pm, jb, order, cols, rhs, out, x):  # pragma: no cover 
             out[cols[r, b]] = x[r]
     for i in range(nb - 2, -1, -1):
         b, nxt = order[i], order[i + 1]
+        if nz[b, 1] == 0:
+            continue
         for r in range(k):
             acc = 0.0
             for q in range(k):
@@ -238,9 +211,10 @@ def _ball_solve(lu, piv, pm, jb, order, cols, rhs, out, x):  # pragma: no cover 
 
 
 @numba.njit(cache=True)
-def _cut(jb, order):  # pragma: no cover - compiled
+def _cut(jb, order, nz):  # pragma: no cover - compiled
     """Order the ring of blocks from just after the pair with the weakest coupling (zero for balls apart), so
-    that dropping that pair's coupling (W may be any matrix) leaves a block tridiagonal system."""
+    that dropping that pair's coupling (W may be any matrix) leaves a block tridiagonal system; ``nz[b]``:
+    whether block b's coupling to b - 1 and to b + 1 is nonzero (balls apart give exact zeros)."""
     nb = jb.shape[0]
     best, cut = np.inf, nb - 1
     if nb >= 3:
@@ -254,6 +228,12 @@ def _cut(jb, order):  # pragma: no cover - compiled
                 best, cut = w, b
     for i in range(nb):
         order[i] = (cut + 1 + i) % nb
+        for side in range(2):
+            nz[i, side] = 0
+            for r in range(jb.shape[2]):
+                for c in range(jb.shape[3]):
+                    if jb[i, 1 + side, r, c] != 0.0:
+                        nz[i, side] = 1
 
 
 @numba.njit(cache=True)
@@ -272,14 +252,17 @@ def _block_solve(lu, piv, cols, rhs, out, x):  # pragma: no cover - compiled
 def _prepare(st, wk, inv_hg):  # pragma: no cover - compiled
     """Factorise I / (h gamma) - W for a step: the ball blocks, then the Schur complement on the ring's states,
     S = I / (h gamma) - R - F Y with Y = (I / (h gamma) - B)^-1 E (E: the balls' rows in the ring's columns,
-    F: the ring's rows in the balls' columns)."""
+    F: the ring's rows in the balls' columns). Without shared rows (``ring_rows`` empty: W without the
+    coupling of balls and ring, see :func:`cageless.simulation.solve._rosw_blocks`) E is left out too: Y = 0,
+    S = I / (h gamma) - R."""
     cols, groups, ring_cols, explicit, ring_rows = st
-    jb, lu, piv, jr, lur, pivr, js, share0, share1, x, g, yy, fy, fz, pm, order = wk
-    _ball_factor(jb, inv_hg, lu, piv, pm, order, x)
+    jb, lu, piv, jr, lur, pivr, js, share0, share1, x, g, yy, fy, fz, pm, order, nz = wk
+    _ball_factor(jb, inv_hg, lu, piv, pm, order, x, nz)
     nr = ring_cols.shape[0]
     for c in range(nr):
         yy[c, :] = 0.0
-        _ball_solve(lu, piv, pm, jb, order, cols, g[c], yy[c], x)
+        if ring_rows.shape[0] > 0:
+            _ball_solve(lu, piv, pm, jb, order, cols, g[c], yy[c], x, nz)
         fy[c, :] = 0.0
         for q in range(ring_rows.shape[0]):
             acc = 0.0
@@ -300,8 +283,8 @@ def _solve(st, wk, hg, rhs, out):  # pragma: no cover - compiled
     states (the energy counters), h gamma times their right-hand side plus their coupling to the balls and
     the ring. O(Z) work: nothing dense of the full size is formed."""
     cols, groups, ring_cols, explicit, ring_rows = st
-    jb, lu, piv, jr, lur, pivr, js, share0, share1, x, g, yy, fy, fz, pm, order = wk
-    _ball_solve(lu, piv, pm, jb, order, cols, rhs, out, x)
+    jb, lu, piv, jr, lur, pivr, js, share0, share1, x, g, yy, fy, fz, pm, order, nz = wk
+    _ball_solve(lu, piv, pm, jb, order, cols, rhs, out, x, nz)
     fz[:] = 0.0
     for q in range(ring_rows.shape[0]):
         acc = 0.0
@@ -314,7 +297,7 @@ def _solve(st, wk, hg, rhs, out):  # pragma: no cover - compiled
         for r in range(nr):
             rhs[ring_cols[r, 0]] += fz[ring_cols[r, 0]]
         _block_solve(lur, pivr, ring_cols, rhs, out, x)
-        for c in range(nr):
+        for c in range(nr if ring_rows.shape[0] > 0 else 0):  # Y = 0 without shared rows
             ur = out[ring_cols[c, 0]]
             for b in range(cols.shape[1]):
                 for f in range(cols.shape[0]):
@@ -329,24 +312,15 @@ def _solve(st, wk, hg, rhs, out):  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def _jacobian(model_id, t, y, p, log, f0, st, wk, y_work, f1, floor):  # pragma: no cover - compiled
-    """Evaluate W: the ball blocks (grouped) with their coupling to the shared rows, and the ring's columns
-    (one at a time, every row: the ring's own block, the balls' rows E and the counters' rows); returns
-    the right-hand sides used."""
+    """Evaluate W by the grouped difference quotients of :func:`cageless.simulation.jacobian.grouped_fd` in the
+    block layout: the ball blocks with their coupling to the shared rows, and the ring's columns (every row:
+    the ring's own block, the balls' rows E and the counters' rows); returns the right-hand sides used."""
     cols, groups, ring_cols, explicit, ring_rows = st
-    jb, lu, piv, jr, lur, pivr, js, share0, share1, x, g, yy, fy, fz, pm, order = wk
-    n_rhs = _fd_blocks(model_id, t, y, p, log, f0, cols, groups, jb, y_work, f1, floor, ring_rows, js, share0,
-                       share1)
-    _cut(jb, order)
-    srur = np.sqrt(np.finfo(np.float64).eps)
-    for c in range(ring_cols.shape[0]):
-        col = ring_cols[c, 0]
-        y_work[col] = y[col] + srur * max(abs(y[col]), floor[col])
-        model_rhs(model_id, t, y_work, p, log, f1)
-        dh = y_work[col] - y[col]
-        for i in range(y.shape[0]):
-            g[c, i] = (f1[i] - f0[i]) / dh
-        y_work[col] = y[col]
-    return n_rhs + ring_cols.shape[0]
+    jb, lu, piv, jr, lur, pivr, js, share0, share1, x, g, yy, fy, fz, pm, order, nz = wk
+    n_rhs = grouped_fd(model_id, t, y, p, log, f0, cols, groups, ring_rows, ring_cols, floor, y_work, f1, share0,
+                       share1, False, jr[0], jb, js, g)
+    _cut(jb, order, nz)
+    return n_rhs
 
 
 @numba.njit(cache=True)
@@ -390,40 +364,8 @@ def _error_norm(y, ynew, err_w, atol, rtol):  # pragma: no cover - compiled
     return np.sqrt(err / n)
 
 
-@numba.njit(cache=True)
-def _controls(model_id, y_new, p, sig, h, h_onset, k1, k7, jump_floor, force_jump):  # pragma: no cover
-    """The contact-onset and force-jump tests of an error-accepted step: (verdict, new signature), verdict
-    0 accept, 1 retry at the onset step (a contact changed in a long step), 2 retry at half the length
-    (a force jumped), 3 accept with a contact change."""
-    verdict = 0
-    sig_new = sig
-    if h_onset > 0.0:
-        sig_new = model_signature(model_id, y_new, p)
-        if sig_new != sig:
-            if h > h_onset:
-                return 1, sig
-            verdict = 3
-    if force_jump > 0.0 and h > h_onset and _force_jumped(k1, k7, jump_floor, force_jump):
-        return 2, sig
-    return verdict, sig_new
-
-
 # Counters of the loop, kept in one integer array so the helpers can update them.
-_STEPS, _REJ, _RHS, _ONSET, _CHANGES, _JUMPS, _JACS = 0, 1, 2, 3, 4, 5, 6
-
-
-@numba.njit(cache=True)
-def _accept(model_id, t, h, y, ynew, k1, k7, p, log, t_out, out, k):  # pragma: no cover - compiled
-    """Write the samples inside (t, t + h], move to the step's end, run the bookkeeping; next sample index."""
-    t_new = t + h
-    while k < t_out.shape[0] and t_out[k] <= t_new:
-        _hermite(t, h, y, ynew, k1, k7, t_out[k], out[k])
-        k += 1
-    for i in range(y.shape[0]):
-        y[i] = ynew[i]
-        k1[i] = k7[i]
-    model_post(model_id, t_new, y, p, log)
-    return k
+_STEPS, _REJ, _RHS, _ONSET, _CHANGES, _JUMPS, _JACS, _LUS = 0, 1, 2, 3, 4, 5, 6, 7
 
 
 @numba.njit(cache=True)
@@ -432,7 +374,7 @@ def _workspace(n, cols, ring_cols, ring_rows):  # pragma: no cover - compiled
     increments (4 x n), and the blocks: (jb, lu, piv, jr, lur, pivr, js, share0, share1, x, g, yy, fy, fz): the
     ball blocks, their factors and pivots, the ring's Schur complement, its factors and pivots, the shared
     rows' coupling to the balls, two shares, a scratch vector, the ring's Jacobian columns (by column), Y, F Y, F u, the
-    block Thomas factors P and the balls' order."""
+    block Thomas factors P, the balls' order and which coupling blocks are nonzero."""
     nb, kf, nr, nq = cols.shape[1], cols.shape[0], ring_cols.shape[0], ring_rows.shape[0]
     vec = np.zeros((10, n))
     u = np.zeros((4, n))
@@ -440,7 +382,7 @@ def _workspace(n, cols, ring_cols, ring_rows):  # pragma: no cover - compiled
           np.zeros((1, nr, nr)), np.zeros((1, nr, nr)), np.zeros((1, nr), dtype=np.int64),
           np.zeros((nb, nq, kf)), np.zeros((nb, max(nq, 1))), np.zeros(max(nq, 1)), np.zeros(max(kf, nr, 1)),
           np.zeros((nr, n)), np.zeros((nr, n)), np.zeros((nr, n)), np.zeros(n), np.zeros((nb, kf, kf)),
-          np.arange(nb))
+          np.arange(nb), np.ones((nb, 2), dtype=np.int64))
     return vec, u, wk
 
 
@@ -448,6 +390,7 @@ def _workspace(n, cols, ring_cols, ring_rows):  # pragma: no cover - compiled
 def _write_stats(stats, cnt, h):  # pragma: no cover - compiled
     stats[0], stats[1], stats[2], stats[3] = cnt[_STEPS], cnt[_REJ], cnt[_RHS], h
     stats[4], stats[5], stats[6], stats[7], stats[8] = cnt[_ONSET], cnt[_CHANGES], cnt[_JUMPS], 0, cnt[_JACS]
+    stats[9] = cnt[_LUS]
 
 
 @numba.njit(cache=True)
@@ -466,13 +409,18 @@ def _start(model_id, t0, y0, p, log, t_out, out, atol, rtol, vec):  # pragma: no
 
 
 @numba.njit(cache=True)
-def _step(model_id, t, h, p, log, atol, rtol, vec, u, st, wk, fresh_w, cnt):  # pragma: no cover - compiled
-    """One attempted step of length h from (t, vec[0]): W evaluated if ``fresh_w``, factorised, the stages;
+def _step(model_id, t, h, p, log, atol, rtol, vec, u, st, wk, fresh_w, cnt, lu_at, lu_ratio):  # pragma: no cover
+    """One attempted step of length h from (t, vec[0]): W evaluated if ``fresh_w``, factorised unless the
+    factors of I / (h' gamma) - W at ``lu_at[0]`` = 1 / (h' gamma) serve (see :func:`rosw_integrate`), the stages;
     returns the error norm (inf if the state became non-finite)."""
     if fresh_w:
         cnt[_RHS] += _jacobian(model_id, t, vec[0], p, log, vec[1], st, wk, vec[7], vec[8], vec[9])
         cnt[_JACS] += 1
-    _prepare(st, wk, 1.0 / (h * GAMMA))
+    inv_hg = 1.0 / (h * GAMMA)
+    if fresh_w or lu_at[0] == 0.0 or not abs(inv_hg / lu_at[0] - 1.0) <= lu_ratio:
+        _prepare(st, wk, inv_hg)
+        lu_at[0] = inv_hg
+        cnt[_LUS] += 1
     _stages(model_id, t, h, p, log, vec, u, st, wk)
     cnt[_RHS] += 3
     if FILTER_ERROR:  # (I - h gamma W)^-1 err: the stiff components' part of the estimate damped
@@ -486,7 +434,7 @@ def _step(model_id, t, h, p, log, atol, rtol, vec, u, st, wk, fresh_w, cnt):  # 
 
 @numba.njit(cache=True)
 def rosw_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_steps, out, stats, h_onset,
-                   jump_floor, force_jump, st, jac_every):  # pragma: no cover - compiled
+                   jump_floor, force_jump, st, jac_every, lu_ratio):  # pragma: no cover - compiled
     """Integrate from ``t0`` and write ``y`` at each ``t_out[k]`` into ``out[k]`` (as
     :func:`cageless.simulation.integrators.dp5.dp5_integrate`, the same controls and status codes).
 
@@ -494,13 +442,19 @@ def rosw_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_s
     b (the balls), ``groups`` the blocks perturbed together (padded with -1), ``ring_cols`` the ring's block
     (may be empty), ``explicit`` every other state, ``ring_rows`` the rows every ball reaches (may be empty).
     ``jac_every`` <= 0 keeps W = 0 (an explicit method of order 3, for the tests of the W-property).
-    ``stats`` (9) receives [n_steps, n_rejected, n_rhs, last_h, n_onset_retries, n_contact_changes,
-    n_force_jump_retries, 0, n_jacobians].
+    ``lu_ratio``: the factors of I / (h' gamma) - W are kept for a step of length h while W is not re-evaluated
+    and |h' / h - 1| <= ``lu_ratio`` (0: factorised every step). The step then uses W + (1 / (h gamma) -
+    1 / (h' gamma)) I in place of W (the explicit states' rows keep theirs); a W-method's order holds for any
+    W (Rang & Angermann 2005), so only its stability moves, as CVODE keeps its Newton matrix while its
+    gamma changes by less than 30 % (Hindmarsh et al., ACM TOMS 31 (2005) 363, sect. 2.1).
+    ``stats`` (10) receives [n_steps, n_rejected, n_rhs, last_h, n_onset_retries, n_contact_changes,
+    n_force_jump_retries, 0, n_jacobians, n_factorisations].
     """
     vec, u, wk = _workspace(y0.shape[0], st[0], st[2], st[4])
     y, k1, k7, ynew = vec[0], vec[1], vec[2], vec[5]
-    cnt = np.zeros(7, dtype=np.int64)
+    cnt = np.zeros(8, dtype=np.int64)
     cnt[_RHS] = 1
+    lu_at = np.zeros(1)  # 1 / (h gamma) of the current factors (0: none yet)
     k = _start(model_id, t0, y0, p, log, t_out, out, atol, rtol, vec)
     t, h, age, status = t0, h0, jac_every, STATUS_OK  # age >= jac_every: evaluate W before the next step
     sig = model_signature(model_id, y, p) if h_onset > 0.0 else 0.0
@@ -512,7 +466,7 @@ def rosw_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_s
         if cnt[_STEPS] + cnt[_REJ] >= max_steps or h < tiny:
             status = STATUS_MAX_STEPS if h >= tiny else STATUS_STEP_UNDERFLOW
             break
-        err = _step(model_id, t, h, p, log, atol, rtol, vec, u, st, wk, 0 < jac_every <= age, cnt)
+        err = _step(model_id, t, h, p, log, atol, rtol, vec, u, st, wk, 0 < jac_every <= age, cnt, lu_at, lu_ratio)
         age = 0 if 0 < jac_every <= age else age
         if not err <= 1.0:  # rejected, or not finite
             cnt[_REJ] += 1

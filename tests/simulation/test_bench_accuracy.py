@@ -7,8 +7,11 @@ from cageless.simulation.bench import CANDIDATES, CVODE_VARIANTS, accuracy_study
 
 def test_accuracy_study_table_and_plot(tmp_path):
     result = accuracy_study(window_s=0.001, settle_s=0.03, numpy_window_s=0.0002)
-    assert len(result["rows"]) == len(CANDIDATES) + len(CVODE_VARIANTS) + 1
+    # the candidates, the CVODE variants, the automatic switch (first, the speed-up's base) and numpy LSODA
+    assert len(result["rows"]) == len(CANDIDATES) + len(CVODE_VARIANTS) + 2
     assert all(r["ok"] for r in result["rows"])
+    assert result["rows"][0]["label"] == "auto (as simulate runs it)" and result["rows"][0]["speedup_vs_auto"] == 1.0
+    assert result["rows"][0]["slip_error_pp"] < 0.05
     dp5 = [r for r in result["rows"] if r["solver"].startswith("dp5")]
     # past the start-up every tolerance stays well within the 0.5 pp convergence bar of DESIGN §7
     assert all(r["slip_error_pp"] < 0.05 for r in dp5)
