@@ -102,10 +102,22 @@ class Detections:
         return int(self.u.size)
 
 
-def static_defects(background: np.ndarray, sigma_noise: float, k: float = 8.0) -> np.ndarray:
-    """Pixels far brighter than their 3 x 3 median in the background frame (hot pixels, fixed glints)."""
+def static_defects(background: np.ndarray, sigma_noise: float, k: float = 8.0,
+                   frames: np.ndarray | None = None) -> np.ndarray:
+    """Pixels far brighter than their 3 x 3 median in the background frame (hot pixels, fixed glints).
+
+    With ``frames`` (a few frames spread over the video), a pixel must also stand out so in their
+    per-pixel lower quartile, i.e. in three quarters of them: the median background keeps traces of the highlights
+    where they pass often and of codec blocks, and masking those cut holes in the highlights' path
+    (a highlight crossing a hole moved by up to 0.7 px; 1.0 mrad RMS on corpus seed 1031, MPEG-4).
+    """
     bg = background.astype(np.float32)
-    return (bg - cv2.medianBlur(bg, 3)) > k * sigma_noise
+    out = (bg - cv2.medianBlur(bg, 3)) > k * sigma_noise
+    if frames is not None and len(frames):
+        k = len(frames) // 4  # bright in three quarters of them: a dark frame or a ball passing over a glint
+        low = np.partition(frames, k, axis=0)[k].astype(np.float32)
+        out &= (low - cv2.medianBlur(low, 3)) > k * sigma_noise
+    return out
 
 
 def noise_sigma(frames: np.ndarray, background: np.ndarray, mask: np.ndarray) -> float:
