@@ -57,7 +57,10 @@ class DetectorParams:
     window_sigma
         Centroid window radius, in highlight sigmas.
     iterations
-        Window re-centring passes.
+        Most window re-centring passes (it stops once the window moves less than 0.001 px). The tapered
+        centroid converges slowly on doubled or elongated highlights: two passes left the estimate where the
+        prediction put it, a lag that decayed over frames (seed 1024: speed RMS 1.06 % of the cage speed
+        with 2 passes, 0.26 % with up to 10).
     min_area_px
         Smallest blob area kept.
     max_aspect
@@ -75,7 +78,7 @@ class DetectorParams:
     detect_sigma: float = 6.0
     weight_sigma: float = 2.0
     window_sigma: float = 3.5
-    iterations: int = 2
+    iterations: int = 10
     min_area_px: int = 2
     max_aspect: float = 2.5
     min_fill: float = 0.3
@@ -201,6 +204,10 @@ def centroid_windows(frame: np.ndarray, background: np.ndarray, mask: np.ndarray
     return _centroids(frame, background, mask, u0, v0, half_arr, float(threshold), int(iterations))
 
 
+#: The window re-centring stops once it moves less than this (px).
+_CONVERGED_PX = 1e-3
+
+
 @numba.njit(cache=True, nogil=True, inline="always")
 def _span(c, half_sq, dy2, lo_lim, hi_lim):  # pragma: no cover - compiled
     """Columns x with (x - c)^2 <= half_sq - dy2, clipped to [lo_lim, hi_lim)."""
@@ -267,7 +274,10 @@ def _centroids(frame, background, mask, u0, v0, half, threshold, iterations):  #
                         m += wgt
             if m <= 0.0:
                 break
-            u, v = su / m, sv / m
+            du, dv = su / m - u, sv / m - v
+            u, v = u + du, v + dv
+            if du * du + dv * dv < _CONVERGED_PX * _CONVERGED_PX:
+                break
         if m > 0.0:
             out_u[j], out_v[j], out_m[j] = u, v, m
     return out_u, out_v, out_m

@@ -33,7 +33,7 @@ from cageless.trace import Trace, VideoInfo, write_trace
 from cageless.tracking.detect import DetectorParams, detect_full, noise_sigma, spot_sigma, static_defects
 from cageless.tracking.geometry import fit_orbit, orbital_angles
 from cageless.tracking.io import CineReader, FrameSource, open_video
-from cageless.tracking.kinematics import DEFAULT_WINDOW, revolution_speed
+from cageless.tracking.kinematics import DEFAULT_TRACK_FIT, DEFAULT_WINDOW, revolution_speed, robust_track_fit
 from cageless.tracking.link import BallCountWarning, TrackSetup, track_frames
 from cageless.tracking.locate import BearingLocation, background_frame, locate_bearing
 from cageless.tracking.locate_motion import holds_the_motion, locate_by_motion, motion_map, plausible_band
@@ -84,6 +84,9 @@ class TrackOptions:
         Track the complete frames of a truncated ``.cine`` instead of refusing it.
     n_balls
         The ball count the video shows, when it differs from the bearing's (default: the bearing's).
+    track_fit
+        Frames of the robust local quadratic each ball's angle is read from (1: the raw angles);
+        samples off the ball's path are dropped (:func:`~cageless.tracking.kinematics.robust_track_fit`).
     """
 
     detector: DetectorParams = field(default_factory=DetectorParams)
@@ -96,6 +99,7 @@ class TrackOptions:
     threads: int = 2
     allow_truncated: bool = False
     n_balls: int | None = None
+    track_fit: int = DEFAULT_TRACK_FIT
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready settings."""
@@ -397,6 +401,10 @@ def _finish(path: Path, video: FrameSource, table: pd.DataFrame, loc: BearingLoc
     roll = math.radians(conditions.camera_roll_deg or 0.0)
     angle, valid, direction, order = orbital_angles(table, orbit, roll)
     times = video.times
+    try:
+        angle, valid = robust_track_fit(times, angle, valid, options.track_fit)
+    except ParameterError as exc:
+        raise TrackingError(path, str(exc)) from exc
     try:
         speed = revolution_speed(times, angle, options.window, options.polyorder)
     except ParameterError as exc:
