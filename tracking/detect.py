@@ -57,10 +57,11 @@ class DetectorParams:
     window_sigma
         Centroid window radius, in highlight sigmas.
     iterations
-        Most window re-centring passes (it stops once the window moves less than 0.001 px). The tapered
-        centroid converges slowly on doubled or elongated highlights: two passes left the estimate where the
-        prediction put it, a lag that decayed over frames (seed 1024: speed RMS 1.06 % of the cage speed
-        with 2 passes, 0.26 % with up to 10).
+        Most window re-centring passes (it stops once the window moves less than 0.001 px; every second
+        pass takes an Aitken delta-squared step). The tapered centroid converges slowly on doubled or
+        elongated highlights: two plain passes left the estimate where the prediction put it, a lag that
+        decayed over frames (seed 1024: speed RMS 1.06 % of the cage speed with 2 passes, 0.26 % with up
+        to 4 accelerated ones, the same as with 10).
     min_area_px
         Smallest blob area kept.
     max_aspect
@@ -78,7 +79,7 @@ class DetectorParams:
     detect_sigma: float = 6.0
     weight_sigma: float = 2.0
     window_sigma: float = 3.5
-    iterations: int = 10
+    iterations: int = 4
     min_area_px: int = 2
     max_aspect: float = 2.5
     min_fill: float = 0.3
@@ -254,7 +255,8 @@ def _centroids(frame, background, mask, u0, v0, half, threshold, iterations):  #
         # Local background: the black ball coating just outside the window (measured once).
         local = _local_background(frame, mask, u, v, r, ring)
         m = 0.0
-        for _ in range(iterations):
+        pdu, pdv = 0.0, 0.0
+        for it in range(iterations):
             su = 0.0
             sv = 0.0
             m = 0.0
@@ -275,9 +277,18 @@ def _centroids(frame, background, mask, u0, v0, half, threshold, iterations):  #
             if m <= 0.0:
                 break
             du, dv = su / m - u, sv / m - v
-            u, v = u + du, v + dv
+            gain = 1.0
+            if it % 2 == 1:
+                # Aitken's delta-squared step: the re-centring contracts by a nearly constant factor r per
+                # pass, so the fixed point lies du / (1 - r) away; r from this pass and the previous one.
+                den = pdu * pdu + pdv * pdv
+                ratio = (du * pdu + dv * pdv) / den if den > 0.0 else 0.0
+                if 0.0 < ratio < 0.9:
+                    gain = 1.0 / (1.0 - ratio)
+            u, v = u + gain * du, v + gain * dv
             if du * du + dv * dv < _CONVERGED_PX * _CONVERGED_PX:
                 break
+            pdu, pdv = du, dv
         if m > 0.0:
             out_u[j], out_v[j], out_m[j] = u, v, m
     return out_u, out_v, out_m
