@@ -57,7 +57,11 @@ class DetectorParams:
     window_sigma
         Centroid window radius, in highlight sigmas.
     iterations
-        Window re-centring passes.
+        Most window re-centring passes (it stops once the window moves less than 0.001 px; every second
+        pass takes an Aitken delta-squared step). The tapered centroid converges slowly on doubled or
+        elongated highlights: two plain passes left the estimate where the prediction put it, a lag that
+        decayed over frames (seed 1024: speed RMS 1.06 % of the cage speed with 2 passes, 0.26 % with up
+        to 4 accelerated ones, the same as with 10).
     min_area_px
         Smallest blob area kept.
     max_aspect
@@ -75,7 +79,7 @@ class DetectorParams:
     detect_sigma: float = 6.0
     weight_sigma: float = 2.0
     window_sigma: float = 3.5
-    iterations: int = 2
+    iterations: int = 4
     min_area_px: int = 2
     max_aspect: float = 2.5
     min_fill: float = 0.3
@@ -102,10 +106,22 @@ class Detections:
         return int(self.u.size)
 
 
-def static_defects(background: np.ndarray, sigma_noise: float, k: float = 8.0) -> np.ndarray:
-    """Pixels far brighter than their 3 x 3 median in the background frame (hot pixels, fixed glints)."""
+def static_defects(background: np.ndarray, sigma_noise: float, k: float = 8.0,
+                   frames: np.ndarray | None = None) -> np.ndarray:
+    """Pixels far brighter than their 3 x 3 median in the background frame (hot pixels, fixed glints).
+
+    With ``frames`` (a few frames spread over the video), a pixel must also stand out so in their
+    per-pixel lower quartile, i.e. in three quarters of them: the median background keeps traces of the highlights
+    where they pass often and of codec blocks, and masking those cut holes in the highlights' path
+    (a highlight crossing a hole moved by up to 0.7 px; 1.0 mrad RMS on corpus seed 1031, MPEG-4).
+    """
     bg = background.astype(np.float32)
-    return (bg - cv2.medianBlur(bg, 3)) > k * sigma_noise
+    out = (bg - cv2.medianBlur(bg, 3)) > k * sigma_noise
+    if frames is not None and len(frames):
+        k = len(frames) // 4  # bright in three quarters of them: a dark frame or a ball passing over a glint
+        low = np.partition(frames, k, axis=0)[k].astype(np.float32)
+        out &= (low - cv2.medianBlur(low, 3)) > k * sigma_noise
+    return out
 
 
 def noise_sigma(frames: np.ndarray, background: np.ndarray, mask: np.ndarray) -> float:
@@ -189,6 +205,10 @@ def centroid_windows(frame: np.ndarray, background: np.ndarray, mask: np.ndarray
     return _centroids(frame, background, mask, u0, v0, half_arr, float(threshold), int(iterations))
 
 
+#: The window re-centring stops once it moves less than this (px).
+_CONVERGED_PX = 1e-3
+
+
 @numba.njit(cache=True, nogil=True, inline="always")
 def _span(c, half_sq, dy2, lo_lim, hi_lim):  # pragma: no cover - compiled
     """Columns x with (x - c)^2 <= half_sq - dy2, clipped to [lo_lim, hi_lim)."""
@@ -235,7 +255,8 @@ def _centroids(frame, background, mask, u0, v0, half, threshold, iterations):  #
         # Local background: the black ball coating just outside the window (measured once).
         local = _local_background(frame, mask, u, v, r, ring)
         m = 0.0
-        for _ in range(iterations):
+        pdu, pdv = 0.0, 0.0
+        for it in range(iterations):
             su = 0.0
             sv = 0.0
             m = 0.0
@@ -255,7 +276,19 @@ def _centroids(frame, background, mask, u0, v0, half, threshold, iterations):  #
                         m += wgt
             if m <= 0.0:
                 break
-            u, v = su / m, sv / m
+            du, dv = su / m - u, sv / m - v
+            gain = 1.0
+            if it % 2 == 1:
+                # Aitken's delta-squared step: the re-centring contracts by a nearly constant factor r per
+                # pass, so the fixed point lies du / (1 - r) away; r from this pass and the previous one.
+                den = pdu * pdu + pdv * pdv
+                ratio = (du * pdu + dv * pdv) / den if den > 0.0 else 0.0
+                if 0.0 < ratio < 0.9:
+                    gain = 1.0 / (1.0 - ratio)
+            u, v = u + gain * du, v + gain * dv
+            if du * du + dv * dv < _CONVERGED_PX * _CONVERGED_PX:
+                break
+            pdu, pdv = du, dv
         if m > 0.0:
             out_u[j], out_v[j], out_m[j] = u, v, m
     return out_u, out_v, out_m
