@@ -17,6 +17,7 @@ from cageless.conditions import OperatingConditions
 from cageless.simulation.models import base as B
 from cageless.simulation.models.observables import film_coefficients, kernel_observables
 from cageless.simulation.models.planar_reference import tangential_force
+from cageless.simulation.models.regime import P_F_FTRAC, race_tangential_array
 from cageless.simulation.parameters import ModelParameters
 from cageless.simulation.scene import Scene
 from cageless.simulation.simulation import Choices, Simulation
@@ -54,7 +55,11 @@ def _closed_forms(pr, t, y, ramp_s):
     u_i = vt - half * om - w_i * r_i
     ur_i = 0.5 * np.abs(vt * (1 - 2 * r_i / ln) - half * om + w_i * r_i)
     assert d > 0
-    return (outer, inner, -tangential_force(u_o, ur_o, outer, p), -tangential_force(u_i, ur_i, inner, p),
+    if p[P_F_FTRAC] > 0.5:  # traction by film regime: the law is checked by hand in test_film_traction_models
+        f_o, f_i = -race_tangential_array(u_o, ur_o, outer, False, p), -race_tangential_array(u_i, ur_i, inner, True, p)
+    else:
+        f_o, f_i = -tangential_force(u_o, ur_o, outer, p), -tangential_force(u_i, ur_i, inner, p)
+    return (outer, inner, f_o, f_i,
             np.where(outer > 0, ur_o, 0.0), np.where(inner > 0, ur_i, 0.0))
 
 
