@@ -234,33 +234,13 @@ def _pair_forces(y, p, log, j, k, z, cj, sj, ck, sk, obs):  # pragma: no cover -
 @numba.njit(cache=True, fastmath=FASTMATH)
 def planar_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
     z = int(p[P_Z])
-    m_ring, g = p[P_MR], p[P_G]
+    m, m_ring, g = p[P_M], p[P_MR], p[P_G]
     grav_on = p[P_F_GRAV] > 0.5
     ramp = p[P_RAMP]
     w_i = p[P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
     power_in, power = 0.0, 0.0
     fy_ring, fz_ring = 0.0, -p[P_FR] - (m_ring * g if grav_on else 0.0)
     trig = log.shape[0] - 2 * z  # scratch: cos and sin of every ball's angle, computed once per call
-    _start(y, p, log, dydt, z, trig, grav_on)
-    if p[P_F_RACE] > 0.5:
-        fy_ring, fz_ring, power_in, power = _add_race(y, p, log, dydt, z, trig, w_i, fy_ring, fz_ring, power_in,
-                                                      power)
-    if p[P_F_BB] > 0.5:
-        power = _add_pairs(y, p, log, dydt, z, trig, power)
-    power = _ball_accelerations(y, p, log, dydt, z, trig, power)
-    dydt[5 * z] = y[5 * z + 2]
-    dydt[5 * z + 1] = y[5 * z + 3]
-    dydt[5 * z + 2] = fy_ring / m_ring
-    dydt[5 * z + 3] = fz_ring / m_ring
-    dydt[5 * z + 4] = power_in
-    dydt[5 * z + 5] = power
-
-
-@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
-def _start(y, p, log, dydt, z, trig, grav_on):  # pragma: no cover - compiled
-    """The trig scratch, the position rates, and the force and torque accumulators (held in the acceleration
-    and spin slots of ``dydt``) with the balls' weight."""
-    m, g = p[P_M], p[P_G]
     for j in range(z):
         log[trig + j] = np.cos(y[z + j])
         log[trig + z + j] = np.sin(y[z + j])
@@ -269,38 +249,37 @@ def _start(y, p, log, dydt, z, trig, grav_on):  # pragma: no cover - compiled
         dydt[2 * z + j] = 0.0  # force accumulators (Cartesian y, z) held in the acceleration slots for now
         dydt[3 * z + j] = -m * g if grav_on else 0.0
         dydt[4 * z + j] = 0.0  # torque accumulator
-
-
-@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
-def _add_race(y, p, log, dydt, z, trig, w_i, fy_ring, fz_ring, power_in, power):  # pragma: no cover - compiled
-    """Every ball's race forces into the accumulators; the ring's force and the powers, updated."""
-    for j in range(z):
-        fy, fz, torque, ry, rz, p_in, p_diss = _race_forces(y, p, j, z, w_i, log[trig + j], log[trig + z + j], None)
-        dydt[2 * z + j] += fy
-        dydt[3 * z + j] += fz
-        dydt[4 * z + j] += torque
-        fy_ring += ry
-        fz_ring += rz
-        power_in += p_in
-        power += p_diss
-    return fy_ring, fz_ring, power_in, power
-
-
-@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
-def _add_pairs(y, p, log, dydt, z, trig, power):  # pragma: no cover - compiled
-    """Every neighbour pair's forces into the accumulators; the dissipated power, updated."""
-    for j in range(z):
-        k = j + 1 if j + 1 < z else 0
-        fy, fz, torque, p_diss = _pair_forces(y, p, log, j, k, z, log[trig + j], log[trig + z + j], log[trig + k],
-                                             log[trig + z + k], None)
-        dydt[2 * z + j] -= fy
-        dydt[3 * z + j] -= fz
-        dydt[2 * z + k] += fy
-        dydt[3 * z + k] += fz
-        dydt[4 * z + j] += torque
-        dydt[4 * z + k] += torque
-        power += p_diss
-    return power
+    if p[P_F_RACE] > 0.5:
+        for j in range(z):  # the two halves of _race_forces, called directly: the loop runs faster fully inlined
+            c, s = log[trig + j], log[trig + z + j]
+            fy, fz, torque, p_diss = _outer_race(y, p, j, z, c, s, None)
+            fy, fz, torque, ry, rz, p_in, p_diss = _inner_race(y, p, j, z, w_i, c, s, fy, fz, torque, p_diss, None)
+            dydt[2 * z + j] += fy
+            dydt[3 * z + j] += fz
+            dydt[4 * z + j] += torque
+            fy_ring += ry
+            fz_ring += rz
+            power_in += p_in
+            power += p_diss
+    if p[P_F_BB] > 0.5:
+        for j in range(z):
+            k = j + 1 if j + 1 < z else 0
+            fy, fz, torque, p_diss = _pair_forces(y, p, log, j, k, z, log[trig + j], log[trig + z + j], log[trig + k],
+                                                 log[trig + z + k], None)
+            dydt[2 * z + j] -= fy
+            dydt[3 * z + j] -= fz
+            dydt[2 * z + k] += fy
+            dydt[3 * z + k] += fz
+            dydt[4 * z + j] += torque
+            dydt[4 * z + k] += torque
+            power += p_diss
+    power = _ball_accelerations(y, p, log, dydt, z, trig, power)
+    dydt[5 * z] = y[5 * z + 2]
+    dydt[5 * z + 1] = y[5 * z + 3]
+    dydt[5 * z + 2] = fy_ring / m_ring
+    dydt[5 * z + 3] = fz_ring / m_ring
+    dydt[5 * z + 4] = power_in
+    dydt[5 * z + 5] = power
 
 
 @numba.njit(cache=True, fastmath=FASTMATH, inline="always")

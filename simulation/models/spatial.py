@@ -322,18 +322,36 @@ def spatial_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
     tb = y.shape[0] - 4  # tilt states: beta_y, beta_z, their rates
     s_bz, c_bz = math.sin(p[P_TILT_Z] + y[tb + 1]), math.cos(p[P_TILT_Z] + y[tb + 1])
     wt = (-s_bz * y[tb + 2], c_bz * y[tb + 2], y[tb + 3])  # angular velocity of the tilting: bz' z + by' Rz y
-    rm = (0.0, 0.0, 0.0)
+    rmx = rmy = rmz = 0.0
     trig = log.shape[0] - 2 * z  # scratch: cos and sin of every ball's angle, once per call
     _start(y, p, log, dydt, z, trig, grav)
-    rf = (p[P_FA] - m_ring * p[P_GAX], 0.0, -p[B.P_FR] - m_ring * grav)
+    rfx, rfy, rfz = p[P_FA] - m_ring * p[P_GAX], 0.0, -p[B.P_FR] - m_ring * grav
     power_in = power = 0.0
     if p[B.P_F_RACE] > 0.5:
-        rf, rm, power_in, power = _add_race(y, p, log, dydt, z, trig, w_i, rot, wt, rf, rm, power_in, power)
+        for j in range(z):
+            for inner in (False, True):
+                f, mo, pin, pd, _, qm = _race(y, p, j, z, inner, w_i, rot, log[trig + j], log[trig + z + j], wt, None)
+                for o, v in ((b + z, f[0]), (2 * z, f[1]), (3 * z, f[2]), (4 * z, mo[0]), (b + 2 * z, mo[1]),
+                             (b + 3 * z, mo[2])):
+                    dydt[o + j] += v
+                if inner:
+                    rfx, rfy, rfz = rfx - f[0], rfy - f[1], rfz - f[2]
+                    rmx, rmy, rmz = rmx + qm[0], rmy + qm[1], rmz + qm[2]
+                power_in += pin
+                power += pd
     if p[B.P_F_BB] > 0.5:
-        power = _add_pairs(y, p, log, dydt, z, trig, power)
+        for j in range(z):
+            k = j + 1 if j + 1 < z else 0
+            fx, fy, fz, mx, my, mz, pd = _pair(y, p, log, j, k, z, log[trig + j], log[trig + z + j], log[trig + k],
+                                               log[trig + z + k], None)
+            for o, v in ((b + z, fx), (2 * z, fy), (3 * z, fz)):
+                dydt[o + j] -= v
+                dydt[o + k] += v
+            for o, mo in ((4 * z, mx), (b + 2 * z, my), (b + 3 * z, mz)):
+                dydt[o + j] += mo
+                dydt[o + k] += mo
+            power += pd
     power = _ball_accelerations(y, p, log, dydt, z, trig, power)
-    rfx, rfy, rfz = rf
-    rmx, rmy, rmz = rm
     dydt[5 * z], dydt[5 * z + 1] = y[5 * z + 2], y[5 * z + 3]
     dydt[5 * z + 2], dydt[5 * z + 3] = rfy / m_ring, rfz / m_ring
     dydt[5 * z + 4], dydt[5 * z + 5] = power_in, power
@@ -359,54 +377,6 @@ def _start(y, p, log, dydt, z, trig, grav):  # pragma: no cover - compiled
     for j in range(z):
         dydt[3 * z + j] = -m * grav
         dydt[b + z + j] = -m * p[P_GAX]  # gravity along the shaft (vertical shaft)
-
-
-@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
-def _add_race(y, p, log, dydt, z, trig, w_i, rot, wt, rf, rm, power_in, power):  # pragma: no cover - compiled
-    """Both race contacts of every ball into the accumulators; the ring's force and moment and the powers,
-    updated."""
-    b = 5 * z + 6
-    rfx, rfy, rfz = rf
-    rmx, rmy, rmz = rm
-    for j in range(z):
-        for inner in (False, True):
-            f, mo, pin, pd, _, qm = _race(y, p, j, z, inner, w_i, rot, log[trig + j], log[trig + z + j], wt, None)
-            fx, fy, fz = f
-            mx, my, mz = mo
-            qx, qy, qz = qm
-            dydt[b + z + j] += fx
-            dydt[2 * z + j] += fy
-            dydt[3 * z + j] += fz
-            dydt[4 * z + j] += mx
-            dydt[b + 2 * z + j] += my
-            dydt[b + 3 * z + j] += mz
-            if inner:
-                rfx, rfy, rfz = rfx - fx, rfy - fy, rfz - fz
-                rmx, rmy, rmz = rmx + qx, rmy + qy, rmz + qz
-            power_in += pin
-            power += pd
-    return (rfx, rfy, rfz), (rmx, rmy, rmz), power_in, power
-
-
-@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
-def _add_pairs(y, p, log, dydt, z, trig, power):  # pragma: no cover - compiled
-    """Every neighbour pair's forces and moments into the accumulators; the dissipated power, updated."""
-    b = 5 * z + 6
-    for j in range(z):
-        k = j + 1 if j + 1 < z else 0
-        fx, fy, fz, mx, my, mz, pd = _pair(y, p, log, j, k, z, log[trig + j], log[trig + z + j], log[trig + k],
-                                           log[trig + z + k], None)
-        dydt[b + z + j] -= fx
-        dydt[2 * z + j] -= fy
-        dydt[3 * z + j] -= fz
-        dydt[b + z + k] += fx
-        dydt[2 * z + k] += fy
-        dydt[3 * z + k] += fz
-        for o, mo in ((4 * z, mx), (b + 2 * z, my), (b + 3 * z, mz)):
-            dydt[o + j] += mo
-            dydt[o + k] += mo
-        power += pd
-    return power
 
 
 @numba.njit(cache=True, fastmath=FASTMATH, inline="always")
