@@ -25,7 +25,8 @@ import numpy as np
 import numpy.typing as npt
 from scipy.optimize import linear_sum_assignment
 
-__all__ = ["Candidates", "Tracklet", "blob_response", "response_map", "bin_mask", "find_candidates", "response_noise",
+__all__ = ["Candidates", "Tracklet", "blob_response", "response_map", "bin_mask", "find_candidates", "refine_candidates",
+           "response_noise",
            "link_tracklets"]
 
 
@@ -52,11 +53,19 @@ class Tracklet:
     response: list[float] = field(default_factory=list)
     misses: int = 0
 
-    def predict(self) -> tuple[float, float]:
-        """Position expected in the next frame (constant velocity over the last two samples)."""
+    def predict(self, frame: int | None = None, times: np.ndarray | None = None) -> tuple[float, float]:
+        """Position expected at ``frame`` (default: the frame after the last sample), at the constant
+        velocity of the last two samples: per frame, or per second when the frame ``times`` are given (a
+        dropped frame is then a longer step, not a faster ball)."""
         if len(self.u) < 2:
             return self.u[-1], self.v[-1]
-        return 2 * self.u[-1] - self.u[-2], 2 * self.v[-1] - self.v[-2]
+        f0, f1 = self.frames[-2], self.frames[-1]
+        f = f1 + 1 if frame is None else frame
+        if times is None:
+            step = (f - f1) / max(f1 - f0, 1)
+        else:
+            step = (times[f] - times[f1]) / max(times[f1] - times[f0], 1e-12)
+        return (self.u[-1] + step * (self.u[-1] - self.u[-2]), self.v[-1] + step * (self.v[-1] - self.v[-2]))
 
     def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Frames, u and v as arrays."""
@@ -145,6 +154,35 @@ def find_candidates(frame: np.ndarray, background: np.ndarray, mask: np.ndarray,
                       peak=(frame[iv, iu].astype(np.float64) - background[iv, iu]))
 
 
+def refine_candidates(c: Candidates, frame: np.ndarray, background: np.ndarray, mask: np.ndarray, radius_px: float,
+                      threshold: float, merge_px: float, iterations: int = 10) -> Candidates:
+    """Move each candidate to the intensity centroid of its blob, then merge those that met.
+
+    A response maximum sits anywhere on an extended highlight (a saturated plateau, an elongated lobe, two
+    lights' highlights run together), and which of its maxima is strongest changes from frame to frame, so
+    tracklets built on them jump along the blob. The background-subtracted, tapered centroid in a window of
+    ``radius_px`` (:func:`cageless.tracking.detect.centroid_windows`), re-centred ``iterations`` times (a
+    mean shift), converges to one point per blob whichever maximum it started from. Candidates that end
+    within ``merge_px`` of a stronger one are dropped; a window with no signal keeps its start.
+    """
+    from cageless.tracking.detect import centroid_windows  # the centroid shared with the per-frame tracker
+
+    if len(c) == 0:
+        return c
+    u, v, m = centroid_windows(frame, background, mask, c.u, c.v, radius_px, threshold, iterations)
+    bad = ~(m > 0)
+    u[bad], v[bad] = c.u[bad], c.v[bad]
+    near = np.hypot(u[:, None] - u[None, :], v[:, None] - v[None, :]) <= merge_px
+    gone = np.zeros(len(c), dtype=bool)
+    keep = []
+    for k in range(len(c)):  # strongest first (find_candidates' order)
+        if not gone[k]:
+            keep.append(k)
+            gone |= near[k]
+    idx = np.asarray(keep, dtype=int)
+    return Candidates(u=u[idx], v=v[idx], response=c.response[idx], peak=c.peak[idx])
+
+
 def response_noise(resp: np.ndarray, mask: np.ndarray) -> float:
     """Robust standard deviation (1.4826 MAD) of the blob response inside ``mask``."""
     vals = resp[mask]
@@ -154,21 +192,41 @@ def response_noise(resp: np.ndarray, mask: np.ndarray) -> float:
     return float(max(1.4826 * np.median(np.abs(vals - med)), 1e-6))
 
 
-def link_tracklets(cands: list[Candidates], gate_px: float, max_misses: int = 2) -> list[Tracklet]:
+def link_tracklets(cands: list[Candidates], gate_px: float, max_misses: int = 2,
+                   track_gate_px: float | None = None, start_response: float = 0.0,
+                   times: np.ndarray | None = None) -> list[Tracklet]:
     """Link per-frame candidates of consecutive frames into tracklets.
 
     Each live tracklet's constant-velocity prediction is assigned to at most one candidate of the
-    next frame by minimum total distance (Hungarian method), within ``gate_px``; a tracklet may miss
-    ``max_misses`` frames in a row. Unclaimed candidates start new tracklets.
+    next frame by minimum total distance (Hungarian method), within ``gate_px`` per frame elapsed; a
+    tracklet may miss ``max_misses`` frames in a row. Unclaimed candidates start new tracklets.
+
+    ``track_gate_px`` (default ``gate_px``) is the gate of a tracklet that already has a velocity (two
+    samples or more): its prediction is then good to the position noise, so a tight gate keeps it from
+    jumping to a neighbouring blob (a second highlight of the same ball, the other end of an elongated one)
+    while its own blob is missed; ``gate_px`` only has to cover the first step, from an unknown speed.
+
+    Only candidates of at least ``start_response`` start a tracklet; weaker ones can only extend one
+    (hysteresis, as in Canny's edge linking: a blob where a track predicts one needs less evidence than a
+    blob anywhere).
+
+    With the frame ``times`` (one per entry of ``cands``), predictions and gates scale with the time
+    elapsed rather than the frames counted, so a dropped frame does not break a tracklet.
     """
     live: list[Tracklet] = []
     done: list[Tracklet] = []
+    fine = gate_px if track_gate_px is None else min(track_gate_px, gate_px)
+    dt = float(np.median(np.diff(times))) if times is not None and len(times) > 1 else 1.0
     for i, c in enumerate(cands):
         if live and len(c):
-            pred = np.array([t.predict() for t in live])
-            gap = np.array([i - t.frames[-1] for t in live], dtype=np.float64)
+            pred = np.array([t.predict(i, times) for t in live])
+            if times is None:
+                gap = np.array([i - t.frames[-1] for t in live], dtype=np.float64)
+            else:
+                gap = np.array([(times[i] - times[t.frames[-1]]) / dt for t in live])
             d = np.hypot(pred[:, :1] - c.u[None, :], pred[:, 1:] - c.v[None, :])
-            gate = gate_px * gap[:, None]
+            per = np.array([fine if len(t.frames) >= 2 else gate_px for t in live])
+            gate = (per * gap)[:, None]
             cost = np.where(d <= gate, d, 1e9)
             rows, cols = linear_sum_assignment(cost)
             ok = cost[rows, cols] < 1e9
@@ -191,6 +249,6 @@ def link_tracklets(cands: list[Candidates], gate_px: float, max_misses: int = 2)
             (still if t.misses <= max_misses else done).append(t)
         live = still
         for k in range(len(c)):
-            if k not in claimed:
+            if k not in claimed and c.response[k] >= start_response:
                 live.append(Tracklet([i], [float(c.u[k])], [float(c.v[k])], [float(c.response[k])]))
     return done + live

@@ -68,8 +68,9 @@ class BearingLocation:
                 slice(max(int(cu - r), 0), min(int(cu + r) + 1, shape[1])))
 
 
-def background_frame(video: FrameSource, n_sample: int = 25) -> npt.NDArray[np.float32]:
-    """Per-pixel median of up to ``n_sample`` frames spread over the video (removes the moving highlights)."""
+def background_frame(video: FrameSource, n_sample: int = 25, quantile: float = 0.5) -> npt.NDArray[np.float32]:
+    """Per-pixel median (or another ``quantile``) of up to ``n_sample`` frames spread over the video (removes
+    the moving highlights where they cover a pixel less than ``1 - quantile`` of the time)."""
     n = len(video)
     idx = np.unique(np.linspace(0, n - 1, min(n, n_sample)).round().astype(int))
     frames = [video.frame_view(int(i)) for i in idx]
@@ -78,7 +79,8 @@ def background_frame(video: FrameSource, n_sample: int = 25) -> npt.NDArray[np.f
     # and the memory used is a few MB instead of 25 frames and their sorted copy.
     for r0 in range(0, out.shape[0], _MEDIAN_ROWS):
         band = np.stack([f[r0:r0 + _MEDIAN_ROWS] for f in frames])
-        out[r0:r0 + _MEDIAN_ROWS] = np.median(band, axis=0)
+        out[r0:r0 + _MEDIAN_ROWS] = (np.median(band, axis=0) if quantile == 0.5
+                                     else np.quantile(band, quantile, axis=0, method="inverted_cdf"))
     return out
 
 

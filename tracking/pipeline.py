@@ -50,6 +50,8 @@ INPUT_HASH = VIDEO_HASH
 #: Shortest segment worth a thread, and the frames two segments share to match identities.
 _MIN_SEGMENT = 1024
 _OVERLAP = 8
+#: Quantile of the sampled frames that the ball selection subtracts (see :func:`_setup`).
+SELECT_QUANTILE = 0.25
 #: Frames served from a memory map between drops of their pages (fault-around maps whole frames:
 #: 8 full-size 16-bit frames are 16 MB).
 _DROP_EVERY = 8
@@ -219,9 +221,14 @@ def _setup(video: FrameSource, loc: BearingLocation, background: np.ndarray, bea
     known = bool(conditions.px_per_mm) or loc.source == "brightness"
     r_prior = (0.5 * g.pitch_diameter_m * 1e3 * conditions.px_per_mm if conditions.px_per_mm
                else 0.5 * (loc.band_inner + loc.band_outer))
-    sel = select_balls(frames, video.times, bg, mask, z=z, ball_diameter_m=g.ball_diameter_m,
+    # The candidates are found over a low quantile of the frames, not their median: an elongated highlight
+    # lying along the orbit covers a pixel for more than half of the time between two balls, and the median
+    # then keeps its ghost, which cuts the highlight into stripes (frame minus background).
+    sel_bg = np.ascontiguousarray(background_frame(video, quantile=SELECT_QUANTILE)[rows, cols])
+    sel = select_balls(frames, video.times, sel_bg, mask, z=z, ball_diameter_m=g.ball_diameter_m,
                        pitch_diameter_m=g.pitch_diameter_m, omega_i=conditions.speed_rad_s, centre0=centre0,
-                       r_prior=r_prior, path=path, prior_known=known)
+                       r_prior=r_prior, path=path, prior_known=known,
+                       pixel_threshold=options.detector.weight_sigma * sigma)
     ring = sel.ring
     ball_px = 2 * g.ball_diameter_m / g.pitch_diameter_m * ring.radius  # now from the measured ball circle
     h, w = mask.shape

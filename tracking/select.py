@@ -11,8 +11,11 @@ wedges between neighbouring balls travel with the balls but on circles at the ed
 
 The stage runs once per video on a few bursts of consecutive frames spread over the clip:
 
-1. blob candidates in every burst frame (:func:`cageless.tracking.candidates.find_candidates`), linked into
-   tracklets;
+1. blob candidates in every burst frame (:func:`cageless.tracking.candidates.find_candidates`, on the frame
+   minus a low quantile of the sampled frames, so that a highlight lying along the orbit leaves no ghost in
+   it), each moved to its blob's centroid (:func:`~cageless.tracking.candidates.refine_candidates`: one
+   point per saturated, elongated or doubled highlight), linked into tracklets with a tight gate once a
+   tracklet has a velocity, and with hysteresis (weaker blobs extend a tracklet but do not start one);
 2. each tracklet's angular speed about the bearing centre: the plausible band for a ball's mean speed
    is :data:`SPEED_BAND` times ``omega_c`` (0.6-1.1: slip up to 25 % plus the unloaded-zone slow-down,
    and balls pushed ahead after impacts, pass; glints at 0 and at 2.5 ``omega_c`` do not); a
@@ -20,13 +23,16 @@ The stage runs once per video on a few bursts of consecutive frames spread over 
    tracked balls' mean speeds are checked against :data:`SPEED_BAND` after tracking;
 3. one common circle by RANSAC over the moving tracklets (Fischler & Bolles 1981), the hypotheses
    with a full complement of balls ranked by their distance from the expected radius (the middle of
-   the ball band, or d_m/2 times px/mm when the scale is given);
+   the ball band, or d_m/2 times px/mm when the scale is given); of circles of about that radius (two
+   lights give two), the one whose members fit it best;
 4. per burst, an exact-Z choice with every cyclic neighbour at least :data:`MIN_SPACING` contact
    spacings apart that maximises the total tracklet weight: a dynamic programme over the cyclic
    order (a global assignment, not per-blob thresholds), and the largest count the spacing allows.
 
-Every tracklet leaves with a status: selected, or rejected with its reason. A clip that shows a ball
-count other than Z, or whose chosen tracks fail the checks, raises :class:`SelectionError`, which
+The count found is the largest that at least half of the bursts show (a ball can be hidden or missed in
+one stretch, but the spacing cannot invent one); the per-frame tracker interpolates and flags the frames
+where a ball is missed. Every tracklet leaves with a status: selected, or rejected with its reason. A clip
+that shows a ball count other than Z, or whose chosen tracks fail the checks, raises :class:`SelectionError`, which
 carries that table so the QC can show what was found.
 """
 
@@ -42,7 +48,8 @@ import numpy.typing as npt
 import pandas as pd
 
 from cageless.errors import TrackingError
-from cageless.tracking.candidates import Tracklet, bin_mask, find_candidates, link_tracklets, response_map, response_noise
+from cageless.tracking.candidates import (Tracklet, bin_mask, find_candidates, link_tracklets, refine_candidates,
+                                          response_map, response_noise)
 from cageless.tracking.locate import fit_circle
 
 __all__ = ["SPEED_BAND", "MIN_SPACING", "BallRing", "Anchor", "Selection", "SelectionError", "select_balls",
@@ -65,6 +72,17 @@ MIN_SPACING = 0.85
 RADIAL_TOL = 0.05
 #: A tracklet must cover this share of its burst.
 MIN_COVER = 0.5
+#: A blob at the place a tracklet predicts extends it down to this share of the response that starts one
+#: (hysteresis): a highlight over a textured or bright face, whose response noise the moving balls raise,
+#: flickers about the start threshold from frame to frame.
+EXTEND_SHARE = 0.6
+#: Window radius of the blob centroid that places each candidate, in ball diameters: a highlight (even
+#: saturated, elongated or two lights' run together) is a small part of its ball (the per-frame tracker
+#: takes blobs up to a quarter ball wide), and distinct blobs of one ball lie further apart than this.
+BLOB_RADIUS = 0.2
+#: Largest step of a tracklet off its constant-velocity prediction per frame, in ball diameters (position
+#: noise; a ball's speed changes by a few per cent over a burst, a small fraction of a ball diameter).
+TRACK_GATE = 0.1
 
 
 class SelectionError(TrackingError):
@@ -93,6 +111,7 @@ class BallRing:
     gap: float  # least angle between chosen neighbours (rad)
     omega_c: float  # pure-rolling cage speed (rad/s)
     omega_i: float  # inner-ring speed (rad/s)
+    pixel_threshold: float = 0.0  # candidate centroid weight threshold (DN)
 
 
 @dataclass(frozen=True)
@@ -127,6 +146,7 @@ class _Context:
     sigma_px: float
     k_sigma: float
     prior_known: bool = True  # False: r_prior is only a scale guess; the circle is chosen by support
+    pixel_threshold: float = 0.0  # centroid weight threshold (DN above the local background)
 
 
 def _burst_plan(n: int, times: np.ndarray, omega_c: float, n_bursts: int) -> list[tuple[int, int]]:
@@ -240,11 +260,15 @@ def _burst_tracklets(frames: Callable[[int], np.ndarray], span: tuple[int, int],
         if noise is None:
             resp, f = response_map(frame, background, ctx.sigma_px)
             noise = response_noise(resp, bin_mask(mask, f))
-        cands.append(find_candidates(frame, background, mask, ctx.sigma_px, ctx.k_sigma, 12 * ctx.z + 32, noise))
+        c = find_candidates(frame, background, mask, ctx.sigma_px, EXTEND_SHARE * ctx.k_sigma, 12 * ctx.z + 32,
+                            noise)
+        cands.append(refine_candidates(c, frame, background, mask, BLOB_RADIUS * ctx.ball_px,
+                                       ctx.pixel_threshold, max(1.0, ctx.sigma_px)))
     dt = float(np.median(np.diff(times[a:b]))) if b - a > 1 else 1e-4
     r_max = ctx.r_prior + ctx.ball_px
     gate = max(3.0, 1.3 * ctx.omega_i * r_max * dt + 2.0)
-    tracks = link_tracklets(cands, gate, max_misses=6)
+    tracks = link_tracklets(cands, gate, max_misses=6, track_gate_px=max(3.0, TRACK_GATE * ctx.ball_px),
+                            start_response=ctx.k_sigma, times=np.asarray(times[a:b], dtype=np.float64))
     for t in tracks:
         t.frames = [f + a for f in t.frames]
     return tracks, float(noise)
@@ -252,9 +276,9 @@ def _burst_tracklets(frames: Callable[[int], np.ndarray], span: tuple[int, int],
 
 def _ransac_circle(pts: np.ndarray, burst: np.ndarray, weight: np.ndarray, ctx: _Context, tol: float,
                    seed: int = 0) -> tuple[float, float, float] | None:
-    """Circle hypotheses through random triples; among those holding (nearly) a full ring of balls in
-    the most bursts, the one closest to the expected radius (or, when the radius is not known, the one
-    whose members are the strongest blobs)."""
+    """Circle hypotheses through random triples. Among those holding (nearly) a full ring of balls in the
+    most bursts: the ones near the expected radius (when it is known) or whose members are the strongest
+    blobs; of these, the nearly full ones; of these, the brightest ring (see :func:`_pick_circle`)."""
     n = len(pts)
     if n < 3:
         return None
@@ -273,13 +297,50 @@ def _ransac_circle(pts: np.ndarray, burst: np.ndarray, weight: np.ndarray, ctx: 
             continue
         res = np.abs(np.hypot(pts[:, 0] - cx, pts[:, 1] - cy) - r)
         inl = res <= tol
-        score = sum(min(int(np.sum(inl & (burst == b))), ctx.z) for b in range(n_b))
-        hyps.append((score, abs(r - ctx.r_prior) if ctx.prior_known else -float(np.sum(weight[inl])), cx, cy, r))
+        score, ring_weight = 0, 0.0
+        for b in range(n_b):
+            w = np.sort(weight[inl & (burst == b)])[::-1][:ctx.z]
+            score += w.size
+            ring_weight += float(w.sum())
+        hyps.append((score, abs(r - ctx.r_prior) if ctx.prior_known else -float(np.sum(weight[inl])), ring_weight,
+                     cx, cy, r))
     if not hyps:
         return None
+    return _pick_circle(hyps, ctx, pts, tol)
+
+
+def _pick_circle(hyps: list[tuple[int, float, float, float, float, float]], ctx: _Context, pts: np.ndarray,
+                 tol: float) -> tuple[float, float, float]:
+    """The ball circle among hypotheses ``(score, prior distance, ring weight, cx, cy, r)``.
+
+    The expected radius (or, without one, the blob strength) tells the ball circle from circles of other
+    things that move with the balls (bright wedges between balls at the band edges, half a ball off it),
+    but not circles of one radius from each other: with two lights, each ball's two highlights travel two
+    circles of the same radius, their centres a fixed offset apart. Of those within a tenth of a ball
+    diameter (or a tenth of the strength) of the best, the nearly full ones (90 % of the fullest) are
+    grouped by centre (distinct circles), each group's best refitted to its members, and the circle whose
+    members lie closest to it (least RMS residual: the most precisely placed highlights) is chosen.
+    """
     top = max(h[0] for h in hyps)
     full = [h for h in hyps if h[0] >= 0.8 * top]
-    _, _, cx, cy, r = min(full, key=lambda h: (h[1], -h[0]))
+    best = min(h[1] for h in full)
+    slack = 0.1 * ctx.ball_px if ctx.prior_known else 0.1 * abs(best)
+    near = [h for h in full if h[1] <= best + slack]
+    most = max(h[0] for h in near)
+    fullest = sorted((h for h in near if h[0] >= 0.9 * most), key=lambda h: (-h[0], -h[2]))
+    groups: list[tuple[int, float, float, float, float, float]] = []
+    for h in fullest:
+        if all(math.hypot(h[3] - g[3], h[4] - g[4]) > tol for g in groups):
+            groups.append(h)
+    if len(groups) == 1:
+        _, _, _, cx, cy, r = groups[0]
+        return cx, cy, r
+    scored = []
+    for h in groups[:4]:
+        inl = np.abs(np.hypot(pts[:, 0] - h[3], pts[:, 1] - h[4]) - h[5]) <= tol
+        fx, fy, fr, rms = fit_circle(pts[inl, 0], pts[inl, 1])
+        scored.append((rms, h[3], h[4], h[5]))
+    _, cx, cy, r = min(scored)
     return cx, cy, r
 
 
@@ -414,18 +475,19 @@ def _table(feats: list[dict[str, float]], reasons: list[str], burst: np.ndarray,
 
 def _context(z: int, ball_diameter_m: float, pitch_diameter_m: float, omega_i: float,
              centre0: tuple[float, float], r_prior: float, k_sigma: float,
-             sigma_px: float | None = None, prior_known: bool = True) -> _Context:
+             sigma_px: float | None = None, prior_known: bool = True, pixel_threshold: float = 0.0) -> _Context:
     ratio = ball_diameter_m / pitch_diameter_m
     ball_px = 2.0 * ratio * r_prior
     return _Context(z=z, gap=MIN_SPACING * 2 * math.asin(min(ratio, 1.0)), omega_c=0.5 * omega_i * (1 - ratio),
                     omega_i=omega_i, ball_px=ball_px, r_prior=r_prior, centre0=centre0,
-                    sigma_px=sigma_px or max(1.0, 0.05 * ball_px), k_sigma=k_sigma, prior_known=prior_known)
+                    sigma_px=sigma_px or max(1.0, 0.05 * ball_px), k_sigma=k_sigma, prior_known=prior_known,
+                    pixel_threshold=pixel_threshold)
 
 
 def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, background: np.ndarray,
                  mask: np.ndarray, *, z: int, ball_diameter_m: float, pitch_diameter_m: float, omega_i: float,
                  centre0: tuple[float, float], r_prior: float, path: object = "video", n_bursts: int = 6,
-                 k_sigma: float = 4.0, prior_known: bool = True) -> Selection:
+                 k_sigma: float = 4.0, prior_known: bool = True, pixel_threshold: float = 0.0) -> Selection:
     """Choose exactly ``z`` ball tracks from bursts spread over the clip (see the module docstring).
 
     Parameters
@@ -442,6 +504,8 @@ def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, backgro
         Bearing centre and the expected radius of the highlight circle (px, cropped image).
     prior_known
         False when ``r_prior`` is only a rough scale (then the circle is chosen by its support).
+    pixel_threshold
+        Per-pixel weight threshold of the centroid that places each candidate (DN; a few noise sigmas).
 
     Raises
     ------
@@ -449,7 +513,7 @@ def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, backgro
         When the clip shows a count other than ``z``, or the chosen tracks fail the checks.
     """
     ctx = _context(z, ball_diameter_m, pitch_diameter_m, omega_i, centre0, r_prior, k_sigma,
-                   prior_known=prior_known)
+                   prior_known=prior_known, pixel_threshold=pixel_threshold)
     spans = _burst_plan(len(times), times, ctx.omega_c, n_bursts)
     tracks: list[Tracklet] = []
     burst: list[int] = []
@@ -469,7 +533,8 @@ def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, backgro
         wts = np.array([math.log1p(feats[k]["response"]) for k in movers])
         circle = _ransac_circle(pts, burst_arr[movers], wts, ctx, tol)
     ring_args = dict(ball_px=ctx.ball_px, sigma_px=ctx.sigma_px, radial_tol_px=tol, response_sigma=float(noise or 1),
-                     k_sigma=k_sigma, z=z, gap=ctx.gap, omega_c=ctx.omega_c, omega_i=omega_i)
+                     k_sigma=k_sigma, z=z, gap=ctx.gap, omega_c=ctx.omega_c, omega_i=omega_i,
+                     pixel_threshold=pixel_threshold)
     if circle is None:
         table = _table(feats, reasons, burst_arr, ctx, direction)
         raise SelectionError(path, f"no {z} highlights moving together along one circle near the cage speed were "
@@ -486,7 +551,9 @@ def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, backgro
     sel_speed = table.loc[table.status == "selected", "speed_ratio"]
     ring = BallRing(centre=(circle[0], circle[1]), radius=circle[2], direction=direction,
                     omega=float(np.median(sel_speed) * ctx.omega_c) if len(sel_speed) else ctx.omega_c, **ring_args)
-    found = int(np.median(counts)) if counts else 0
+    # A ball can be hidden or missed in a stretch of the clip (a land, a dark frame, a glint crossing it), but
+    # the spacing cannot invent one: the count is the largest that at least half the stretches show.
+    found = int(sorted(counts, reverse=True)[(len(counts) - 1) // 2]) if counts else 0
     good = [a for a in anchors if a is not None]
     log.info("%s: ball circle r = %.1f px, counts per burst %s, %d of %d bursts with %d balls", path, circle[2],
              counts, len(good), len(spans), z)
@@ -506,7 +573,8 @@ def anchor_at(frames: Callable[[int], np.ndarray], times: np.ndarray, background
               ring: BallRing, start: int = 0) -> Anchor | None:
     """An anchor from one burst at ``start`` on a known ring (for a segment without one); None if not found."""
     ctx = _Context(z=ring.z, gap=ring.gap, omega_c=ring.omega_c, omega_i=ring.omega_i, ball_px=ring.ball_px,
-                   r_prior=ring.radius, centre0=ring.centre, sigma_px=ring.sigma_px, k_sigma=ring.k_sigma)
+                   r_prior=ring.radius, centre0=ring.centre, sigma_px=ring.sigma_px, k_sigma=ring.k_sigma,
+                   pixel_threshold=ring.pixel_threshold)
     span = _burst_plan(len(times) - start, times[start:], ctx.omega_c, 1)[0]
     span = (span[0] + start, span[1] + start)
     tracks, _ = _burst_tracklets(frames, span, background, mask, ctx, times, ring.response_sigma)
