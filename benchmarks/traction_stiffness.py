@@ -144,7 +144,8 @@ def cost(run_ms: float, repeats: int = 5, calls: int = 2000) -> None:
     print("| film_traction | steps | RHS calls | wall (s) |\n|---|---|---|---|")
     for key in ("on", "off"):
         print(f"| {key} | {rows[key][0]} | {rows[key][1]} | {rows[key][2]:.1f} |")
-    print(f"\nratio on/off: steps {rows['on'][0] / rows['off'][0]:.2f}, RHS calls {rows['on'][1] / rows['off'][1]:.2f}, "
+    print(f"\nratio on/off: steps {rows['on'][0] / rows['off'][0]:.2f}, "
+          f"RHS calls {rows['on'][1] / rows['off'][1]:.2f}, "
           f"wall {rows['on'][2] / rows['off'][2]:.2f}")
 
 

@@ -165,18 +165,16 @@ def test_several_parameters_use_a_design_then_nelder_mead(tmp_path, capsys):
 
 
 # -- recovering a known value ------------------------------------------------------------------------------
-# The "measurement" is a simulation with traction_sliding_coefficient = 0.02 (seed 17, 20 ms start-up left out,
-# 50 ms kept, 6000 rpm, 500 N), written as a video trace; the calibration runs seeds 0..1, so it never sees the
-# measured trajectory. Why this parameter and not C_ho: measured on this branch, the unloaded-zone slip barely
-# responds to C_ho (3000 rpm, 150 ms start-up + 100 ms, 4 seeds: peak 2.157-2.201 % and profile MAE against a
-# C_ho = 3000 run 0.029-0.043 pp for every C_ho in 2000..8000, seed spread 0.01 pp), so C_ho is not identifiable
-# from it; the sliding traction coefficient moves the peak from 13.2 % (0.012) to 0.9 % (0.03).
-# Noise: at the true value the peak of one seed's profile is 6.61 / 7.08 / 6.87 % for seeds 17 / 23 / 31
-# (std 0.24 pp); near 0.02 the peak falls by ~530 pp per unit of the coefficient (7.48 % at 0.018, 5.89 % at 0.021),
-# so a one-seed target pins the coefficient to ~0.0005 (1 sigma): the peak-target tolerance is 0.002 (4 sigma).
-# The profile objective averages ~180 bins and was measured to land within 0.0002 for all three seeds: its
-# tolerance is 0.001.
-TRUE, RANGE = 0.02, (0.012, 0.03)
+# The "measurement" is a simulation with the inlet meniscus distance of the rolling losses r_s = 0.3 mm (seed
+# 17, 20 ms start-up left out, 50 ms kept, 6000 rpm, 500 N), written as a video trace; the calibration runs seeds
+# 0..1, so it never sees the measured trajectory. Why this parameter: the unloaded-zone slip barely responds to
+# C_ho (3000 rpm, 4 seeds: peak 2.157-2.201 % for every C_ho in 2000..8000, measured before issue 16), and since
+# the race contacts take their traction from the film regime (the film_traction effect, issue 16) the traction
+# curve's sliding coefficient acts only between balls (fitted 0.02145 for a true 0.02, measured), while the
+# rolling losses set the slip: at 3000 rpm, 500 N the peak moves from 7.2 % (r_s = 0.16 mm) to 14.3 % (0.66 mm).
+# Measured with the profile objective (budget 8, 2 seeds): fitted 0.3068 mm for seed 17 (2.3 %); the tolerances
+# are 5 % (profile) and 10 % (one-seed peak target, noisier).
+TRUE, RANGE = 0.3e-3, (0.15e-3, 0.6e-3)
 
 
 def _measured(tmp_path: Path, seed: int) -> tuple[Path, float]:
@@ -188,22 +186,22 @@ def _measured(tmp_path: Path, seed: int) -> tuple[Path, float]:
     from cageless.simulation.simulation import Simulation
 
     scene = Scene(OperatingConditions(6000.0, 500.0, 0.0), default_bearing(), duration_s=0.07, seed=seed)
-    trace = Simulation(scene, ModelParameters(traction_sliding_coefficient=TRUE)).run()
+    trace = Simulation(scene, ModelParameters(meniscus_distance_m=TRUE)).run()
     return as_video_trace(trace, 0.02, tmp_path / f"measured{seed}.trace.h5"), 100 * peak_unloaded_slip(trace, 0.02)
 
 
-def test_calibration_recovers_a_known_traction_coefficient_from_a_trace(tmp_path, capsys):
+def test_calibration_recovers_a_known_meniscus_distance_from_a_trace(tmp_path, capsys):
     path, _ = _measured(tmp_path, 17)
     out = tmp_path / "fit.toml"
     start = time.perf_counter()
-    assert main(["calibrate", str(path), "--vary", f"traction_sliding_coefficient={RANGE[0]}:{RANGE[1]}",
+    assert main(["calibrate", str(path), "--vary", f"meniscus_distance_m={RANGE[0]}:{RANGE[1]}",
                  "--settle", "0.02", "--budget", "8", "--seeds", "2", "-q", "-o", str(out)]) == 0
     wall = time.perf_counter() - start
     cal = tomllib.loads(out.read_text())["calibration"]
-    fitted = cal["fitted"]["traction_sliding_coefficient"]
-    print(f"true {TRUE}, fitted {fitted:.5f}, {cal['evaluations_used']} evaluations x 2 seeds, {wall:.1f} s, "
+    fitted = cal["fitted"]["meniscus_distance_m"]
+    print(f"true {TRUE}, fitted {fitted:.4g}, {cal['evaluations_used']} evaluations x 2 seeds, {wall:.1f} s, "
           f"MAE {cal['objective_pp']:.3f} pp", file=sys.stderr)
-    assert abs(fitted - TRUE) < 0.001
+    assert abs(fitted - TRUE) < 0.05 * TRUE
     assert cal["trace_sha256"] and cal["condition"] == "6000 rpm, 500 N radial, 0 N axial"
     assert cal["metric"] == "mae" and cal["evaluations_used"] == 8
 
@@ -212,11 +210,11 @@ def test_calibration_recovers_a_known_traction_coefficient_from_a_trace(tmp_path
 @pytest.mark.parametrize("seed", [17, 23, 31])
 def test_calibration_recovers_it_from_other_measurements_and_from_the_peak(tmp_path, seed):
     path, peak = _measured(tmp_path, seed)
-    bound = [Bound("traction_sliding_coefficient", *RANGE)]
+    bound = [Bound("meniscus_distance_m", *RANGE)]
     from cageless.app.calibrate import target_from_trace
 
     by_trace = calibrate(target_from_trace(path, 0.05), bound, budget=10, seeds=2, settle_s=0.02, progress=False)
     by_peak = calibrate(target_from_peak(6000.0, 500.0, peak, duration_s=0.05), bound, budget=10, seeds=2,
                         settle_s=0.02, progress=False)
-    assert abs(by_trace.fitted["traction_sliding_coefficient"] - TRUE) < 0.001
-    assert abs(by_peak.fitted["traction_sliding_coefficient"] - TRUE) < 0.002
+    assert abs(by_trace.fitted["meniscus_distance_m"] - TRUE) < 0.05 * TRUE
+    assert abs(by_peak.fitted["meniscus_distance_m"] - TRUE) < 0.1 * TRUE
