@@ -43,7 +43,8 @@ def observables(pr: Problem, t: npt.NDArray[np.float64], y: npt.NDArray[np.float
     p = pr.params
     z = int(p[B.P_Z])
     trac = p[B.P_F_TRAC] > 0.5
-    fields = kernel_observables(pr, t, y, film_coefficients(scene) if film_on and trac else None)
+    # the films at the oil's viscosity at its temperature, as the race forces use it (the ETA0 slot)
+    fields = kernel_observables(pr, t, y, film_coefficients(scene, float(p[B.P_ETA0])) if film_on and trac else None)
     names = ["inner_normal", "outer_normal", "ball_ball_normal"] + (["inner_traction", "outer_traction"] if trac
                                                                      else [])
     names += ["inner_film", "outer_film"] if film_on else []
@@ -101,16 +102,18 @@ def _observe(model_id, ts, ys, p, log, c_outer, c_inner, out):  # pragma: no cov
                 out[i, f_h, j] = c_h * max(out[i, f_u, j], 1e-6) ** 0.67 * q ** -0.067 if q > 0.0 else np.nan
 
 
-def film_coefficients(scene: Scene) -> tuple[float, float]:
+def film_coefficients(scene: Scene, viscosity_pa_s: float | None = None) -> tuple[float, float]:
     """c_h of the outer and inner race contact in the Hamrock-Dowson central film h = c_h u^0.67 Q^-0.067
-    (:func:`cageless.simulation.traction.film_coefficient`; SI units)."""
+    (:func:`cageless.simulation.traction.film_coefficient`; SI units), at ``viscosity_pa_s`` (default: the
+    lubricant's reference viscosity; a run passes its oil's viscosity at the oil temperature)."""
     b = scene.bearing
     g, lub = b.geometry, b.lubricant
     assert lub is not None
+    eta0 = lub.dynamic_viscosity_pa_s if viscosity_pa_s is None else viscosity_pa_s
     eta = compliance(b.material)
     rc = race_curvatures(g)
     d = g.ball_diameter_m
     rx = {"inner": 1.0 / (2.0 / d + 2.0 / g.inner_race_diameter_m), "outer": 1.0 / (2.0 / d - 2.0 / g.outer_race_diameter_m)}
-    outer, inner = (film_coefficient(hertz_contact(*rc[race], eta), rx[race], lub.dynamic_viscosity_pa_s,
+    outer, inner = (film_coefficient(hertz_contact(*rc[race], eta), rx[race], eta0,
                                      lub.pressure_viscosity_coefficient_1_pa, 2.0 / eta) for race in ("outer", "inner"))
     return outer, inner

@@ -118,3 +118,22 @@ def test_spatial_observables_reduce_to_the_planar_ones():
         np.testing.assert_allclose(b[field][keep], a[field][keep], rtol=1e-6,
                                    atol=1e-9 * max(np.max(np.abs(a[field])), 1e-12), err_msg=B.OBSERVABLES[field])
     assert np.sum(a[B.OBS_INNER_NORMAL] > 10.0) >= 5 and np.max(np.abs(a[B.OBS_INNER_TRACTION])) > 0.1
+
+
+def test_films_in_the_trace_use_the_oil_viscosity_at_its_temperature():
+    """The reported films use eta(T), as the race forces do: Hamrock & Dowson (1977) give h_c ~ (eta u)^0.67, so
+    at 60 degC the films are (eta(60)/eta(20))^0.67 of those at 20 degC on the same states."""
+    from cageless.simulation.models.observables import observables
+
+    scene = Scene(conditions=OperatingConditions(3000.0, 500.0), duration_s=1e-3)
+    runs = {}
+    for temp in (20.0, 60.0):
+        pr = Simulation(scene, ModelParameters(oil_temperature_c=temp)).build()
+        ys = np.array([_moving_state(pr, 0)])
+        runs[temp] = (pr.params[B.P_ETA0], observables(pr, np.array([6e-3]), ys, scene, True)["contacts"])
+    (eta20, c20), (eta60, c60) = runs[20.0], runs[60.0]
+    assert eta60 < 0.5 * eta20  # the paper's temperature coefficient thins the oil by more than half over 40 K
+    for name in ("outer_film", "inner_film"):
+        loaded = np.isfinite(c20[name])
+        assert loaded.sum() >= 5
+        np.testing.assert_allclose(c60[name][loaded] / c20[name][loaded], (eta60 / eta20) ** 0.67, rtol=1e-9)
