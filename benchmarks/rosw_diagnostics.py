@@ -37,6 +37,7 @@ from typing import Any
 import numba
 import numpy as np
 
+from cageless.atomic import atomic_write_text
 from cageless.simulation.bench import _settled_problem
 from cageless.simulation.integrators import rosw as rw
 from cageless.simulation.kernels import model_gaps, model_rhs, model_signature
@@ -245,9 +246,7 @@ def main() -> None:
     d = diagnose(args.level, args.window, args.rtol, args.jac_every, args.lu_ratio, args.trace)
     print(format_report(d))
     if args.json:
-        tmp = args.json.with_suffix(".tmp")
-        tmp.write_text(json.dumps(d, indent=1))
-        tmp.replace(args.json)
+        atomic_write_text(args.json, json.dumps(d, indent=1))
 
 
 if __name__ == "__main__":

@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from cageless.atomic import atomic_write_text
 from cageless.conditions import OperatingConditions
 from cageless.kinematics import theoretical_cage_speed
 from cageless.simulation.bench import _errors, _settled_problem
@@ -145,9 +146,7 @@ def main() -> None:
         log.info("%s", format_rows(rows))
     print(format_rows(rows))
     if args.json:
-        tmp = args.json.with_suffix(".tmp")
-        tmp.write_text(json.dumps(rows, indent=1))
-        tmp.replace(args.json)
+        atomic_write_text(args.json, json.dumps(rows, indent=1))
 
 
 if __name__ == "__main__":

@@ -11,6 +11,7 @@ a refactor that leaves the physics alone leaves every hash as it was.
 import hashlib
 import json
 import sys
+from pathlib import Path
 
 import numpy as np
 from cageless.conditions import OperatingConditions
@@ -42,6 +43,7 @@ def digest(a):
 if len(sys.argv) < 2 or sys.argv[1] in ("-h", "--help"):
     sys.exit(__doc__)
 out_dir = sys.argv[1]
+Path(out_dir).mkdir(parents=True, exist_ok=True)
 names = sys.argv[2:] or list(SCENES)
 res = {}
 for name in names:

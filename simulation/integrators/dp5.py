@@ -108,9 +108,7 @@ def dp5_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_st
             continue
         verdict, sig = _controls(model_id, ynew, p, sig, h, h_onset, ks[0], ks[6], jump_floor, force_jump)
         if verdict == 1 or verdict == 2:  # a contact changed in a long step, or a force jumped
-            cnt[_REJ] += 1
-            cnt[_ONSET if verdict == 1 else _JUMPS] += 1
-            h = h_onset if verdict == 1 else max(0.5 * h, h_onset)
+            h = _retry_step(verdict, h, h_onset, cnt)
             continue
         cnt[_CHANGES] += verdict == 3
         cnt[_STIFF] += _stiff(h, ks, ynew, yt)
@@ -186,6 +184,15 @@ def _stiff(h, ks, ynew, yt):  # pragma: no cover - compiled
         num += (ks[6, i] - ks[5, i]) ** 2
         den += (ynew[i] - yt[i]) ** 2
     return 1 if den > 0.0 and h * h * num > 3.25 * 3.25 * den else 0
+
+
+@numba.njit(cache=True)
+def _retry_step(verdict, h, h_onset, cnt):  # pragma: no cover - compiled
+    """Count a step refused by :func:`_controls` and return the length to retry it at: the onset step after a
+    contact change in a long step (verdict 1), half the length after a force jump (verdict 2)."""
+    cnt[_REJ] += 1
+    cnt[_ONSET if verdict == 1 else _JUMPS] += 1
+    return h_onset if verdict == 1 else max(0.5 * h, h_onset)
 
 
 @numba.njit(cache=True)

@@ -44,7 +44,7 @@ import numba
 import numpy as np
 
 from cageless.simulation.integrators.dp5 import (STATUS_MAX_STEPS, STATUS_NONFINITE, STATUS_OK,
-                                                 STATUS_STEP_UNDERFLOW, _accept, _controls)
+                                                 STATUS_STEP_UNDERFLOW, _accept, _controls, _retry_step)
 from cageless.simulation.jacobian import grouped_fd
 from cageless.simulation.kernels import model_rhs, model_signature
 
@@ -484,9 +484,7 @@ def rosw_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_s
         rejected = False
         verdict, sig = _controls(model_id, ynew, p, sig, h, h_onset, k1, k7, jump_floor, force_jump)
         if verdict == 1 or verdict == 2:  # a contact changed in a long step, or a force jumped
-            cnt[_REJ] += 1
-            cnt[_ONSET if verdict == 1 else _JUMPS] += 1
-            h = h_onset if verdict == 1 else max(0.5 * h, h_onset)
+            h = _retry_step(verdict, h, h_onset, cnt)
             continue
         cnt[_CHANGES] += verdict == 3
         age = jac_every if verdict == 3 else age + 1  # a contact opened or closed: a damping term switched

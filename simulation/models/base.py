@@ -9,10 +9,12 @@ their physics modules (:mod:`cageless.simulation.models.contact_laws`) use them.
 
 from __future__ import annotations
 
+import numba
+
 from cageless.simulation.effects import parameter_slots
 from cageless.simulation.layout import ParameterLayout
 
-__all__ = ["BODY_SLOTS", "LAYOUT", "OBSERVABLES", "N_OBS"]
+__all__ = ["BODY_SLOTS", "LAYOUT", "OBSERVABLES", "N_OBS", "signature_add"]
 
 #: The model body: ball count Z, ball diameter D, ball mass M and spin inertia I, the ring's translational
 #: mass MR, the race diameters DI and DO, the radial load FR, the ring speed WI and its ramp time RAMP.
@@ -45,3 +47,16 @@ OBSERVABLES = ("outer_normal", "inner_normal", "outer_traction", "inner_traction
 (OBS_OUTER_NORMAL, OBS_INNER_NORMAL, OBS_OUTER_TRACTION, OBS_INNER_TRACTION, OBS_OUTER_ENTRAIN, OBS_INNER_ENTRAIN,
  OBS_BB_NORMAL, OBS_BB_TRACTION, OBS_OUTER_FILM, OBS_INNER_FILM) = range(len(OBSERVABLES))
 N_OBS = len(OBSERVABLES)
+
+
+@numba.njit(cache=True, inline="always")
+def signature_add(sig, j, z, outer, inner, pair):  # pragma: no cover - compiled
+    """Ball j's closed contacts added to a contact signature: (index + 1) of each closed contact, the outer race
+    contacts indexed 0..Z-1, the inner Z..2Z-1, the pairs (j, j+1) 2Z..3Z-1 (both models' ``*_signature``)."""
+    if outer > 0.0:
+        sig += 1.0 + j
+    if inner > 0.0:
+        sig += 1.0 + z + j
+    if pair > 0.0:
+        sig += 1.0 + 2 * z + j
+    return sig

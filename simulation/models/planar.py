@@ -52,7 +52,7 @@ from cageless.simulation.models.base import (LAYOUT, OBS_BB_NORMAL, OBS_BB_TRACT
                                              OBS_INNER_TRACTION, OBS_OUTER_ENTRAIN, OBS_OUTER_NORMAL, OBS_OUTER_TRACTION,
                                              P_CD, P_CHI, P_CHO, P_D, P_DI, P_DO, P_DRY, P_ETA0, P_FR,
                                     P_F_BB, P_F_BBFILM, P_F_DRAG, P_F_GRAV, P_F_LUB, P_F_RACE, P_F_ROLL, P_F_TRAC, P_G, P_H0,
-                                    P_I, P_KB, P_KI, P_KO, P_M, P_MR, P_RAMP, P_RHO_MIX, P_V_IN_MIN, P_WI, P_Z)
+                                    P_I, P_KB, P_KI, P_KO, P_M, P_MR, P_RAMP, P_RHO_MIX, P_V_IN_MIN, P_WI, P_Z, signature_add)
 from cageless.simulation.models.energy import planar_energy
 from cageless.simulation.models.planar_layout import PlanarLayout
 from cageless.simulation.models.contact_log import (EVENT_FIELDS, ONSET_RESOLUTION, RUBBING_FACTOR, contact_events,
@@ -375,12 +375,7 @@ def planar_signature(y, p):  # pragma: no cover - compiled
     sig = 0.0
     for j in range(z):
         outer, inner, pair = _overlaps(y, p, j, z)
-        if outer > 0.0:
-            sig += 1.0 + j
-        if inner > 0.0:
-            sig += 1.0 + z + j
-        if pair > 0.0:
-            sig += 1.0 + 2 * z + j
+        sig = signature_add(sig, j, z, outer, inner, pair)
     return sig * (sig + 1.0)  # spreads sums so that one contact swapping for another rarely keeps the value
 
 

@@ -104,12 +104,7 @@ def spatial_signature(y, p):  # pragma: no cover - compiled
     sig = 0.0
     for j in range(z):
         outer, inner, pair = _overlaps(y, p, j, z, rot)
-        if outer > 0.0:
-            sig += 1.0 + j
-        if inner > 0.0:
-            sig += 1.0 + z + j
-        if pair > 0.0:
-            sig += 1.0 + 2 * z + j
+        sig = B.signature_add(sig, j, z, outer, inner, pair)
     return sig * (sig + 1.0)
 
 

@@ -20,6 +20,8 @@ off differ by the traction alone, which is compared with the hand value.
 from __future__ import annotations
 
 import math
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -31,6 +33,9 @@ from cageless.simulation.models import spatial as S
 from cageless.simulation.parameters import ModelParameters
 from cageless.simulation.run import initial_state
 from cageless.simulation.scene import Scene
+
+sys.path.insert(0, str(Path(__file__).parent))
+from effect_helpers import effect_contribution  # noqa: E402
 
 H0 = 0.2e-6  # fixed film: Lambda = 2 with sigma = 0.1 um, the middle of the mixed band (w = 1/2)
 
@@ -62,16 +67,7 @@ def _setup(level, film, temperature_c=20.0):
 
 
 def _traction_only(pr, y):
-    off = pr.params.copy()
-    off[pr.layout.index("F_TRAC")] = 0.0
-    on = pr.rhs(0.0, y)
-    saved = pr.params.copy()
-    pr.params[:] = off
-    try:
-        base = pr.rhs(0.0, y)
-    finally:
-        pr.params[:] = saved
-    return on - base
+    return effect_contribution(pr, y, "F_TRAC")
 
 
 @pytest.mark.parametrize("level", ["planar", "spatial"])

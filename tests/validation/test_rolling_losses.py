@@ -19,6 +19,8 @@ dissipation. The radii are the textbook ones (Harris & Kotzalas, *Essential Conc
 from __future__ import annotations
 
 import math
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -29,6 +31,9 @@ from cageless.simulation.models import spatial as S
 from cageless.simulation.parameters import ModelParameters
 from cageless.simulation.run import initial_state
 from cageless.simulation.scene import Scene
+
+sys.path.insert(0, str(Path(__file__).parent))
+from effect_helpers import effect_contribution  # noqa: E402
 
 R_S = 0.4e-3
 H0 = 0.2e-6
@@ -56,16 +61,7 @@ def _problem(level="planar"):
 
 
 def _difference(pr, y):
-    """dy/dt with the effect on, minus with it off."""
-    off = pr.params.copy()
-    off[pr.layout.index("F_ROLL")] = 0.0
-    on = pr.rhs(0.0, y)
-    pr.params[:], saved = off, pr.params.copy()
-    try:
-        base = pr.rhs(0.0, y)
-    finally:
-        pr.params[:] = saved
-    return on - base
+    return effect_contribution(pr, y, "F_ROLL")
 
 
 @pytest.mark.parametrize("level", ["planar", "spatial"])
