@@ -75,10 +75,13 @@ class Tracklet:
 def _hessian_min(img: np.ndarray, sigma: float) -> np.ndarray:
     """``sigma^2`` times the smallest eigenvalue of the negative Hessian of ``img`` smoothed at ``sigma``."""
     g = cv2.GaussianBlur(img, (0, 0), sigma, borderType=cv2.BORDER_REPLICATE)
-    # The scale 1/4 of each second difference applied by Sobel itself (a power of two: the same values).
-    dxx = cv2.Sobel(g, cv2.CV_32F, 2, 0, ksize=3, scale=0.25, borderType=cv2.BORDER_REPLICATE)
-    dyy = cv2.Sobel(g, cv2.CV_32F, 0, 2, ksize=3, scale=0.25, borderType=cv2.BORDER_REPLICATE)
-    dxy = cv2.Sobel(g, cv2.CV_32F, 1, 1, ksize=3, scale=0.25, borderType=cv2.BORDER_REPLICATE)
+    # (Sobel's own ``scale=0.25`` is not the same: OpenCV's vector path rounds differently on some pixels.)
+    dxx = cv2.Sobel(g, cv2.CV_32F, 2, 0, ksize=3, borderType=cv2.BORDER_REPLICATE)
+    dyy = cv2.Sobel(g, cv2.CV_32F, 0, 2, ksize=3, borderType=cv2.BORDER_REPLICATE)
+    dxy = cv2.Sobel(g, cv2.CV_32F, 1, 1, ksize=3, borderType=cv2.BORDER_REPLICATE)
+    dxx *= 0.25
+    dyy *= 0.25
+    dxy *= 0.25
     # With a = -dxx, c = -dyy: sigma^2 (0.5 (a + c) - sqrt(h^2 + dxy^2)), h = 0.5 (a - c), computed in place
     # (negations and the factors 0.5 are exact, so these are the same float32 values).
     mean = dxx + dyy
