@@ -258,13 +258,14 @@ def cyclic_select(angles: npt.ArrayLike, weights: npt.ArrayLike, z: int, gap: fl
 
 
 def _prefix_argmax(x: np.ndarray) -> np.ndarray:
-    out = np.zeros(x.size, dtype=np.int64)
-    best = 0
-    for i in range(x.size):
-        if x[i] > x[best]:
-            best = i
-        out[i] = best
-    return out
+    """Index of the first maximum of ``x[:i + 1]`` for every i (x without NaN): each element that beats every
+    element before it starts a new run."""
+    if x.size == 0:
+        return np.zeros(0, dtype=np.int64)
+    beats = np.empty(x.size, dtype=bool)
+    beats[0] = True
+    beats[1:] = x[1:] > np.maximum.accumulate(x)[:-1]
+    return np.maximum.accumulate(np.where(beats, np.arange(x.size), 0))
 
 
 def _greedy_count(rel: np.ndarray, gap: float) -> int:

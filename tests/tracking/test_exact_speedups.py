@@ -47,3 +47,24 @@ def test_tracklet_fits_are_bit_identical_to_numpy():
         assert np.float64(_slope(x, y)).tobytes() == np.float64(np.polyfit(x, y, 1)[0]).tobytes()
         vals = list(rng.exponential(4.0, n))
         assert np.float64(_median(vals)).tobytes() == np.float64(np.median(vals)).tobytes()
+
+
+def _prefix_argmax_loop(x: np.ndarray) -> np.ndarray:
+    out = np.zeros(x.size, dtype=np.int64)
+    best = 0
+    for i in range(x.size):
+        if x[i] > x[best]:
+            best = i
+        out[i] = best
+    return out
+
+
+def test_prefix_argmax_matches_the_loop_with_ties_and_minus_infinity():
+    from cageless.tracking.select import _prefix_argmax
+
+    rng = np.random.default_rng(5)
+    for _ in range(3000):
+        n = int(rng.integers(0, 40))
+        x = rng.integers(-3, 4, n).astype(np.float64)  # many ties
+        x[rng.random(n) < 0.3] = -np.inf
+        assert np.array_equal(_prefix_argmax(x), _prefix_argmax_loop(x))
