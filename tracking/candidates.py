@@ -75,12 +75,26 @@ class Tracklet:
 def _hessian_min(img: np.ndarray, sigma: float) -> np.ndarray:
     """``sigma^2`` times the smallest eigenvalue of the negative Hessian of ``img`` smoothed at ``sigma``."""
     g = cv2.GaussianBlur(img, (0, 0), sigma, borderType=cv2.BORDER_REPLICATE)
-    dxx = cv2.Sobel(g, cv2.CV_32F, 2, 0, ksize=3, borderType=cv2.BORDER_REPLICATE) * 0.25
-    dyy = cv2.Sobel(g, cv2.CV_32F, 0, 2, ksize=3, borderType=cv2.BORDER_REPLICATE) * 0.25
-    dxy = cv2.Sobel(g, cv2.CV_32F, 1, 1, ksize=3, borderType=cv2.BORDER_REPLICATE) * 0.25
-    a, c = -dxx, -dyy
-    half = 0.5 * (a - c)
-    return (sigma * sigma) * (0.5 * (a + c) - np.sqrt(half * half + dxy * dxy))
+    # (Sobel's own ``scale=0.25`` is not the same: OpenCV's vector path rounds differently on some pixels.)
+    dxx = cv2.Sobel(g, cv2.CV_32F, 2, 0, ksize=3, borderType=cv2.BORDER_REPLICATE)
+    dyy = cv2.Sobel(g, cv2.CV_32F, 0, 2, ksize=3, borderType=cv2.BORDER_REPLICATE)
+    dxy = cv2.Sobel(g, cv2.CV_32F, 1, 1, ksize=3, borderType=cv2.BORDER_REPLICATE)
+    dxx *= 0.25
+    dyy *= 0.25
+    dxy *= 0.25
+    # With a = -dxx, c = -dyy: sigma^2 (0.5 (a + c) - sqrt(h^2 + dxy^2)), h = 0.5 (a - c), computed in place
+    # (negations and the factors 0.5 are exact, so these are the same float32 values).
+    mean = dxx + dyy
+    np.multiply(mean, -0.5, out=mean)  # 0.5 (a + c)
+    np.subtract(dyy, dxx, out=dyy)
+    np.multiply(dyy, 0.5, out=dyy)  # h
+    np.multiply(dyy, dyy, out=dyy)
+    np.multiply(dxy, dxy, out=dxy)
+    np.add(dyy, dxy, out=dyy)
+    np.sqrt(dyy, out=dyy)
+    np.subtract(mean, dyy, out=mean)
+    mean *= sigma * sigma
+    return mean
 
 
 #: Scales searched, in expected highlight widths: small and saturated highlights, and highlights

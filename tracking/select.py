@@ -160,13 +160,39 @@ def _burst_plan(n: int, times: np.ndarray, omega_c: float, n_bursts: int) -> lis
 
 def _features(t: Tracklet, times: np.ndarray, centre: tuple[float, float]) -> dict[str, float]:
     f, u, v = t.arrays()
-    th = np.unwrap(np.arctan2(-(v - centre[1]), u - centre[0]))
+    th = _unwrap(np.arctan2(-(v - centre[1]), u - centre[0]))
     tt = times[f]
-    omega = float(np.polyfit(tt - tt.mean(), th, 1)[0]) if f.size >= 3 else 0.0
+    omega = _slope(tt - tt.mean(), th) if f.size >= 3 else 0.0
     mid = f.size // 2
     return {"u": float(u[mid]), "v": float(v[mid]), "frame": int(f[mid]), "omega": omega,
             "radius": float(np.mean(np.hypot(u - centre[0], v - centre[1]))), "n": int(f.size),
-            "response": float(np.median(t.response))}
+            "response": _median(t.response)}
+
+
+def _unwrap(th: np.ndarray) -> np.ndarray:
+    """:func:`numpy.unwrap`, without its work when no step reaches pi (then it adds zeros: ``th + 0.0``)."""
+    if th.size < 2 or bool(np.all(np.abs(np.diff(th)) < math.pi)):
+        return th + 0.0
+    return np.unwrap(th)
+
+
+def _slope(x: np.ndarray, y: np.ndarray) -> float:
+    """The slope of ``np.polyfit(x, y, 1)``, by the same scaled least squares without its argument checks
+    (the same value; many short tracklets made the checks a large share of the selection's time)."""
+    lhs = np.empty((x.size, 2))
+    lhs[:, 0] = x + 0.0
+    lhs[:, 1] = 1.0
+    scale = np.sqrt((lhs * lhs).sum(axis=0))
+    lhs /= scale
+    c = np.linalg.lstsq(lhs, y + 0.0, x.size * np.finfo(np.float64).eps)[0]
+    return float(c[0] / scale[0])
+
+
+def _median(values: list[float]) -> float:
+    """:func:`numpy.median` of a short list of finite numbers (the middle one, or the mean of the middle two)."""
+    s = sorted(values)
+    k = len(s) // 2
+    return float(s[k]) if len(s) % 2 else float((s[k - 1] + s[k]) / 2)
 
 
 def _speed_reason(ratio: float, omega: float, ctx: _Context) -> str:
@@ -232,13 +258,14 @@ def cyclic_select(angles: npt.ArrayLike, weights: npt.ArrayLike, z: int, gap: fl
 
 
 def _prefix_argmax(x: np.ndarray) -> np.ndarray:
-    out = np.zeros(x.size, dtype=np.int64)
-    best = 0
-    for i in range(x.size):
-        if x[i] > x[best]:
-            best = i
-        out[i] = best
-    return out
+    """Index of the first maximum of ``x[:i + 1]`` for every i (x without NaN): each element that beats every
+    element before it starts a new run."""
+    if x.size == 0:
+        return np.zeros(0, dtype=np.int64)
+    beats = np.empty(x.size, dtype=bool)
+    beats[0] = True
+    beats[1:] = x[1:] > np.maximum.accumulate(x)[:-1]
+    return np.maximum.accumulate(np.where(beats, np.arange(x.size), 0))
 
 
 def _greedy_count(rel: np.ndarray, gap: float) -> int:
