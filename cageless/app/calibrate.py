@@ -309,6 +309,24 @@ def _search(f: _Objective, d: int, budget: int) -> str:
             "Nelder-Mead with bounds (scipy.optimize.minimize), unit-scaled")
 
 
+def _check_range_ends(bounds: list[Bound], fixed: Mapping[str, Any]) -> None:
+    """Both ends of every varied model parameter must make a valid parameter set with the held values (a rule
+    between two parameters, such as peak above sliding traction, can refuse part of a documented range)."""
+    from cageless.simulation.parameters import ModelParameters
+
+    for b in bounds:
+        if "." in b.name:
+            continue
+        for value in (b.low, b.high):
+            try:
+                ModelParameters().with_overrides({**fixed, b.name: value})
+            except ParameterError as exc:
+                other = exc.parameter.removeprefix("parameters.")
+                shown = "" if exc.value is None or other == b.name else f"={exc.value}"
+                raise UsageError(f"--vary {b.name}={b.low:g}:{b.high:g}: at {value:g}, {other}{shown} {exc.rule}. "
+                                 "Narrow the range, or set the other parameter with --set.") from None
+
+
 def calibrate(target: Target, bounds: list[Bound], budget: int | None = None, seeds: int = 2, metric: str = "mae",
               settle_s: float | None = None, fixed: Mapping[str, Any] | None = None, bearing: Bearing | None = None,
               workers: int = 2, scheduler: str | None = None, progress: bool = True) -> CalibrationResult:
@@ -337,6 +355,7 @@ def calibrate(target: Target, bounds: list[Bound], budget: int | None = None, se
     fixed = dict(fixed or {})
     model_fixed = {k: v for k, v in fixed.items() if "." not in k}
     ModelParameters().with_overrides(model_fixed)  # checked before any work starts
+    _check_range_ends(bounds, model_fixed)
     bearing = bearing or default_bearing()
     base = sweep_base(target.speed_rpm, target.radial_load_n, target.axial_load_n, target.duration_s, settle_s,
                       model_fixed, bearing, command="calibrate")
@@ -347,7 +366,7 @@ def calibrate(target: Target, bounds: list[Bound], budget: int | None = None, se
         method = _search(f, d, budget)
     ok = [r for r in f.table if r["status"] == "ok"]
     if not ok:
-        raise CagelessError("every calibration run failed: " + f.table[0]["status"])
+        raise CagelessError("every calibration run failed: " + f.table[0]["status"].removeprefix("failed: "))
     best = min(ok, key=lambda r: r["objective_pp"])
     return CalibrationResult(fitted={b.name: best[b.name] for b in bounds}, objective_pp=best["objective_pp"],
                              evaluations=f.table, method=method, budget=budget, seeds=seeds, metric=metric,
@@ -362,10 +381,10 @@ EDGE_SHARE = 0.02
 def fit_warnings(result: CalibrationResult) -> list[str]:
     """Say where a calibration does not determine its parameters.
 
-    Four checks on the evaluation table: several parameters against one number (a peak-slip target);
-    a fitted value at the edge of its range; an objective whose whole spread over the evaluations is
-    within the seeds' own spread (the target does not see the parameter); and other evaluations,
-    far from the fitted values, that fit as well within that spread.
+    Checks on the evaluation table: several parameters against one number (a peak-slip target); a fitted
+    value at the edge of its range; one seed per evaluation (noise unknown); an objective whose whole spread
+    over the evaluations is within the largest seed-to-seed spread (the target does not see the parameter);
+    and other evaluations, far from the fitted values, that fit as well within that spread.
     """
     out: list[str] = []
     ok = [r for r in result.evaluations if r["status"] == "ok"]
@@ -377,7 +396,11 @@ def fit_warnings(result: CalibrationResult) -> list[str]:
         if min(share, 1.0 - share) < EDGE_SHARE:
             out.append(f"{b.name} = {result.fitted[b.name]:.6g} is at the edge of its range {b.low:g}:{b.high:g}; "
                        "the best value may lie outside it")
-    spread = np.nanmedian([r["seed_spread_pp"] for r in ok]) if len(ok) and result.seeds > 1 else 0.0
+    if result.seeds == 1:
+        out.append("one seed per evaluation: the objective's seed-to-seed noise is unknown; --seeds 2 or more "
+                   "shows whether the fit is determined")
+    spreads = [r["seed_spread_pp"] for r in ok if np.isfinite(r["seed_spread_pp"])]
+    spread = max(spreads) if spreads and result.seeds > 1 else 0.0  # the noise an evaluation can carry
     objectives = np.array([r["objective_pp"] for r in ok])
     if len(ok) > 2 and np.isfinite(spread) and np.ptp(objectives) <= spread:
         out.append(f"the objective changes by {np.ptp(objectives):.3f} pp over the evaluations, within the "

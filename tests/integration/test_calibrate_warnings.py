@@ -55,3 +55,14 @@ def test_several_parameters_against_one_peak_are_underdetermined():
     bounds = [CHO, Bound("restitution", 0.5, 0.9)]
     texts = fit_warnings(_result(rows, bounds, {"cho_n_s_m": 5000.0, "restitution": 0.7}))
     assert texts[0].startswith("a peak slip is one number: it cannot determine 2 parameters")
+
+
+def test_noise_is_judged_by_the_largest_seed_spread_and_one_seed_is_named():
+    # the objective ranges over 0.57 pp while one evaluation's seeds differ by 0.62 pp: noise, not a fit
+    rows = [(0.0252786, 4.493), (0.0252853, 5.060), (0.02, 4.8), (0.03, 4.9)]
+    bound = Bound("traction_sliding_coefficient", 0.01, 0.03)
+    res = _result(rows, [bound], {"traction_sliding_coefficient": 0.0252786}, spread=0.1)
+    res.evaluations[1]["seed_spread_pp"] = 0.62
+    assert any("within the seeds' spread (0.620 pp)" in w for w in fit_warnings(res))
+    one = CalibrationResult(**{**res.__dict__, "seeds": 1})
+    assert fit_warnings(one)[0].startswith("one seed per evaluation")

@@ -146,3 +146,22 @@ def test_a_missing_video_is_named_once(tmp_path, capsys):
     assert main(["track", str(missing), "-o", str(tmp_path / "o"), "-q"]) == 1
     out = capsys.readouterr().out
     assert out == f"FAILED {missing}: no such file or folder.\n"
+
+
+def test_a_rule_between_two_parameters_names_the_one_to_set_as_well(tmp_path, capsys):
+    argv = ["simulate", "--speed-rpm", "3000", "-o", str(tmp_path / "x.trace.h5")]
+    assert main([*argv, "--set", "traction_sliding_coefficient=0.1"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: --set traction_sliding_coefficient=0.1: traction_peak_coefficient=0.06 must exceed")
+    assert "--set traction_peak_coefficient=" in err and "None" not in err
+    assert main([*argv, "--set", "no_such=1"]) == 2
+    assert capsys.readouterr().err.startswith("error: --set: 'no_such' is not a model parameter")
+
+
+def test_a_vary_range_that_breaks_a_parameter_rule_is_refused_before_any_run(tmp_path, capsys):
+    argv = ["calibrate", "--speed-rpm", "3000", "--radial-load-n", "500", "--target-peak-slip-pct", "7.79",
+            "--vary", "traction_sliding_coefficient=0.01:0.2", "-o", str(tmp_path / "fit.toml")]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "at 0.2, traction_peak_coefficient=0.06 must exceed traction_sliding_coefficient" in err
+    assert not (tmp_path / "fit.toml").exists()

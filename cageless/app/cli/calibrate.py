@@ -97,8 +97,9 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     what = "peak miss" if target.profile is None else args.metric.upper()
     for row in res.evaluations:
         vals = ", ".join(f"{b.name}={row[b.name]:.6g}" for b in bounds)
-        print(f"{row['index']:3d}  {vals}  {what} {row['objective_pp']:.3f} pp  peak {row['peak_slip_pct']:.2f} %  "
-              f"{row['status']}")
+        result = (f"{what} {row['objective_pp']:.3f} pp  peak {row['peak_slip_pct']:.2f} %  ok" if row["status"] == "ok"
+                  else row["status"])
+        print(f"{row['index']:3d}  {vals}  {result}")
     fitted = ", ".join(f"{k} = {v:.6g}" for k, v in res.fitted.items())
     print(f"fitted at {target.condition}: {fitted}; {what} {res.objective_pp:.3f} pp after {len(res.evaluations)} "
           f"evaluations x {res.seeds} seeds ({res.method}; {res.wall_s:.0f} s) -> {out}")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 import logging
 import math
 import re
@@ -121,9 +122,36 @@ def parameter_values(args: argparse.Namespace, config: dict[str, Any]) -> dict[s
     try:
         ModelParameters().with_overrides(values)
     except ParameterError as exc:
-        name = exc.parameter.removeprefix("parameters.")
-        where = ("--set" if name in given else f"--config {args.config}: [parameters]" if name in table
-                 else f"--parameter-set {getattr(args, 'parameter_set', None)}")
-        shown = "" if exc.value is None else f"={exc.value:g}" if isinstance(exc.value, float) else f"={exc.value}"
-        raise UsageError(f"{where} {name}{shown}: {exc.rule}. {exc.hint}".rstrip()) from None
+        raise UsageError(_parameter_error_text(exc, given, table, args)) from None
     return values
+
+
+def _parameter_error_text(exc: Any, given: dict[str, Any], table: dict[str, Any], args: argparse.Namespace) -> str:
+    """A model-parameter error named by where the user gave the value: ``--set``, the ``--config`` file, or
+    the parameter set; a rule between two parameters names the one given and the one to give as well."""
+    if not exc.parameter.startswith("parameters."):
+        return str(exc)
+    name = exc.parameter.removeprefix("parameters.")
+    shown = "" if exc.value is None else f"={exc.value:g}" if isinstance(exc.value, float) else f"={exc.value}"
+    if name in given:
+        return f"--set {name}{shown}: {exc.rule}. {exc.hint}".rstrip()
+    if name in table:
+        return f"--config {args.config}: [parameters] {name}{shown}: {exc.rule}. {exc.hint}".rstrip()
+    other = next((n for n in given if n in exc.rule), None)
+    if other is not None:
+        return (f"--set {other}={given[other]}: {name}{shown} {exc.rule}; set {name} as well "
+                f"(--set {name}=...).")
+    named = getattr(args, "parameter_set", None)
+    source = f"--parameter-set {named}" if named else "the default parameter set"
+    return f"{source}: {name}{shown}: {exc.rule}. {exc.hint}".rstrip()
+
+
+def failed_line(video: Path | str, why: object, shown: Path | str | None = None) -> str:
+    """``FAILED <video>: <why>``, naming the video once even when the message starts with its path (or its
+    file name); ``shown`` is how the video is named on the line (default: as given)."""
+    text = str(why)
+    head = f"{Path(video).name}: "
+    cut = text.find(head)
+    if cut == 0 or (cut > 0 and text[cut - 1] in "/\\" and " " not in text[:cut]):  # the name, or a path to it
+        text = text[cut + len(head):]
+    return f"FAILED {shown if shown is not None else video}: {text}"

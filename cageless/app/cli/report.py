@@ -60,7 +60,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     from cageless.errors import UsageError
     from cageless.app.lab import LabOptions, run_lab
     from cageless.app.calibrate import describe_calibration
-    from cageless.app.cli.common import parameter_values
+    from cageless.app.cli.common import failed_line, parameter_values
     from cageless.simulation.parameter_sets import DEFAULT_SET
 
     from cageless.app.lab import CACHE_NAME, REPORT_PRODUCTS
@@ -83,7 +83,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     res = run_lab(args.lab, args.out, options, bearing_from_config(config), progress=not args.quiet)
     for row in res.rows:
         if row.status == "failed":
-            print(f"FAILED {row.label}: {row.message}")
+            print(failed_line(row.label, row.message))
         else:
             print(f"{row.label}: {row.speed_rpm:g} r/min, {row.radial_load_n:g} N: theoretical slip "
                   f"{row.theoretical_slip_pct:.2f} %, experimental {row.experimental_slip_pct:.2f} %, "

@@ -193,14 +193,15 @@ def _summary_line(trace: Any, sol: Any, out: str) -> str:
     ev = trace.events
     from cageless.kinematics import startup_duration
 
-    settle = min(startup_duration(trace.speed_rpm, trace.ball_diameter_m, trace.pitch_diameter_m),
-                 0.5 * float(trace.time[-1]))
+    startup = startup_duration(trace.speed_rpm, trace.ball_diameter_m, trace.pitch_diameter_m)
+    settle = min(startup, 0.5 * float(trace.time[-1]))
+    short = "" if settle == startup else f" (half the run; compare and report leave out {1e3 * startup:.0f} ms)"
     dp5_only = sol.method in ("dp5", "auto: dp5")
-    counted = "" if dp5_only else " by DP5; CVODE's and scipy's rejections are not counted"
-    return (f"{trace.status} ({sol.method}): {sol.n_steps} steps, {sol.n_rejected} rejected{counted} "
+    by, uncounted = ("", "") if dp5_only else (" by DP5", "; CVODE's and scipy's own rejections are not counted")
+    return (f"{trace.status} ({sol.method}): {sol.n_steps} steps, {sol.n_rejected} rejected{by} "
             f"({sol.n_onset_retries} at contact onsets, {sol.n_force_jump_retries} at force jumps; "
-            f"{sol.n_contact_changes} contact changes; {sol.n_stiff_steps} at the stability edge), "
+            f"{sol.n_contact_changes} contact changes; {sol.n_stiff_steps} at the stability edge){uncounted}, "
             f"{sol.n_rhs} RHS calls, "
             f"{trace.simulation.wall_s:.2f} s wall for {trace.time[-1]:g} s simulated; contact episodes "
             f"{len(ev)} ({int((ev.kind == 'impact').sum())} impacts); peak slip in the unloaded zone after "
-            f"{1e3 * settle:.0f} ms: {100 * peak_unloaded_slip(trace, settle_s=settle):.2f}% -> {out}")
+            f"{1e3 * settle:.0f} ms{short}: {100 * peak_unloaded_slip(trace, settle_s=settle):.2f}% -> {out}")

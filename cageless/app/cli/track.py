@@ -12,7 +12,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from cageless.bearing import Bearing
-from cageless.app.cli.common import finite_float
+from cageless.app.cli.common import failed_line, finite_float
 from cageless.conditions import (
     IMAGE_SUFFIXES,
     LabEntry,
@@ -149,16 +149,6 @@ def _validate(args: argparse.Namespace) -> None:
     check_output_dir(args.out, "-o")
 
 
-def failed_line(video: Path | str, why: object) -> str:
-    """``FAILED <video>: <why>``, naming the video once even when the message starts with its path."""
-    text = str(why)
-    for prefix in (f"{video}: ", f"{Path(video).name}: "):
-        if text.startswith(prefix):
-            text = text[len(prefix):]
-            break
-    return f"FAILED {video}: {text}"
-
-
 def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bearing, options: Any, out: Path) -> int:
     failed = 0
     for e in entries:
@@ -183,7 +173,7 @@ def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bear
                            f"{100 * info['detected']:.1f}% detected, peak unloaded slip "
                            f"{100 * info['peak_slip']:.2f}% -> {info['path']}{warn}")
             else:
-                tqdm.write(failed_line(video.name, info))
+                tqdm.write(failed_line(video, info, shown=video.name))
                 failed += 1
     return 1 if failed else 0
 
