@@ -60,7 +60,7 @@ def _prefix_argmax_loop(x: np.ndarray) -> np.ndarray:
 
 
 def test_prefix_argmax_matches_the_loop_with_ties_and_minus_infinity():
-    from cageless.tracking.select import _prefix_argmax
+    from cageless.tracking.cyclic import _prefix_argmax
 
     rng = np.random.default_rng(5)
     for _ in range(3000):
