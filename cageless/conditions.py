@@ -37,7 +37,7 @@ from typing import Any
 import pandas as pd
 
 from cageless.bearing import Bearing, Geometry
-from cageless.errors import CagelessError, ConditionsError, ParameterError, suggest
+from cageless.errors import CagelessError, ConditionsError, MissingConditionsError, ParameterError, suggest
 from cageless.units import rpm_to_rad_s
 
 __all__ = [
@@ -374,7 +374,7 @@ def resolve_conditions(
             merged[key] = value
             origin[key] = label
     if "speed_rpm" not in merged:
-        raise ConditionsError(
+        raise MissingConditionsError(
             video, "no operating conditions found.",
             f"Give them in a sidecar ({video.stem}.toml with speed_rpm = ...), a row of "
             f"{CONDITIONS_CSV}, or the file name (e.g. n3000_Fr500_Fa0{video.suffix}).",

@@ -100,6 +100,10 @@ class ConditionsError(_PathError):
     """The operating conditions of one video are missing or malformed."""
 
 
+class MissingConditionsError(ConditionsError):
+    """No source (sidecar, ``conditions.csv``, file name) gives a video's operating conditions."""
+
+
 class TraceFormatError(_PathError):
     """A trace file is missing, malformed, or of an unsupported schema."""
 

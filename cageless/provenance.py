@@ -32,7 +32,7 @@ from cageless._version import __version__
 from cageless.atomic import atomic_write_text
 
 __all__ = ["InputFile", "Provenance", "sha256_file", "hash_file", "prefetch_hash", "HASH_ALGORITHMS", "VIDEO_HASH", "git_commit",
-           "cache_dir"]
+           "cache_dir", "code_digest"]
 
 _CHUNK = 1 << 20
 #: The hash algorithms an input can be recorded with.
@@ -172,6 +172,29 @@ def git_commit() -> str | None:
         capture_output=True, text=True, timeout=5, check=False,
     )
     return out.stdout.strip() + ("-dirty" if dirty.stdout.strip() else "")
+
+
+#: The packages whose sources decide results (the science packages install as sub-packages of cageless).
+_CODE_PACKAGES = ("cageless", "cageless.tracking", "cageless.simulation", "cageless.comparison")
+
+
+@lru_cache(maxsize=1)
+def code_digest() -> str:
+    """SHA-256 over the relative path and bytes of every ``.py`` file of cageless and its science packages.
+
+    Read once per process without importing the packages. A report's job cache keys on it, so work done
+    by other code (an edited checkout, an upgrade under the same version) is redone, not reused.
+    """
+    import importlib.util
+
+    h = hashlib.sha256()
+    for name in _CODE_PACKAGES:
+        spec = importlib.util.find_spec(name)
+        for root in sorted(spec.submodule_search_locations or []) if spec else []:
+            for path in sorted(Path(root).rglob("*.py")):
+                h.update(f"{name}/{path.relative_to(root).as_posix()}".encode())
+                h.update(path.read_bytes())
+    return h.hexdigest()
 
 
 def _utc_now() -> str:

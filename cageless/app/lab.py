@@ -12,7 +12,8 @@
 5. Write ``OUT/report.html`` and ``OUT/slip_table.{csv,md,tex,html}``.
 
 Work whose inputs and configuration are unchanged is skipped on a re-run: each job has a key (the
-SHA-256 of the input file, the resolved configuration and the software version) kept with its output
+SHA-256 of the input file, the resolved configuration, the software version and the digest of the
+package's source files, so a changed code base redoes the work) kept with its output
 in ``OUT/.cageless-cache.json``. A failing video or simulation becomes a failed row with its message;
 the rest completes. Jobs run in local processes on both cores, or on a Dask cluster when a scheduler
 address is given (one task per video, one per scene).
@@ -44,7 +45,7 @@ from cageless.errors import CagelessError
 from cageless.kinematics import startup_duration, theoretical_cage_speed
 from cageless.outputs import clean_stale_parts, output_lock
 from cageless.parallel import job_pool
-from cageless.provenance import hash_file, sha256_file
+from cageless.provenance import code_digest, hash_file, sha256_file
 from cageless.trace import read_trace
 from cageless.validate import plausible_entry
 
@@ -172,7 +173,9 @@ class _Cache:
 
     @staticmethod
     def key(kind: str, payload: dict[str, Any]) -> str:
-        text = json.dumps({"kind": kind, "version": __version__, **payload}, sort_keys=True, default=str)
+        """SHA-256 of the job's kind, inputs and configuration, the software version and the code's digest."""
+        text = json.dumps({"kind": kind, "version": __version__, "code": code_digest(), **payload}, sort_keys=True,
+                          default=str)
         return hashlib.sha256(text.encode()).hexdigest()
 
     def hit(self, key: str) -> str | None:
@@ -403,13 +406,13 @@ def _simulate_all(pool: Any, entries: list[LabEntry], traces: dict[Path, Any], b
                   progress: bool) -> tuple[dict[SimKey, Any], int]:
     lengths: dict[SimKey, list[float]] = {}
     conditions: dict[SimKey, tuple[OperatingConditions, Bearing]] = {}
-    for e in entries:
+    for e in entries:  # a condition none of whose videos could be tracked has nothing to be compared with
+        if isinstance(traces[e.video], CagelessError):
+            continue
         k = _sim_key(e, bearings[e.video], base)
         conditions.setdefault(k, (e.resolved.conditions, bearings[e.video]))
-        lengths.setdefault(k, [])
-        if not isinstance(traces[e.video], CagelessError):
-            tr = read_trace(traces[e.video])
-            lengths[k].append(float(tr.time[-1] - tr.time[0]))
+        tr = read_trace(traces[e.video])
+        lengths.setdefault(k, []).append(float(tr.time[-1] - tr.time[0]))
     sims: dict[SimKey, Any] = {}
     jobs, keys, pending = [], [], []
     for k, (c, bearing) in conditions.items():

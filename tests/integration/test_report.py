@@ -71,8 +71,10 @@ def test_a_bad_video_is_a_failed_row_and_the_rest_completes(tmp_path, capsys):
     (lab / "mystery.avi").write_bytes(b"\x00" * 10)  # no conditions anywhere
     out = tmp_path / "out"
     assert main(["report", str(lab), "-o", str(out), "-q", *ONE_REV]) == 1
-    text = capsys.readouterr().out
+    text = capsys.readouterr().err
     assert "FAILED n3000_Fr500_Fa0.cine" in text and "FAILED mystery.avi" in text
+    # a condition whose only video could not be tracked is not simulated (nothing to compare it with)
+    assert [p.name for p in (out / "simulations").glob("*.h5")] == ["n6000_Fr500_Fa0.sim.trace.h5"]
     table = pd.read_csv(out / "slip_table.csv")
     assert sorted(table.status) == ["failed", "failed", "ok"]
     html = _report_checks(out, 3)
@@ -124,7 +126,7 @@ def test_a_failed_simulation_is_a_failed_row(tmp_path, capsys):
     config.write_text("[bearing]\nlubricant = false\n")
     out = tmp_path / "out"
     assert main(["report", str(lab), "-o", str(out), "-q", "--config", str(config)]) == 1
-    assert "simulation failed" in capsys.readouterr().out
+    assert "simulation failed" in capsys.readouterr().err
     table = pd.read_csv(out / "slip_table.csv")
     assert list(table.status) == ["failed"] and "dry_friction_coefficient" in table.message[0]
     assert (out / "traces" / "n6000_Fr500_Fa0.trace.h5").exists()

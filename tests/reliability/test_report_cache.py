@@ -84,6 +84,29 @@ def test_r27_a_truncated_cached_simulation_is_redone(report_template, tmp_path, 
     assert _skipped(run.out) == 1
 
 
+def test_changed_code_under_the_same_version_redoes_everything(report_template, tmp_path, capsys, mini_lab,
+                                                              in_process_pool, monkeypatch):
+    """The job keys hold the digest of the package's sources: an edited checkout or an upgrade that kept the
+    version number does not reuse traces the old code wrote."""
+    from cageless.app import lab
+
+    out = _copy(report_template, tmp_path)
+    monkeypatch.setattr(lab, "code_digest", lambda: "0" * 64)
+    run = cli(capsys, "report", mini_lab, "-o", out, *QUICK_REPORT)
+    assert_clean(run, 0)
+    assert _skipped(run.out) == 0
+
+
+def test_code_digest_covers_the_science_packages():
+    from pathlib import Path
+
+    import cageless.simulation
+    from cageless.provenance import code_digest
+
+    assert len(code_digest()) == 64 and code_digest() == code_digest()
+    assert (Path(cageless.simulation.__file__).parent / "kernels.py").is_file()  # a source the digest reads
+
+
 def test_r10_an_old_or_damaged_cache_file_redoes_everything(report_template, tmp_path, capsys, mini_lab,
                                                            in_process_pool):
     out = _copy(report_template, tmp_path)

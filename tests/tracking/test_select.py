@@ -127,7 +127,7 @@ def test_wrong_speed_is_refused_without_a_trace(bright, capsys):
     d, clip = bright
     out = d / "wrong"
     assert main(["track", str(clip["video"]), "-o", str(out), "-q", "--speed-rpm", "6000"]) == 1
-    text = capsys.readouterr().out
+    text = capsys.readouterr().err
     assert "FAILED bright.cine" in text and "No trace written" in text
     assert not list(out.glob("*.trace.h5"))
     table = pd.read_csv(out / "qc" / "bright.candidates.csv")

@@ -67,7 +67,7 @@ def test_wrong_ball_count_is_an_error_with_qc_and_no_trace(tmp_path, capsys):
     table = pd.read_csv(tmp_path / "out" / "qc" / "thirteen.candidates.csv")
     assert set(table.status) <= {"selected", "rejected"} and table.reason.notna().sum() > 0
     assert main(["track", str(video), "-o", str(tmp_path / "cli"), "-q", "--speed-rpm", "3000"]) == 1
-    text = capsys.readouterr().out
+    text = capsys.readouterr().err
     assert "FAILED thirteen.cine" in text and "--n-balls 13" in text
     assert not list((tmp_path / "cli").glob("*.trace.h5"))
     assert main(["track", str(video), "-o", str(tmp_path / "cli"), "-q", "--speed-rpm", "3000", "--n-balls", "13"]) == 0
@@ -93,10 +93,11 @@ def test_cli_folder_one_bad_video_does_not_stop_the_rest(tmp_path, capsys):
     (lab / "mystery.cine").write_bytes(b"\0")  # no conditions anywhere
     out = tmp_path / "out"
     assert main(["track", str(lab), "-o", str(out), "-q", "--workers", "1"]) == 1
-    text = capsys.readouterr().out
-    assert "ok     n3000_Fr500.cine: 30 frames, 14 balls" in text
-    assert "FAILED n1800_Fr500.cine" in text and "too short" in text
-    assert "FAILED" in text and "mystery.cine: no operating conditions found" in text
+    cap = capsys.readouterr()
+    assert "ok     n3000_Fr500.cine: 30 frames, 14 balls" in cap.out
+    assert "FAILED n1800_Fr500.cine" in cap.err and "too short" in cap.err
+    assert "FAILED" in cap.err and "mystery.cine: no operating conditions found" in cap.err
+    assert "`--speed-rpm` gives its speed" in cap.err  # the missing-conditions line says how to give them here
     assert [p.name for p in out.glob("*.trace.h5")] == ["n3000_Fr500.trace.h5"]
     tr = read_trace(out / "n3000_Fr500.trace.h5")
     assert tr.source == "video" and tr.speed_rpm == 3000 and tr.qc["n_balls_found"] == 14

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from typing import Any
 
 from cageless.app.cli.common import add_parameter_set_option, finite_float
@@ -83,7 +84,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     res = run_lab(args.lab, args.out, options, bearing_from_config(config), progress=not args.quiet)
     for row in res.rows:
         if row.status == "failed":
-            print(failed_line(row.label, row.message))
+            print(failed_line(row.label, row.message), file=sys.stderr)
         else:
             print(f"{row.label}: {row.speed_rpm:g} r/min, {row.radial_load_n:g} N: theoretical slip "
                   f"{row.theoretical_slip_pct:.2f} %, experimental {row.experimental_slip_pct:.2f} %, "

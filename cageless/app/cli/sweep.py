@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from typing import Any
 
 from cageless.app.cli.common import add_parameter_set_option, finite_float
@@ -76,6 +77,6 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     print(summarise(runs, list(vary)).to_string(index=False, float_format=lambda v: f"{v:.4g}"))
     failed = runs[runs.status != "ok"]
     for _, r in failed.iterrows():
-        print(f"FAILED seed {r.seed}: {r.message}")
+        print(f"FAILED seed {r.seed}: {r.message}", file=sys.stderr)
     print(f"runs -> {paths['runs']}; summary -> {paths['summary']}; plot -> {paths['plot']}")
     return 1 if len(failed) else 0

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import sys
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -22,7 +23,7 @@ from cageless.conditions import (
     resolve_conditions,
 )
 from cageless.config import bearing_from_config
-from cageless.errors import CagelessError, UsageError
+from cageless.errors import CagelessError, MissingConditionsError, UsageError
 from cageless.outputs import check_output_dir, clean_stale_parts, output_lock
 from cageless.validate import check_options, plausible_entry
 
@@ -153,7 +154,9 @@ def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bear
     failed = 0
     for e in entries:
         if not e.ok:
-            print(failed_line(e.video, e.error))
+            hint = (" For a single video, `--speed-rpm` gives its speed on the command line."
+                    if isinstance(e.error, MissingConditionsError) else "")
+            print(failed_line(e.video, e.error) + hint, file=sys.stderr)
             failed += 1
     jobs = []
     for e in entries:
@@ -161,7 +164,7 @@ def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bear
             try:  # a sidecar may describe another bearing (n_balls, ball_diameter_mm, pitch_diameter_mm)
                 jobs.append((e.video, e.resolved.conditions, bearing_with_keys(bearing, e.resolved), options, out))
             except CagelessError as exc:
-                print(failed_line(e.video, exc))
+                print(failed_line(e.video, exc), file=sys.stderr)
                 failed += 1
     workers = max(1, min(args.workers, len(jobs)))
     with tqdm(total=len(jobs), desc="videos", unit="video", disable=args.quiet or not jobs) as bar:
@@ -173,7 +176,7 @@ def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bear
                            f"{100 * info['detected']:.1f}% detected, peak unloaded slip "
                            f"{100 * info['peak_slip']:.2f}% -> {info['path']}{warn}")
             else:
-                tqdm.write(failed_line(video, info, shown=video.name))
+                tqdm.write(failed_line(video, info, shown=video.name), file=sys.stderr)
                 failed += 1
     return 1 if failed else 0
 
