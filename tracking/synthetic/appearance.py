@@ -213,10 +213,9 @@ def _outer_radius_factor(land_frac: float) -> float:
     return 0.5 + 0.55 + 0.1 * land_frac
 
 
-def draw_params(seed: int) -> ClipParams:
-    """Map ``seed`` to a clip's parameters (see the module docstring); deterministic."""
-    s = int(seed)
-    rng = np.random.default_rng([s, 7])
+def _draw_layout(s: int) -> dict[str, Any]:
+    """Bearing, camera framing and speed: the ball count and gap, the image size and scale, the pitch
+    diameter that fits the outer ring face in the image (balls at least 16 px across), the centre offset."""
     z = int(round(_cont(s, "n_balls", 12, 20)))
     gap = _cont(s, "gap", 0.02, min(0.08, 0.9 / z))  # less than one ball pitch free: a full complement
     width, height = _pick(s, "resolution", RESOLUTIONS)
@@ -224,7 +223,6 @@ def draw_params(seed: int) -> ClipParams:
     land_mode = _pick(s, "land_mode", ("hidden", "over"))
     land_frac = _cont(s, "land_frac", 0.0, 1.0)
     sin_half = math.sin(math.pi * (1 - gap) / z)  # D / d_m
-    # The outer ring face must fit the image; the ball must be at least 16 px across.
     span_mm = 0.9 * min(width, height) / px_mm
     dm_max = min(80.0, span_mm / (1 + 2 * sin_half * _outer_radius_factor(land_frac)))
     dm_min = min(dm_max, max(10.0, 16.0 / (px_mm * sin_half)))
@@ -233,85 +231,126 @@ def draw_params(seed: int) -> ClipParams:
     margin = max(0.0, 0.5 * (0.96 * min(width, height) - od_px))
     off_r = margin * _cont(s, "offset", 0.0, 1.0)
     off_a = 2 * math.pi * factor_u(s, "offset_angle")
-    speed = _cont(s, "speed", 1800.0, 6000.0)
-    fps = _pick(s, "fps", FRAME_RATES)
-    container = _pick(s, "container", CONTAINERS)
-    bit_depth = {"cine-8": 8, "avi-mjpg": 8, "cine-p12": 12}.get(container, 16)
-    if container == "cine-16" and factor_u(s, "bit_depth_16") < 0.5:
-        bit_depth = 12  # 12-bit data in 16-bit words, as Phantom software saves by default
-    ball_px = px_mm * d_m * sin_half
-    # The specular lobe has half-widths sigma D across and sigma elongation D along (px, D the ball diameter):
-    # at least 0.8 px across, and at most 0.12 D along (a highlight, not a glow over the whole ball).
-    # Hidden mode: the lands leave a band of half-width w = (0.8 + 0.2 land_frac) R visible (R = D / 2); the
-    # lobe must stay 2.5 half-widths and a chamfer (1.5 px) clear of the lands at every orbital angle, or the
-    # lands would clip it unevenly round the orbit and bias its centroid: the lobe is at most 0.07 D long
-    # there, and the light tilt is limited.
+    return {"n_balls": z, "free_gap": gap, "width": width, "height": height, "px_per_mm": px_mm,
+            "land_mode": land_mode, "land_frac": land_frac, "pitch_diameter_mm": d_m,
+            "centre_offset_px": (off_r * math.cos(off_a), off_r * math.sin(off_a)),
+            "speed_rpm": _cont(s, "speed", 1800.0, 6000.0), "fps": _pick(s, "fps", FRAME_RATES),
+            "_sin_half": sin_half, "_off_r": off_r}
+
+
+def _draw_highlight(s: int, lay: dict[str, Any]) -> dict[str, Any]:
+    """The specular lobe's half-widths and the light tilt, kept clear of the ring lands.
+
+    The lobe has half-widths sigma D across and sigma elongation D along (px, D the ball diameter): at least
+    0.8 px across, and at most 0.12 D along (a highlight, not a glow over the whole ball). Hidden mode: the
+    lands leave a band of half-width w = (0.8 + 0.2 land_frac) R visible (R = D / 2); the lobe must stay 2.5
+    half-widths and a chamfer (1.5 px) clear of the lands at every orbital angle, or the lands would clip it
+    unevenly round the orbit and bias its centroid: the lobe is at most 0.07 D long there, and the light tilt
+    is limited.
+    """
+    ball_px = lay["px_per_mm"] * lay["pitch_diameter_mm"] * lay["_sin_half"]
+    hidden = lay["land_mode"] == "hidden"
     sigma = max(_cont(s, "highlight_sigma", 0.04, 0.10), 0.8 / ball_px)
     elongation = _cont(s, "elongation", 1.0, 3.0)
-    w_r = 0.8 + 0.2 * land_frac if land_mode == "hidden" else 1.0
-    cap = 0.07 if land_mode == "hidden" else 0.12
+    w_r = 0.8 + 0.2 * lay["land_frac"] if hidden else 1.0
+    cap = 0.07 if hidden else 0.12
     if sigma * elongation > cap:
         sigma = max(0.8 / ball_px, cap / elongation)
         elongation = min(elongation, max(1.0, cap / sigma))
     room = w_r - 5.0 * sigma * elongation - 1.5 / (0.5 * ball_px)
     tilt_max = math.degrees(2 * math.asin(min(0.5, max(room, math.sin(math.radians(2.5))))))
-    tilt = _cont(s, "light_tilt", 4.0, tilt_max) if land_mode == "hidden" else _cont(s, "light_tilt", 8.0, 60.0)
-    exp_max = min(0.9 / fps, 120e-6)
-    exposure = _cont(s, "exposure", 2e-6, exp_max)
-    omega_c = 0.5 * speed * math.pi / 30 * (1 - sin_half)
+    tilt = _cont(s, "light_tilt", 4.0, tilt_max) if hidden else _cont(s, "light_tilt", 8.0, 60.0)
+    return {"highlight_sigma": sigma, "elongation": elongation, "light_tilt_deg": tilt, "_ball_px": ball_px}
+
+
+def _draw_exposure_and_lens(s: int, lay: dict[str, Any], light: dict[str, Any]) -> dict[str, Any]:
+    """Exposure (motion blur under a quarter of the ball) and radial distortion k1.
+
+    Distortion about the image centre bends an off-centre orbit (the highlight circle is off-centre by the
+    bearing offset plus the highlight offset e): a perfect circle-fitting detector then errs by about
+    |k1| (e rho + e^2) / r_n^2 rad (rho the orbit radius, r_n the half-diagonal, px: the first term from the
+    distortion's gradient across the orbit, the second from its local anisotropy; checked against
+    score.ideal_trace). k1 is scaled down where that would exceed 0.12 mrad, so the bars stay reachable.
+    """
+    d_m, px_mm, ball_px = lay["pitch_diameter_mm"], lay["px_per_mm"], light["_ball_px"]
+    exposure = _cont(s, "exposure", 2e-6, min(0.9 / lay["fps"], 120e-6))
+    omega_c = 0.5 * lay["speed_rpm"] * math.pi / 30 * (1 - lay["_sin_half"])
     blur_px = exposure * omega_c * 0.5 * d_m * px_mm
     if blur_px > 0.25 * ball_px:  # keep the blur under a quarter of the ball
         exposure *= 0.25 * ball_px / blur_px
-    # Distortion about the image centre bends an off-centre orbit (the highlight circle is off-centre by the
-    # bearing offset plus the highlight offset e): a perfect circle-fitting detector then errs by about
-    # |k1| (e rho + e^2) / r_n^2 rad (rho the orbit radius, r_n the half-diagonal, px: the first term from the
-    # distortion's gradient across the orbit, the second from its local anisotropy; checked against
-    # score.ideal_trace). k1 is scaled down where that would exceed 0.12 mrad, so the bars stay reachable.
     k1 = _cont(s, "distortion", -0.02, 0.02)
-    e_px = off_r + 0.5 * ball_px * math.sin(math.radians(tilt) / 2)
+    e_px = lay["_off_r"] + 0.5 * ball_px * math.sin(math.radians(light["light_tilt_deg"]) / 2)
     rho_px = 0.5 * d_m * px_mm
-    r_n2 = 0.25 * ((width - 1) ** 2 + (height - 1) ** 2)
+    r_n2 = 0.25 * ((lay["width"] - 1) ** 2 + (lay["height"] - 1) ** 2)
     k1 *= min(1.0, 1.2e-4 * r_n2 / max(abs(k1) * e_px * (rho_px + e_px), 1e-12))
+    return {"exposure_s": exposure, "distortion_k1": k1}
+
+
+def _draw_container(s: int, rng: np.random.Generator) -> dict[str, Any]:
+    """Container, bit depth, codec and JPEG quality (8-bit data only; some 8-bit cines are clean)."""
+    container = _pick(s, "container", CONTAINERS)
+    bit_depth = {"cine-8": 8, "avi-mjpg": 8, "cine-p12": 12}.get(container, 16)
+    if container == "cine-16" and factor_u(s, "bit_depth_16") < 0.5:
+        bit_depth = 12  # 12-bit data in 16-bit words, as Phantom software saves by default
     jpeg = int(round(_cont(s, "jpeg", 30, 90))) if bit_depth == 8 else 0
     codec = _pick(s, "codec", CODECS) if container == "avi-mjpg" else "none"
     if codec == "mpeg4":
         jpeg = 0  # the encoder's own quantisation
     if container == "cine-8" and rng.random() < 0.35:
-        jpeg = 0  # some 8-bit cines are clean
-    # The highlight is the brightest thing on a ball: the rim (the ring faces mirrored in the ball's edge)
-    # stays under 0.6 of it.
-    highlight_peak = _cont(s, "highlight_peak", 0.25, 4.0)
-    n_frames, n_long = _frames_for(z, speed, gap, fps)
-    dark = _maybe(s, "dark_frames", 0.4, 0.003, 0.02)
-    dropped = _maybe(s, "dropped_frames", 0.4, 0.003, 0.03) if container != "avi-mjpg" else 0.0
-    return ClipParams(
-        seed=s, n_balls=z, pitch_diameter_mm=d_m, free_gap=gap, speed_rpm=speed,
-        slip_peak=_cont(s, "slip", 0.0, 0.25), restitution=_cont(s, "restitution", 0.0, 0.8),
-        direction=_pick(s, "direction", (1, -1)), radial_load_n=_cont(s, "load", 0.0, 2000.0),
-        width=width, height=height, px_per_mm=px_mm, fps=fps, container=container, bit_depth=bit_depth,
-        exposure_s=exposure, full_well_e=_cont(s, "full_well", 4000.0, 30000.0),
-        read_noise_e=_cont(s, "read_noise", 2.0, 40.0), black_level=_cont(s, "black_level", 0.0, 0.06),
-        centre_offset_px=(off_r * math.cos(off_a), off_r * math.sin(off_a)),
-        roll_deg=_cont(s, "roll", -15.0, 15.0), distortion_k1=k1,
-        light_tilt_deg=tilt, light_azimuth_deg=360.0 * factor_u(s, "light_azimuth"),
-        highlight_peak=highlight_peak, highlight_sigma=sigma,
-        elongation=elongation, elongation_angle_deg=180.0 * factor_u(s, "elong_angle"),
+        jpeg = 0
+    return {"container": container, "bit_depth": bit_depth, "jpeg_quality": jpeg, "codec": codec}
+
+
+def _draw_scene_look(s: int, rng: np.random.Generator, highlight_peak: float) -> dict[str, Any]:
+    """Lights, lighting gradients, flicker, ring faces and the ball's look; the highlight is the brightest
+    thing on a ball: the rim (the ring faces mirrored in the ball's edge) stays under 0.6 of it."""
+    return dict(
+        light_azimuth_deg=360.0 * factor_u(s, "light_azimuth"), highlight_peak=highlight_peak,
+        elongation_angle_deg=180.0 * factor_u(s, "elong_angle"),
         second_light_rel=_maybe(s, "second_light", 0.4, 0.3, 0.9),
         second_light_azimuth_deg=360.0 * factor_u(s, "second_azimuth"),
         vignetting=_cont(s, "vignetting", 0.0, 0.6), gradient=_cont(s, "gradient", 0.0, 0.5),
         gradient_angle_deg=360.0 * factor_u(s, "gradient_angle"),
         flicker_amplitude=_maybe(s, "flicker", 0.6, 0.02, 0.25), flicker_hz=_pick(s, "flicker_hz", (100.0, 120.0)),
         ring_face=_pick(s, "ring_face", ("bright", "dark")), ring_level=_cont(s, "ring_level", 0.0, 1.0),
-        ring_texture=_pick(s, "texture", ("brushed", "machined", "scratched")), land_mode=land_mode,
-        land_frac=land_frac, ball_albedo=_cont(s, "ball_albedo", 0.01, 0.12), rim=min(_cont(s, "rim", 0.0, 0.6), 0.6 * highlight_peak),
-        cavity_level=_cont(s, "cavity", 0.0, 0.35), background_level=float(rng.uniform(0.01, 0.15)),
+        ring_texture=_pick(s, "texture", ("brushed", "machined", "scratched")),
+        ball_albedo=_cont(s, "ball_albedo", 0.01, 0.12), rim=min(_cont(s, "rim", 0.0, 0.6), 0.6 * highlight_peak),
+        cavity_level=_cont(s, "cavity", 0.0, 0.35), background_level=float(rng.uniform(0.01, 0.15)))
+
+
+def _draw_faults(s: int, container: str) -> dict[str, Any]:
+    """Glints, dust, specks, hot pixels, dark and dropped frames."""
+    return dict(
         n_static_glints=int(round(_cont(s, "static_glints", 0, 12))),
         n_turning_glints=int(round(_cont(s, "turning_glints", 0, 8))),
         glint_rel=_cont(s, "glint_rel", 0.5, 3.0), n_dust=int(round(_cont(s, "dust", 0, 30))),
         n_specks=int(round(_cont(s, "specks", 0, 10))), n_hot_pixels=int(round(_cont(s, "hot_pixels", 0, 300))),
-        jpeg_quality=jpeg, dark_frame_rate=dark, dropped_frame_rate=dropped,
-        n_frames=n_frames, n_frames_long=n_long, codec=codec,
-    )
+        dark_frame_rate=_maybe(s, "dark_frames", 0.4, 0.003, 0.02),
+        dropped_frame_rate=_maybe(s, "dropped_frames", 0.4, 0.003, 0.03) if container != "avi-mjpg" else 0.0)
+
+
+def draw_params(seed: int) -> ClipParams:
+    """Map ``seed`` to a clip's parameters (see the module docstring); deterministic.
+
+    Every factor is drawn by its own name (:func:`factor_u`), so the draws do not depend on their order;
+    the two draws of ``rng`` (a clean 8-bit cine, the background level) keep theirs.
+    """
+    s = int(seed)
+    rng = np.random.default_rng([s, 7])
+    lay = _draw_layout(s)
+    light = _draw_highlight(s, lay)
+    medium = _draw_container(s, rng)
+    look = _draw_scene_look(s, rng, _cont(s, "highlight_peak", 0.25, 4.0))
+    n_frames, n_long = _frames_for(lay["n_balls"], lay["speed_rpm"], lay["free_gap"], lay["fps"])
+    fields = {k: v for part in (lay, light) for k, v in part.items() if not k.startswith("_")}
+    return ClipParams(
+        seed=s, **fields, **_draw_exposure_and_lens(s, lay, light), **medium, **look,
+        **_draw_faults(s, medium["container"]),
+        slip_peak=_cont(s, "slip", 0.0, 0.25), restitution=_cont(s, "restitution", 0.0, 0.8),
+        direction=_pick(s, "direction", (1, -1)), radial_load_n=_cont(s, "load", 0.0, 2000.0),
+        full_well_e=_cont(s, "full_well", 4000.0, 30000.0), read_noise_e=_cont(s, "read_noise", 2.0, 40.0),
+        black_level=_cont(s, "black_level", 0.0, 0.06), roll_deg=_cont(s, "roll", -15.0, 15.0),
+        n_frames=n_frames, n_frames_long=n_long)
 
 
 def _frames_for(z: int, speed_rpm: float, gap: float, fps: float) -> tuple[int, int]:
