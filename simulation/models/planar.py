@@ -21,7 +21,9 @@ Effects, each gated by its flag so that an effect that is off is never evaluated
   (:func:`cageless.simulation.forces.hertz_damped`) and friction from the sliding of the
   two surfaces (the same traction law, or dry Coulomb friction);
 * ball-ball film: squeeze film 6 pi eta (D/4)^2 (-dh/dt) / h between approaching
-  neighbours with a gap below 4/3 Delta_r, h floored at Delta_r (= h_0);
+  neighbours with a gap below 4/3 Delta_r, h floored at Delta_r (= h_0), handed over smoothly to zero
+  around the cut-off and to the Hertz contact around a gap of zero
+  (:func:`cageless.simulation.forces.squeeze_film`);
 * gravity on balls and ring, the radial load on the ring (toward -z);
 * drag 1/2 C_D rho A V^2 against the orbital motion.
 
@@ -42,7 +44,8 @@ import numpy.typing as npt
 
 from cageless.bearing import Bearing
 from cageless.errors import ParameterError
-from cageless.simulation.forces import FASTMATH, damping_factor, hertz_damped, hertz_impact_duration
+from cageless.simulation.forces import (FASTMATH, SQUEEZE_CUTOFF, SQUEEZE_TAPER, damping_factor, hertz_damped,
+                                       hertz_impact_duration, squeeze_film)
 from cageless.simulation.hertz import ball_ball_contact, compliance, hertz_contact, race_curvatures
 from cageless.simulation import effects as effects_table
 from cageless.simulation.effects import check_lubricant, effect_flags
@@ -192,7 +195,7 @@ def _pair_forces(y, p, log, j, k, z, cj, sj, ck, sk, obs):  # pragma: no cover -
     dz = rk * sk - rj * sj
     ln = np.sqrt(dx * dx + dz * dz)
     delta = d - ln
-    film = p[P_F_BBFILM] > 0.5 and -delta < 4.0 / 3.0 * p[P_H0]
+    film = p[P_F_BBFILM] > 0.5 and -delta < (SQUEEZE_CUTOFF + SQUEEZE_TAPER) * p[P_H0]
     if delta <= 0.0 and not film:
         return 0.0, 0.0, 0.0, 0.0
     nx, nz = dx / ln, dz / ln
@@ -202,18 +205,17 @@ def _pair_forces(y, p, log, j, k, z, cj, sj, ck, sk, obs):  # pragma: no cover -
     vkz = y[2 * z + k] * sk + rk * y[3 * z + k] * ck
     delta_dot = -((vkx - vjx) * nx + (vkz - vjz) * nz)
     if delta <= 0.0:
-        # squeeze film between the approaching balls: F = 6 pi eta R^2 (-dh/dt) / h, R = D/4, h >= Delta_r
-        if delta_dot > 0.0:
-            f = 6.0 * np.pi * p[P_ETA0] * (0.25 * d) ** 2 * delta_dot / max(-delta, p[P_H0])
-            return f * nx, f * nz, 0.0, f * delta_dot
-        return 0.0, 0.0, 0.0, 0.0
+        f = squeeze_film(-delta, delta_dot, p[P_ETA0], 0.25 * d, p[P_H0])  # between the approaching balls
+        return f * nx, f * nz, 0.0, f * delta_dot
     # approach speed at onset: recorded after the first accepted step in contact (planar_post); until
     # then the current approach speed, so the force depends on no trial stage of any step
     # (floored: see ModelParameters.min_approach_speed_m_s)
     v_in = max(log[j] if log[j] > 0.0 else delta_dot, p[P_V_IN_MIN])
     f = hertz_damped(delta, delta_dot, v_in, p[P_KB], p[P_CHI])
     elastic = p[P_KB] * delta * np.sqrt(delta)
-    p_diss = (f - elastic) * delta_dot
+    # the squeeze film fading out over the first overlap (squeeze_film), on the normal force, not on friction's load
+    f_film = squeeze_film(-delta, delta_dot, p[P_ETA0], 0.25 * d, p[P_H0]) if p[P_F_BBFILM] > 0.5 else 0.0
+    p_diss = (f - elastic + f_film) * delta_dot
     if obs is not None:
         obs[OBS_BB_NORMAL] = elastic
     f_t = torque = 0.0
@@ -227,8 +229,8 @@ def _pair_forces(y, p, log, j, k, z, cj, sj, ck, sk, obs):  # pragma: no cover -
             obs[OBS_BB_TRACTION] = abs(tangential(u, u_r, elastic, p))
         p_diss -= f_t * u
         torque = 0.5 * d * f_t
-        return f * nx - f_t * tx, f * nz - f_t * tz, torque, p_diss
-    return f * nx, f * nz, torque, p_diss
+        return (f + f_film) * nx - f_t * tx, (f + f_film) * nz - f_t * tz, torque, p_diss
+    return (f + f_film) * nx, (f + f_film) * nz, torque, p_diss
 
 
 @numba.njit(cache=True, fastmath=FASTMATH)

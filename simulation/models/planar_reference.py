@@ -10,9 +10,13 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
+from cageless.simulation.forces import squeeze_film
 from cageless.simulation.models import base as B
 
 __all__ = ["reference_rhs", "tangential_force"]
+
+#: :func:`cageless.simulation.forces.squeeze_film` (its Python source, not the compiled function) over arrays.
+_SQUEEZE = np.vectorize(squeeze_film.py_func, otypes=[float])
 
 
 def tangential_force(u_s: np.ndarray, u_r: np.ndarray, q: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -160,8 +164,8 @@ def _pairs(y: np.ndarray, p: np.ndarray, log: np.ndarray, fy: np.ndarray, fz: np
         np.add.at(torque, k, 0.5 * d * ft)
     film = np.zeros(z)
     if p[B.P_F_BBFILM] > 0.5:
-        near = (~touching) & (-delta < 4.0 / 3.0 * p[B.P_H0]) & (ddot > 0)
-        film = np.where(near, 6 * np.pi * p[B.P_ETA0] * (0.25 * d) ** 2 * ddot / np.maximum(-delta, p[B.P_H0]), 0.0)
+        # the one squeeze-film law of the compiled models, run as plain Python on each pair
+        film = _SQUEEZE(-delta, ddot, p[B.P_ETA0], 0.25 * d, p[B.P_H0])
         power += np.sum(film * ddot)
     on_k_y = (f + film) * nx + ft * nz
     on_k_z = (f + film) * nz - ft * nx

@@ -41,7 +41,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cageless.bearing import Bearing
-from cageless.simulation.forces import FASTMATH, hertz_damped
+from cageless.simulation.forces import FASTMATH, SQUEEZE_CUTOFF, SQUEEZE_TAPER, hertz_damped, squeeze_film
 from cageless.simulation.hertz import compliance, hertz_contact, race_curvatures
 from cageless.simulation.models import base as B
 from cageless.simulation.models import planar as P
@@ -249,7 +249,7 @@ def _pair(y, p, log, j, k, z, cj, sj, ck, sk, obs):  # pragma: no cover - compil
     ln = math.sqrt(dx * dx + dy * dy + dz * dz)
     delta = d - ln
     zero = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-    film = p[B.P_F_BBFILM] > 0.5 and -delta < 4.0 / 3.0 * p[B.P_H0]
+    film = p[B.P_F_BBFILM] > 0.5 and -delta < (SQUEEZE_CUTOFF + SQUEEZE_TAPER) * p[B.P_H0]
     if delta <= 0.0 and not film:
         return zero
     nx, ny, nz = dx / ln, dy / ln, dz / ln
@@ -261,17 +261,17 @@ def _pair(y, p, log, j, k, z, cj, sj, ck, sk, obs):  # pragma: no cover - compil
     vkz = y[2 * z + k] * sk + y[k] * y[3 * z + k] * ck
     ddot = -((vkx - vjx) * nx + (vky - vjy) * ny + (vkz - vjz) * nz)
     if delta <= 0.0:
-        if ddot > 0.0:
-            f = 6.0 * np.pi * p[B.P_ETA0] * (0.25 * d) ** 2 * ddot / max(-delta, p[B.P_H0])
-            return f * nx, f * ny, f * nz, 0.0, 0.0, 0.0, f * ddot
-        return zero
+        f = squeeze_film(-delta, ddot, p[B.P_ETA0], 0.25 * d, p[B.P_H0])
+        return f * nx, f * ny, f * nz, 0.0, 0.0, 0.0, f * ddot
     v_in = max(log[j] if log[j] > 0.0 else ddot, p[B.P_V_IN_MIN])
     f = hertz_damped(delta, ddot, v_in, p[B.P_KB], p[B.P_CHI])
     elastic = p[B.P_KB] * delta * math.sqrt(delta)
-    p_diss = (f - elastic) * ddot
+    # the squeeze film fading out over the first overlap (squeeze_film), on the normal force, not on friction's load
+    f_film = squeeze_film(-delta, ddot, p[B.P_ETA0], 0.25 * d, p[B.P_H0]) if p[B.P_F_BBFILM] > 0.5 else 0.0
+    p_diss = (f - elastic + f_film) * ddot
     if obs is not None:
         obs[B.OBS_BB_NORMAL] = elastic
-    fx, fy, fz = f * nx, f * ny, f * nz
+    fx, fy, fz = (f + f_film) * nx, (f + f_film) * ny, (f + f_film) * nz
     mx = my = mz = 0.0
     if p[B.P_F_TRAC] > 0.5:
         ojx, ojy, ojz = y[4 * z + j], y[b + 2 * z + j], y[b + 3 * z + j]
