@@ -19,7 +19,7 @@ import numpy as np
 
 from cageless.tracking.detect import _centroids
 
-__all__ = ["run_block", "warm_up", "WIDEN_AFTER", "REDETECT_AFTER", "MAX_MASS_RATIO"]
+__all__ = ["run_block", "WIDEN_AFTER", "REDETECT_AFTER", "MAX_MASS_RATIO"]
 
 #: The limits of :mod:`cageless.tracking.link` (defined here so that the compiled kernel sees constants).
 WIDEN_AFTER = 3
@@ -111,10 +111,3 @@ def run_block(stack, k0, k1, step, frame0, times, bg, mask, cx, cy, half, thr, i
         _update(i, t, dt, pred, mu, mv, mm, ok, cx, cy, theta, radius, omega, misses, ref_mass, out_u, out_v, out_m)
         t_state[0] = t
     return k1
-
-
-@numba.njit(cache=True, nogil=True)
-def warm_up(x):  # pragma: no cover - compiled
-    """Return ``x + 1``. The first call of any compiled function in a process loads numba's typing registries
-    (about 0.2-0.4 s of CPU, measured); the pipeline calls this one in a thread while it reads the first frames."""
-    return x + 1

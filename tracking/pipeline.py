@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import logging
 import math
-import threading
 import warnings
 from collections import OrderedDict
 from concurrent.futures import ThreadPoolExecutor
@@ -36,7 +35,6 @@ from cageless.tracking.geometry import fit_orbit, orbital_angles
 from cageless.tracking.io import CineReader, FrameSource, open_video
 from cageless.tracking.kinematics import DEFAULT_TRACK_FIT, DEFAULT_WINDOW, revolution_speed, robust_track_fit
 from cageless.tracking.link import BallCountWarning, TrackSetup, track_frames
-from cageless.tracking.link_kernel import warm_up
 from cageless.tracking.locate import BearingLocation, background_frame, locate_bearing
 from cageless.tracking.locate_motion import holds_the_motion, locate_by_motion, motion_map, plausible_band
 from cageless.tracking.qc import QCReport, build_qc, slip_warnings, write_qc, write_selection_qc
@@ -286,8 +284,6 @@ def track_video(
         raise TrackingError(path, f"{target} exists and is not a cageless trace; cageless does not overwrite files "
                                   "it did not write. Move it, or track into another folder.")
     fps = options.fps or conditions.fps
-    # numba's one-off start-up cost, paid on the other core while the background and the bearing are found.
-    threading.Thread(target=warm_up, args=(1,), name="cageless-numba-warm-up", daemon=True).start()
     prov = Provenance.start(config={"tracking": options.to_dict(), "conditions": conditions.to_dict(),
                                     **(config or {})}, inputs=[path], background=True,
                              hash_algorithm=INPUT_HASH)
