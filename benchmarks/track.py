@@ -2,7 +2,7 @@
 
     python benchmarks/track.py [--dir bench_footage] [--frames 2400] [--repeats 3] [--json out.json]
     python benchmarks/track.py --speed [--dir bench_footage] [--lengths 1000 5000 10000]
-                               [--baseline OLD_SOURCE_TREE] [--repeats 2] [--json out.json]
+                               [--baseline OLD_SOURCE_TREE] [--repeats 2] [--json out.json] [--clip CLIP]
 
 Without ``--speed`` it runs the accuracy-versus-time study of :mod:`cageless.tracking.bench`
 (detectors, smoothing windows, trackpy on the same frames, peak memory).
@@ -18,6 +18,9 @@ lengths from its start, and for each length measures, each in a fresh process:
 * **end to end, cold**: ``cageless track clip.cine --speed-rpm 3000`` from a new interpreter
   with an empty hash cache (imports, hashing, tracking, writing the trace and its QC);
 * **peak RSS** of that end-to-end process (``VmHWM``, read as it exits);
+
+with, for each, the CPU time (all threads; ``process_time`` in process, ``wait4``'s rusage for the cold run) per
+frame: on a shared machine the wall-clock figures move with the load, the CPU time much less;
 
 and once: the wall time of ``cageless --version``, and trackpy (``locate`` + ``link``) on the
 first 100 frames of the same footage, giving the same-run ratio of our pipeline frames/s to
@@ -63,25 +66,32 @@ _PIPELINE = _PRELUDE + (
     "h = pv.hash_file({clip!r}, getattr(p, 'INPUT_HASH', 'sha256')) if hasattr(pv, 'hash_file') "
     "else pv.sha256_file({clip!r}); "
     # The tracking loop alone (every frame after the set-up), timed around the pipeline's _track_all.
-    "loop = [0.0]; inner = p._track_all\n"
-    "def timed(*a, **k):\n t0 = time.perf_counter(); out = inner(*a, **k); loop[0] += time.perf_counter() - t0\n"
+    "loop = [0.0, 0.0]; inner = p._track_all\n"
+    "def timed(*a, **k):\n t0, c0 = time.perf_counter(), time.process_time(); out = inner(*a, **k)\n"
+    " loop[0] += time.perf_counter() - t0; loop[1] += time.process_time() - c0\n"
     " return out\n"
     "p._track_all = timed; "
-    "t = time.perf_counter(); r = p.track_video({clip!r}, OperatingConditions(3000.0, 500.0), "
+    "t, c = time.perf_counter(), time.process_time(); r = p.track_video({clip!r}, OperatingConditions(3000.0, 500.0), "
     "default_bearing(), progress=False); "
-    "print(json.dumps({{'s': time.perf_counter() - t, 'n': int(r.trace.n_samples), 'loop_s': loop[0]}}))"
+    "print(json.dumps({{'s': time.perf_counter() - t, 'cpu_s': time.process_time() - c, 'n': int(r.trace.n_samples), "
+    "'loop_s': loop[0], 'loop_cpu_s': loop[1]}}))"
 )
 _CLI = _PRELUDE + "from cageless.app.cli import main; sys.exit(main({argv!r}))"
+#: CPU time (user + system, s) of the last child :func:`_child` ran.
+_LAST_CPU_S = float("nan")
 
 
 def _child(code: str, env: dict[str, str] | None = None) -> tuple[float, float, str]:
-    """Run ``python -c code``; return its wall time (s), peak RSS (MiB) and stdout."""
+    """Run ``python -c code``; return its wall time (s), peak RSS (MiB) and stdout (the CPU time of the last child
+    is left in :data:`_LAST_CPU_S`)."""
+    global _LAST_CPU_S
     t0 = time.perf_counter()
     with tempfile.TemporaryFile("w+") as out:
         proc = subprocess.Popen([sys.executable, "-c", code], stdout=out, stderr=subprocess.PIPE, text=True,
                                 env={**os.environ, **(env or {})})
-        _, status, _ = os.wait4(proc.pid, 0)
+        _, status, usage = os.wait4(proc.pid, 0)
         wall = time.perf_counter() - t0
+        _LAST_CPU_S = usage.ru_utime + usage.ru_stime
         proc.returncode = os.waitstatus_to_exitcode(status)
         err = proc.stderr.read() if proc.stderr else ""
         out.seek(0)
@@ -92,13 +102,20 @@ def _child(code: str, env: dict[str, str] | None = None) -> tuple[float, float, 
     return wall, (peak[-1] / 1024.0 if peak else float("nan")), text
 
 
-def _clips(folder: Path, lengths: list[int], footage: int | None = None) -> dict[int, Path]:
-    """A clip of ``footage`` frames (default the longest length) rendered once; the others are its first frames."""
+def _clips(folder: Path, lengths: list[int], footage: int | None = None,
+           clip: Path | None = None) -> dict[int, Path]:
+    """A clip of ``footage`` frames (default the longest length) rendered once, or ``clip``; the others are its
+    first frames (written into ``folder``)."""
     from cageless.tracking.bench import prepare_footage
     from cageless.tracking.io import open_video, write_cine
 
-    longest = footage or max(lengths)
-    video, _ = prepare_footage(folder, longest)
+    if clip is not None:
+        with open_video(clip) as src:
+            longest = len(src)
+        video = clip
+    else:
+        longest = footage or max(lengths)
+        video, _ = prepare_footage(folder, longest)
     clips = {longest: video}
     with open_video(video) as src:
         for n in sorted(set(lengths) - {longest}):
@@ -118,8 +135,10 @@ def _measure(src: Path, clip: Path) -> dict[str, float]:
         wall, rss, _ = _child(_CLI.format(src=str(src), argv=["track", str(clip), "-o", tmp + "/out",
                                                                 "--speed-rpm", "3000", "-q"]),
                               {"CAGELESS_CACHE_DIR": tmp + "/c2"})
-    return {"pipeline_fps": r["n"] / r["s"], "loop_fps": r["n"] / r["loop_s"], "cold_fps": r["n"] / wall,
-            "cold_s": wall, "peak_rss_mib": rss}
+    n = r["n"]
+    return {"pipeline_fps": n / r["s"], "loop_fps": n / r["loop_s"], "cold_fps": n / wall,
+            "cold_s": wall, "peak_rss_mib": rss, "pipeline_cpu_ms": 1e3 * r.get("cpu_s", float("nan")) / n,
+            "loop_cpu_ms": 1e3 * r.get("loop_cpu_s", float("nan")) / n, "cold_cpu_ms": 1e3 * _LAST_CPU_S / n}
 
 
 def _version_s(src: Path, repeats: int) -> float:
@@ -143,9 +162,10 @@ def _trackpy_fps(clip: Path, n: int = 100) -> float | None:
 
 
 def speed_table(folder: Path, lengths: list[int], repeats: int, baseline: Path | None,
-                footage: int | None = None) -> dict[str, Any]:
-    """Measure every tree on every clip length, interleaved, best of ``repeats``."""
-    clips = _clips(folder, lengths, footage)
+                footage: int | None = None, clip: Path | None = None) -> dict[str, Any]:
+    """Measure every tree on every clip length, interleaved, best of ``repeats`` (``clip``: an existing
+    full-size clip instead of the rendered one, the lengths cut from its start)."""
+    clips = _clips(folder, lengths, footage, clip)
     trees = {"this": HERE} | ({"baseline": baseline.resolve()} if baseline else {})
     for src in trees.values():  # warm-up: numba caches, page cache
         _measure(src, clips[min(lengths)])
@@ -156,14 +176,11 @@ def speed_table(folder: Path, lengths: list[int], repeats: int, baseline: Path |
                 m = _measure(src, clips[n])
                 print(f"  {n} frames, {name}: {json.dumps(m)}", file=sys.stderr, flush=True)  # partial results
                 best = rows[name].get(n)
-                rows[name][n] = m if best is None else {
-                    "pipeline_fps": max(best["pipeline_fps"], m["pipeline_fps"]),
-                    "loop_fps": max(best["loop_fps"], m["loop_fps"]),
-                    "cold_fps": max(best["cold_fps"], m["cold_fps"]), "cold_s": min(best["cold_s"], m["cold_s"]),
-                    "peak_rss_mib": max(best["peak_rss_mib"], m["peak_rss_mib"])}
+                rows[name][n] = m if best is None else {  # the best of each figure; the peak memory's worst
+                    k: (max if k == "peak_rss_mib" or k.endswith("_fps") else min)(best[k], m[k]) for k in m}
     version = {name: _version_s(src, 5) for name, src in trees.items()}
     longest = max(lengths)
-    tpy = _trackpy_fps(clips[footage or longest])
+    tpy = _trackpy_fps(clips[max(clips)])  # the rendered clip has its truth; the cut ones do not
     return {"lengths": sorted(lengths), "rows": {k: {str(n): v for n, v in r.items()} for k, r in rows.items()},
             "version_s": version, "trackpy_fps": tpy, "trackpy_frames": 100}
 
@@ -174,17 +191,22 @@ def format_speed(r: dict[str, Any]) -> str:
     lines = ["Tracking speed, 1280x800 16-bit cine from the page cache, 3000 rpm, both cores"
              + (" (this tree vs baseline, same run)" if len(trees) > 1 else ""),
              f"{'frames':>7} {'tree':<9}{'pipeline f/s':>13}{'loop f/s':>10}{'cold e2e f/s':>14}{'cold e2e s':>11}"
-             f"{'peak RSS MiB':>14}"]
+             f"{'peak RSS MiB':>14}{'CPU ms/frame: pipeline':>24}{'loop':>6}{'cold':>6}"]
     for n in r["lengths"]:
         for t in trees:
             m = r["rows"][t][str(n)]
             lines.append(f"{n:>7} {t:<9}{m['pipeline_fps']:>13.0f}{m['loop_fps']:>10.0f}{m['cold_fps']:>14.0f}"
                          f"{m['cold_s']:>11.2f}"
-                         f"{m['peak_rss_mib']:>14.0f}")
+                         f"{m['peak_rss_mib']:>14.0f}{m.get('pipeline_cpu_ms', float('nan')):>24.3f}"
+                         f"{m.get('loop_cpu_ms', float('nan')):>6.3f}{m.get('cold_cpu_ms', float('nan')):>6.3f}")
         if len(trees) > 1:
             a, b = r["rows"]["this"][str(n)], r["rows"]["baseline"][str(n)]
             lines.append(f"{'':>7} {'ratio':<9}{a['pipeline_fps'] / b['pipeline_fps']:>12.2f}x"
-                         f"{a['loop_fps'] / b['loop_fps']:>9.2f}x{a['cold_fps'] / b['cold_fps']:>13.2f}x")
+                         f"{a['loop_fps'] / b['loop_fps']:>9.2f}x{a['cold_fps'] / b['cold_fps']:>13.2f}x"
+                         f"{'':>25}{b['pipeline_cpu_ms'] / a['pipeline_cpu_ms']:>23.2f}x"
+                         f"{b['loop_cpu_ms'] / a['loop_cpu_ms']:>5.2f}x{b['cold_cpu_ms'] / a['cold_cpu_ms']:>5.2f}x")
+    if len(trees) > 1:
+        lines.append("ratio: this tree's speed over the baseline's (for CPU: the baseline's CPU time over this tree's)")
     lines.append("cageless --version: " + ", ".join(f"{t} {s:.3f} s" for t, s in r["version_s"].items()))
     if r["trackpy_fps"]:
         longest = str(r["lengths"][-1])
@@ -193,7 +215,8 @@ def format_speed(r: dict[str, Any]) -> str:
         lines.append(f"trackpy locate+link on {r['trackpy_frames']} frames of the same clip: "
                      f"{r['trackpy_fps']:.1f} frames/s; pipeline / trackpy: {ratios}")
     else:
-        lines.append("trackpy: not installed (pip install 'cageless[bench]')")
+        lines.append("trackpy: not run (not installed: pip install 'cageless[bench]'; or the clip has no "
+                     "<clip>.truth.csv)")
     return "\n".join(lines)
 
 
@@ -208,10 +231,12 @@ def main() -> None:
     ap.add_argument("--baseline", type=Path, help="another cageless source tree to compare against")
     ap.add_argument("--footage", type=int, help="frames of the rendered clip the lengths are cut from "
                     "(default the longest length)")
+    ap.add_argument("--clip", type=Path, help="an existing full-size 3000 rpm clip to measure instead of "
+                    "rendering one (its frame count is the longest length)")
     args = ap.parse_args()
     args.dir.mkdir(parents=True, exist_ok=True)
     if args.speed:
-        result = speed_table(args.dir, args.lengths, args.repeats, args.baseline, args.footage)
+        result = speed_table(args.dir, args.lengths, args.repeats, args.baseline, args.footage, args.clip)
         print(format_speed(result))
     else:
         from cageless.tracking.bench import format_tables, run_benchmark

@@ -176,6 +176,22 @@ class _CroppedFrames:
         return block
 
 
+class _CropView:
+    """The rows and columns of a video that :func:`~cageless.tracking.locate.background_frame` needs, cropped:
+    per-pixel statistics over the crop are those of the full frames cropped, for less work."""
+
+    def __init__(self, video: FrameSource, rows: slice, cols: slice) -> None:
+        self.video, self.rows, self.cols = video, rows, cols
+        self.frame_shape = (len(range(*rows.indices(video.frame_shape[0]))),
+                            len(range(*cols.indices(video.frame_shape[1]))))
+
+    def __len__(self) -> int:
+        return len(self.video)
+
+    def frame_view(self, i: int) -> np.ndarray:
+        return self.video.frame_view(i)[self.rows, self.cols]
+
+
 def _locate(video: FrameSource, background: np.ndarray, bearing: Bearing, path: Path) -> BearingLocation:
     """The bearing and its ball band from brightness; from motion when that fails, gives a band that
     does not fit a ball, or a band where little moves (dark ring faces, balls over bright faces)."""
@@ -224,7 +240,9 @@ def _setup(video: FrameSource, loc: BearingLocation, background: np.ndarray, bea
     # The candidates are found over a low quantile of the frames, not their median: an elongated highlight
     # lying along the orbit covers a pixel for more than half of the time between two balls, and the median
     # then keeps its ghost, which cuts the highlight into stripes (frame minus background).
-    sel_bg = np.ascontiguousarray(background_frame(video, quantile=SELECT_QUANTILE)[rows, cols])
+    # Over the crop only: a per-pixel quantile, so the values of the full frames cropped (tested), on 41 % of the
+    # pixels of the 1280 x 800 benchmark clip (0.20 -> 0.045 s of CPU there).
+    sel_bg = background_frame(_CropView(video, rows, cols), quantile=SELECT_QUANTILE)
     sel = select_balls(frames, video.times, sel_bg, mask, z=z, ball_diameter_m=g.ball_diameter_m,
                        pitch_diameter_m=g.pitch_diameter_m, omega_i=conditions.speed_rad_s, centre0=centre0,
                        r_prior=r_prior, path=path, prior_known=known,

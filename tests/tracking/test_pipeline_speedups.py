@@ -1,0 +1,52 @@
+"""The pipeline's shortcuts give the very values of the plain forms they replace.
+
+Reference: :func:`cageless.tracking.locate.background_frame` over the full frames, then cropped (the form the
+pipeline used before it computed the selection's background over the crop only); a per-pixel quantile
+depends on that pixel's values alone, so the two must agree bit for bit.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from cageless.tracking.io import open_video, write_cine
+from cageless.tracking.locate import background_frame
+from cageless.tracking.pipeline import _CropView
+
+
+@pytest.mark.parametrize("n_frames", [7, 30])
+@pytest.mark.parametrize("quantile", [0.25, 0.5])
+def test_background_over_the_crop_is_the_full_background_cropped(tmp_path, n_frames, quantile):
+    rng = np.random.default_rng(n_frames)
+    frames = rng.integers(0, 4096, (n_frames, 90, 130)).astype(np.uint16)
+    frames[:, 10:20, 10:20] = 7  # ties
+    clip = write_cine(tmp_path / "c.cine", frames, fps=1000.0, fmt="16", real_bpp=12)
+    rows, cols = slice(13, 77), slice(29, 118)
+    with open_video(clip) as video:
+        full = background_frame(video, quantile=quantile)[rows, cols]
+        crop = background_frame(_CropView(video, rows, cols), quantile=quantile)
+    assert crop.shape == (64, 89)
+    assert crop.dtype == full.dtype == np.float32
+    assert crop.tobytes() == full.tobytes()
+
+
+def _background_plain(video, n_sample: int = 25, quantile: float = 0.5) -> np.ndarray:
+    """The background as first written: numpy's median (or inverted_cdf quantile) over the stacked frames' first axis."""
+    idx = np.unique(np.linspace(0, len(video) - 1, min(len(video), n_sample)).round().astype(int))
+    stack = np.stack([video.frame_view(int(i)) for i in idx])
+    out = np.median(stack, axis=0) if quantile == 0.5 else np.quantile(stack, quantile, axis=0, method="inverted_cdf")
+    return out.astype(np.float32)
+
+
+@pytest.mark.parametrize("n_frames", [4, 7, 30])
+@pytest.mark.parametrize("quantile", [0.25, 0.5])
+def test_background_frame_is_numpys_median_over_the_first_axis(tmp_path, n_frames, quantile):
+    rng = np.random.default_rng(10 + n_frames)
+    frames = rng.integers(0, 4096, (n_frames, 70, 150)).astype(np.uint16)
+    frames[:, 5:9, :] = 11  # ties
+    clip = write_cine(tmp_path / "c.cine", frames, fps=1000.0, fmt="16", real_bpp=12)
+    with open_video(clip) as video:
+        got = background_frame(video, quantile=quantile)
+        ref = _background_plain(video, quantile=quantile)
+    assert got.tobytes() == ref.tobytes()
