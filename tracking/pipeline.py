@@ -351,25 +351,50 @@ def _track_all(path: Path, fps: float | None, video: FrameSource, frames: _Cropp
 
     with ThreadPoolExecutor(max_workers=k) as pool:
         parts = list(pool.map(one, spans))
-    return _stitch(parts, spans, times)
+    joined = _stitch(parts, spans, times)
+    if joined is None:  # the segments' ball identities could not be matched: the one-pass result is the answer
+        log.warning("%s: the %d segments' ball identities did not match on their overlaps; tracking in one pass",
+                    path.name, k)
+        return track_frames(frames, times, setup, str(path), options.strict, update)[0]
+    return joined
 
 
-def _stitch(parts: list[pd.DataFrame], spans: list[tuple[int, int]], times: np.ndarray) -> pd.DataFrame:
-    """Join segment tables, renaming each segment's balls to the first segment's by position on the overlap."""
+#: Largest distance (px) between one ball's positions in two segments on the frames both tracked.
+STITCH_GATE_PX = 2.0
+
+
+def _match_segments(prev_u: np.ndarray, prev_v: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray | None:
+    """This segment's column for each previous ball, by a minimum-cost assignment of the median distances on
+    the overlap frames; ``None`` when a ball both segments saw there is matched further than the gate."""
+    from scipy.optimize import linear_sum_assignment
+
+    with warnings.catch_warnings():  # a ball missed on every overlap frame by one segment: an all-NaN median
+        warnings.simplefilter("ignore", RuntimeWarning)
+        d = np.nanmedian(np.hypot(prev_u[:, :, None] - u[:, None, :], prev_v[:, :, None] - v[:, None, :]), axis=0)
+    seen = np.isfinite(d)
+    rows, cols = linear_sum_assignment(np.where(seen, d, 1e6))  # unseen pairs only take what is left over
+    if np.any(seen[rows, cols] & (d[rows, cols] > STITCH_GATE_PX)):
+        return None
+    mapping = np.empty_like(cols)
+    mapping[rows] = cols
+    return mapping
+
+
+def _stitch(parts: list[pd.DataFrame], spans: list[tuple[int, int]], times: np.ndarray) -> pd.DataFrame | None:
+    """Join segment tables, renaming each segment's balls to the first segment's by position on the overlap;
+    ``None`` when the segments disagree (ball counts, or a ball's position on the overlap)."""
     z = int(parts[0].ball.max()) + 1
     grids = []
     for part in parts:
         if int(part.ball.max()) + 1 != z:
-            raise TrackingError("video", "segments saw different ball counts; track with threads=1.")
+            return None
         grids.append({c: part[c].to_numpy().reshape(-1, z) for c in ("u_px", "v_px", "mass")})
     out = {c: grids[0][c] for c in ("u_px", "v_px", "mass")}
     for (a, _), g in zip(spans[1:], grids[1:], strict=True):
         prev_u, prev_v = out["u_px"][a:], out["v_px"][a:]
-        d = np.nanmedian(np.hypot(prev_u[:, :, None] - g["u_px"][: len(prev_u), None, :],
-                                  prev_v[:, :, None] - g["v_px"][: len(prev_v), None, :]), axis=0)
-        mapping = np.argmin(np.nan_to_num(d, nan=np.inf), axis=1)  # previous ball -> this segment's column
-        if len(set(mapping.tolist())) != z:
-            raise TrackingError("video", "could not match ball identities between segments; track with threads=1.")
+        mapping = _match_segments(prev_u, prev_v, g["u_px"][: len(prev_u)], g["v_px"][: len(prev_v)])
+        if mapping is None:
+            return None
         for c in out:
             out[c] = np.concatenate([out[c][:a], g[c][:, mapping]])
     n = len(times)
