@@ -120,7 +120,7 @@ def test_cli_sample_lab_in_parallel(tmp_path, capsys):
 def test_cli_speed_for_a_bare_video(tmp_path, capsys):
     video = _clip(tmp_path / "bare.cine", n=30)
     assert main(["track", str(video), "-o", str(tmp_path / "o"), "-q"]) == 1
-    assert "no operating conditions found" in capsys.readouterr().out
+    assert "no operating conditions found" in capsys.readouterr().err
     assert main(["track", str(video), "-o", str(tmp_path / "o"), "-q", "--speed-rpm", "3000"]) == 0
     assert main(["track", str(video), "-o", str(tmp_path / "o"), "--window", "4"]) == 2
 
