@@ -12,7 +12,7 @@ import numba
 from cageless.simulation.models import planar, spatial, textbook, two_balls
 
 __all__ = ["PLANAR", "SPATIAL", "TWO_BALLS", "OSCILLATOR", "RICCATI", "model_rhs", "model_post", "model_signature",
-           "model_ring_share", "model_gaps", "model_observe"]
+           "model_ring_share", "model_gaps"]
 
 PLANAR, TWO_BALLS, SPATIAL = planar.MODEL_ID, two_balls.MODEL_ID, spatial.MODEL_ID
 OSCILLATOR, RICCATI = textbook.OSCILLATOR, textbook.RICCATI
@@ -70,13 +70,3 @@ def model_ring_share(model_id, t, y, p, log, j, out):  # pragma: no cover - comp
         planar.planar_ring_share(t, y, p, log, j, out)
     elif model_id == SPATIAL:
         spatial.spatial_ring_share(t, y, p, log, j, out)
-
-
-@numba.njit(cache=True)
-def model_observe(model_id, t, y, p, log, out):  # pragma: no cover - compiled
-    """The observables of state ``y`` at time ``t`` (:data:`cageless.simulation.models.base.OBSERVABLES`, one
-    column per ball) from the ball-bearing models' own force functions; nothing for the other models."""
-    if model_id == PLANAR:
-        planar.planar_observe(t, y, p, log, out)
-    elif model_id == SPATIAL:
-        spatial.spatial_observe(t, y, p, log, out)

@@ -81,30 +81,21 @@ def dp5_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_st
     t_end = t_out[t_out.shape[0] - 1]
     tiny = 1e-13 * max(abs(t_end), t_end - t0)  # round-off scale of the time axis
     while k < t_out.shape[0]:
-        if cnt[_STEPS] + cnt[_REJ] >= max_steps:
-            status = STATUS_MAX_STEPS
-            break
-        if t_end - t <= tiny:  # only round-off left: the remaining samples are the current state
-            out[k:, :] = y
-            break
-        h = min(h, h_max, t_end - t)
-        if h < tiny:
-            status = STATUS_STEP_UNDERFLOW
+        stop, h = _before_step(cnt, max_steps, t, t_end, h, h_max, tiny)
+        if stop >= 0:
+            if stop == STATUS_OK:  # only round-off left: the remaining samples are the current state
+                out[k:, :] = y
+            status = stop
             break
         _dp5_stages(model_id, t, h, y, p, log, ks, yt, ynew)
         cnt[_RHS] += 6
         err = _dp5_error(h, y, ynew, ks, atol, rtol)
-        if not np.isfinite(err):
-            h *= 0.25
-            cnt[_REJ] += 1
-            if h < tiny:
+        h_retry, refused = _error_refusal(err, h, cnt)
+        if refused:
+            h = h_retry
+            if h < tiny and not np.isfinite(err):
                 status = STATUS_NONFINITE
                 break
-            continue
-        fac11 = err ** 0.17  # 0.2 - 0.75 beta, beta = 0.04
-        if err > 1.0:
-            cnt[_REJ] += 1
-            h = h / min(5.0, fac11 / 0.9)
             continue
         verdict, sig = _controls(model_id, ynew, p, sig, h, h_onset, ks[0], ks[6], jump_floor, force_jump)
         if verdict == 1 or verdict == 2:  # a contact changed in a long step, or a force jumped
@@ -112,9 +103,7 @@ def dp5_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_st
             continue
         cnt[_CHANGES] += verdict == 3
         cnt[_STIFF] += _stiff(h, ks, ynew, yt)
-        fac = fac11 / err_old ** 0.04
-        fac = max(0.1, min(5.0, fac / 0.9))
-        err_old = max(err, 1e-4)
+        fac, err_old = _pi_factor(err, err_old)
         k = _accept(model_id, t, h, y, ynew, ks[0], ks[6], p, log, t_out, out, k)
         t = t + h
         cnt[_STEPS] += 1
@@ -123,7 +112,44 @@ def dp5_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_st
     return status
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
+def _before_step(cnt, max_steps, t, t_end, h, h_max, tiny):  # pragma: no cover - compiled
+    """Before a step: (-1, its length) to take it, else (the status the loop stops with, h): too many steps,
+    only round-off of the time axis left (``STATUS_OK``: the remaining samples are the current state), or a
+    step-size underflow."""
+    if cnt[_STEPS] + cnt[_REJ] >= max_steps:
+        return STATUS_MAX_STEPS, h
+    if t_end - t <= tiny:
+        return STATUS_OK, h
+    h = min(h, h_max, t_end - t)
+    if h < tiny:
+        return STATUS_STEP_UNDERFLOW, h
+    return -1, h
+
+
+@numba.njit(cache=True, inline="always")
+def _error_refusal(err, h, cnt):  # pragma: no cover - compiled
+    """A step refused by its error estimate: (the length to retry it at, True), counted as rejected; a quarter of
+    the length when the new state is not finite, the controller's shrink err^0.17 / 0.9 (at most 5) when the
+    error exceeds 1. (h, False) when the error accepts the step."""
+    if not np.isfinite(err):
+        cnt[_REJ] += 1
+        return h * 0.25, True
+    if err > 1.0:
+        cnt[_REJ] += 1
+        return h / min(5.0, err ** 0.17 / 0.9), True  # 0.17 = 0.2 - 0.75 beta, beta = 0.04
+    return h, False
+
+
+@numba.njit(cache=True, inline="always")
+def _pi_factor(err, err_old):  # pragma: no cover - compiled
+    """The PI controller's step-length divisor after an accepted step (within 0.1 .. 5, safety 0.9), and the
+    error to remember for the next one (floored at 1e-4)."""
+    fac = err ** 0.17 / err_old ** 0.04
+    return max(0.1, min(5.0, fac / 0.9)), max(err, 1e-4)
+
+
+@numba.njit(cache=True, inline="always")
 def _samples_before(t_out, t, y, out):  # pragma: no cover - compiled
     """Write the samples at or before ``t`` (the start) as ``y``; the next sample index."""
     k = 0
@@ -133,7 +159,7 @@ def _samples_before(t_out, t, y, out):  # pragma: no cover - compiled
     return k
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _dp5_stages(model_id, t, h, y, p, log, ks, yt, ynew):  # pragma: no cover - compiled
     """The stages k2 .. k7 of one step of length h from (t, y) with ks[0] = f(y): the new state into ``ynew``,
     its derivative into ks[6] (FSAL); ``yt`` is left holding the sixth stage's state."""
@@ -158,7 +184,7 @@ def _dp5_stages(model_id, t, h, y, p, log, ks, yt, ynew):  # pragma: no cover - 
     model_rhs(model_id, t + h, ynew, p, log, ks[6])
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _dp5_error(h, y, ynew, ks, atol, rtol):  # pragma: no cover - compiled
     """The RMS of err_i / (atol_i + rtol max(|y_i|, |ynew_i|)) of the embedded 4th-order estimate; inf when the
     new state is not finite."""
@@ -175,7 +201,7 @@ def _dp5_error(h, y, ynew, ks, atol, rtol):  # pragma: no cover - compiled
     return err if finite else np.inf
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _stiff(h, ks, ynew, yt):  # pragma: no cover - compiled
     """Whether an accepted step sits at the stability edge: h |lambda| > 3.25 (see :func:`dp5_integrate`)."""
     num = 0.0
@@ -186,7 +212,7 @@ def _stiff(h, ks, ynew, yt):  # pragma: no cover - compiled
     return 1 if den > 0.0 and h * h * num > 3.25 * 3.25 * den else 0
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _retry_step(verdict, h, h_onset, cnt):  # pragma: no cover - compiled
     """Count a step refused by :func:`_controls` and return the length to retry it at: the onset step after a
     contact change in a long step (verdict 1), half the length after a force jump (verdict 2)."""
@@ -195,7 +221,7 @@ def _retry_step(verdict, h, h_onset, cnt):  # pragma: no cover - compiled
     return h_onset if verdict == 1 else max(0.5 * h, h_onset)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _controls(model_id, y_new, p, sig, h, h_onset, k1, k7, jump_floor, force_jump):  # pragma: no cover
     """The contact-onset and force-jump tests of an error-accepted step: (verdict, new signature), verdict
     0 accept, 1 retry at the onset step (a contact changed in a long step), 2 retry at half the length
@@ -214,7 +240,7 @@ def _controls(model_id, y_new, p, sig, h, h_onset, k1, k7, jump_floor, force_jum
     return verdict, sig_new
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _accept(model_id, t, h, y, ynew, k1, k7, p, log, t_out, out, k):  # pragma: no cover - compiled
     """Write the samples inside (t, t + h], move to the step's end, run the bookkeeping; next sample index."""
     t_new = t + h
@@ -228,7 +254,7 @@ def _accept(model_id, t, h, y, ynew, k1, k7, p, log, t_out, out, k):  # pragma: 
     return k
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _write_stats(stats, cnt, h):  # pragma: no cover - compiled
     for i in range(cnt.shape[0]):
         stats[i] = cnt[i]

@@ -2,8 +2,10 @@
 
 The contact forces, entrainment speeds and films come from the compiled models themselves: at every sample
 :func:`kernel_observables` evaluates the model's own race and ball-ball force functions (the ones its
-right-hand side calls; :func:`cageless.simulation.kernels.model_observe`) and they write what they compute
-into an output array, so the trace cannot drift from the forces the solver integrated. They give:
+right-hand side calls; :func:`cageless.simulation.models.planar.planar_observe`,
+:func:`cageless.simulation.models.spatial.spatial_observe`) and they write what they compute into an output
+array, so the trace cannot drift from the forces the solver integrated. Each model has its own compiled
+sample loop, so a run compiles the observation code of its own model only. They give:
 
 * ``*_normal``: the elastic (Hertz) part of each contact's normal force, K delta^1.5;
 * ``inner_traction``, ``outer_traction``: the race traction on the ball along the rolling direction, the
@@ -24,9 +26,9 @@ import numba
 import numpy as np
 import numpy.typing as npt
 
-from cageless.simulation import kernels
 from cageless.simulation.hertz import compliance, hertz_contact, race_curvatures
 from cageless.simulation.models import base as B
+from cageless.simulation.models import planar as P
 from cageless.simulation.models import spatial as S
 from cageless.simulation.models.spatial_geometry import race_geometry
 from cageless.simulation.problem import Problem
@@ -83,23 +85,43 @@ def kernel_observables(pr: Problem, t: npt.NDArray[np.float64], y: npt.NDArray[n
     log[:z] = 0.0  # onset speeds are not kept per sample (they enter no field written: the elastic force does)
     out = np.zeros((len(t), B.N_OBS, z))
     c_outer, c_inner = film if film is not None else (np.nan, np.nan)
-    _observe(pr.model_id, np.ascontiguousarray(t, dtype=np.float64), np.ascontiguousarray(y, dtype=np.float64),
-             pr.params, log, c_outer, c_inner, out)
+    loop = {P.MODEL_ID: _observe_planar, S.MODEL_ID: _observe_spatial}.get(pr.model_id)
+    if loop is None:  # a model without race contacts: every field 0, the films NaN
+        out[:, [B.OBS_OUTER_FILM, B.OBS_INNER_FILM]] = np.nan
+    else:
+        loop(np.ascontiguousarray(t, dtype=np.float64), np.ascontiguousarray(y, dtype=np.float64), pr.params, log,
+             c_outer, c_inner, out)
     out[~np.all(np.isfinite(y), axis=1)] = np.nan
     return out
 
 
 @numba.njit(cache=True)
-def _observe(model_id, ts, ys, p, log, c_outer, c_inner, out):  # pragma: no cover - compiled
-    """Every sample's observables (:func:`cageless.simulation.kernels.model_observe`), then the race films
-    h = c_h max(u_r, 1 um/s)^0.67 Q^-0.067 from the same pass (NaN where the contact is open)."""
+def _observe_planar(ts, ys, p, log, c_outer, c_inner, out):  # pragma: no cover - compiled
+    """Every sample's observables of the planar model (:func:`cageless.simulation.models.planar.planar_observe`)
+    and their films (:func:`_films`)."""
     for i in range(ts.shape[0]):
-        kernels.model_observe(model_id, ts[i], ys[i], p, log, out[i])
-        for j in range(out.shape[2]):
-            for f_q, f_u, f_h, c_h in ((B.OBS_OUTER_NORMAL, B.OBS_OUTER_ENTRAIN, B.OBS_OUTER_FILM, c_outer),
-                                       (B.OBS_INNER_NORMAL, B.OBS_INNER_ENTRAIN, B.OBS_INNER_FILM, c_inner)):
-                q = out[i, f_q, j]
-                out[i, f_h, j] = c_h * max(out[i, f_u, j], 1e-6) ** 0.67 * q ** -0.067 if q > 0.0 else np.nan
+        P.planar_observe(ts[i], ys[i], p, log, out[i])
+        _films(out[i], c_outer, c_inner)
+
+
+@numba.njit(cache=True)
+def _observe_spatial(ts, ys, p, log, c_outer, c_inner, out):  # pragma: no cover - compiled
+    """Every sample's observables of the spatial model (:func:`cageless.simulation.models.spatial.spatial_observe`)
+    and their films (:func:`_films`)."""
+    for i in range(ts.shape[0]):
+        S.spatial_observe(ts[i], ys[i], p, log, out[i])
+        _films(out[i], c_outer, c_inner)
+
+
+@numba.njit(cache=True, inline="always")
+def _films(row, c_outer, c_inner):  # pragma: no cover - compiled
+    """The race films of one sample's observables ``row`` (fields, Z) from the same pass:
+    h = c_h max(u_r, 1 um/s)^0.67 Q^-0.067 (NaN where the contact is open)."""
+    for j in range(row.shape[1]):
+        for f_q, f_u, f_h, c_h in ((B.OBS_OUTER_NORMAL, B.OBS_OUTER_ENTRAIN, B.OBS_OUTER_FILM, c_outer),
+                                   (B.OBS_INNER_NORMAL, B.OBS_INNER_ENTRAIN, B.OBS_INNER_FILM, c_inner)):
+            q = row[f_q, j]
+            row[f_h, j] = c_h * max(row[f_u, j], 1e-6) ** 0.67 * q ** -0.067 if q > 0.0 else np.nan
 
 
 def film_coefficients(scene: Scene, viscosity_pa_s: float | None = None) -> tuple[float, float]:

@@ -339,7 +339,7 @@ def planar_ring_rows(n_balls: int) -> list[int]:
     return [5 * n_balls + 2, 5 * n_balls + 3, 5 * n_balls + 4, 5 * n_balls + 5]
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def planar_observe(t, y, p, log, out):  # pragma: no cover - compiled
     """The observables of state ``y`` at time t from the right-hand side's own force functions: per ball j,
     ``out[:, j]`` gets the fields of :data:`cageless.simulation.models.base.OBSERVABLES` (films excluded)."""

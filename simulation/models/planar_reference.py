@@ -3,15 +3,24 @@
 It computes the same forces as :mod:`cageless.simulation.models.planar` with vectorised
 numpy instead of compiled loops; the tests assert the two agree, and
 ``benchmarks`` time the compiled path against this one under ``solve_ivp``.
+
+The geometry, kinematics and assembly are written here again (what the comparison checks); the contact
+laws are not: the traction or dry friction (:func:`~cageless.simulation.models.contact_laws.tangential`),
+the drag and the churning moment (:func:`~cageless.simulation.models.contact_laws.ball_drag`,
+:func:`~cageless.simulation.models.contact_laws.ball_churning`) are the models' own compiled laws mapped
+over the arrays, so a law has one copy. The laws themselves are tested against their closed forms and
+sources (``tests/validation/test_lubricant_formulas.py``, ``tests/simulation/test_parameters_ensemble.py``).
 """
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 import numpy.typing as npt
 
-from cageless.simulation.forces import squeeze_film
+from cageless.simulation.forces import FASTMATH, squeeze_film
 from cageless.simulation.models import base as B
+from cageless.simulation.models.contact_laws import ball_churning, ball_drag, tangential
 
 __all__ = ["reference_rhs", "tangential_force"]
 
@@ -19,15 +28,33 @@ __all__ = ["reference_rhs", "tangential_force"]
 _SQUEEZE = np.vectorize(squeeze_film.py_func, otypes=[float])
 
 
-def tangential_force(u_s: np.ndarray, u_r: np.ndarray, q: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """Signed tangential force (N): the traction regression, or dry Coulomb-Stribeck friction."""
-    if p[B.P_DRY] > 0.5:
-        mu_c, mu_s = p[B.P_MU_DRY], p[B.P_MU_STATIC]
-        mu = mu_c + (mu_s - mu_c) * np.exp(-(u_s / p[B.P_V_STRIBECK]) ** 2)
-        return np.where(q > 0, mu * q * np.tanh(u_s / p[B.P_V_REG]), 0.0)
-    sr = np.abs(u_s) / np.maximum(np.abs(u_r), p[B.P_U_FLOOR])
-    mu = (p[B.P_TA] + p[B.P_TB] * sr) * np.exp(-p[B.P_TC] * sr) + p[B.P_TD]
-    return np.where((q > 0) & (u_s != 0), np.sign(u_s) * mu * q, 0.0)
+@numba.njit(cache=True, fastmath=FASTMATH)
+def _tangential_map(u_s, u_r, q, p, out):  # pragma: no cover - compiled
+    for i in range(out.shape[0]):
+        out[i] = tangential(u_s[i], u_r[i], q[i], p)
+
+
+@numba.njit(cache=True, fastmath=FASTMATH)
+def _drag_map(v, om, p, f, m):  # pragma: no cover - compiled
+    for i in range(v.shape[0]):
+        f[i] = ball_drag(v[i], p)
+        m[i] = ball_churning(om[i], p)
+
+
+def _flat(*arrays: npt.ArrayLike) -> tuple[tuple[int, ...], list[np.ndarray]]:
+    """The broadcast shape of ``arrays`` and each as a contiguous float64 vector of that many values."""
+    b = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64) for a in arrays))
+    return b[0].shape, [np.ascontiguousarray(a).ravel() for a in b]
+
+
+def tangential_force(u_s: npt.ArrayLike, u_r: npt.ArrayLike, q: npt.ArrayLike, p: np.ndarray) -> np.ndarray:
+    """Signed tangential force (N) over arrays: the models' law
+    (:func:`~cageless.simulation.models.contact_laws.tangential`: the traction regression, or dry
+    Coulomb-Stribeck friction), zero where ``q`` <= 0."""
+    shape, (a, b, c) = _flat(u_s, u_r, q)
+    out = np.empty(a.size)
+    _tangential_map(a, b, c, p, out)
+    return out.reshape(shape)
 
 
 def reference_rhs(t: float, y: npt.NDArray[np.float64], p: npt.NDArray[np.float64],
@@ -119,17 +146,12 @@ def _races(y: np.ndarray, p: np.ndarray, w_i: float, c: np.ndarray, s: np.ndarra
 
 
 def _drag(v: np.ndarray, om: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Drag (N) on the orbital speeds v and churning moments (N m) on the spins om, vectorised."""
-    d, rho, mu = p[B.P_D], p[B.P_RHO_MIX], p[B.P_MU_MIX]
-    if p[B.P_CD] > 0:
-        f = -0.125 * np.pi * p[B.P_CD] * rho * d * d * v * np.abs(v)
-    else:
-        re = rho * np.abs(v) * d / mu
-        cd = np.maximum(24.0 / np.maximum(re, 1e-300) * (1.0 + 0.15 * re ** 0.687), 0.44)
-        f = -np.sign(v) * 0.125 * np.pi * cd * rho * d * d * v * v
-    w, r = np.abs(om), 0.5 * d
-    m = -np.sign(om) * (8.0 * np.pi * mu * r ** 3 * w + 3.225 * np.sqrt(rho * mu) * r ** 4 * w ** 1.5)
-    return f, m
+    """Drag (N) on the orbital speeds v and churning moments (N m) on the spins om: the models' laws
+    (:func:`~cageless.simulation.models.contact_laws.ball_drag`, ``ball_churning``) over the arrays."""
+    shape, (a, b) = _flat(v, om)
+    f, m = np.empty(a.size), np.empty(a.size)
+    _drag_map(a, b, p, f, m)
+    return f.reshape(shape), m.reshape(shape)
 
 
 def _pairs(y: np.ndarray, p: np.ndarray, log: np.ndarray, fy: np.ndarray, fz: np.ndarray,

@@ -440,7 +440,7 @@ def spatial_ring_share(t, y, p, log, j, out):  # pragma: no cover - compiled
         out[6] -= ball_drag(v, p) * v + _churn(y, p, j, z, None)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def spatial_observe(t, y, p, log, out):  # pragma: no cover - compiled
     """The observables of state ``y`` at time t from the right-hand side's own force functions, as
     :func:`cageless.simulation.models.planar.planar_observe` writes them (traction: its component along the

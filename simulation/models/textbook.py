@@ -16,13 +16,13 @@ __all__ = ["oscillator_problem", "riccati_problem", "OSCILLATOR", "RICCATI"]
 OSCILLATOR, RICCATI = 2, 3
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")  # compiled into the kernels' switch
 def oscillator_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
     dydt[0] = y[1]
     dydt[1] = -p[0] * p[0] * y[0]
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")  # compiled into the kernels' switch
 def riccati_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
     dydt[0] = p[0] * y[0] * y[0]
 

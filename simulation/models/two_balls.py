@@ -19,7 +19,7 @@ __all__ = ["two_ball_problem", "MODEL_ID"]
 MODEL_ID = 1
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")  # compiled into the kernels' switch
 def two_ball_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
     diameter, mass1, mass2, stiffness, chi = p[0], p[1], p[2], p[3], p[4]
     delta = diameter - (y[1] - y[0])
@@ -35,7 +35,7 @@ def two_ball_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
     dydt[3] = f / mass2
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")  # compiled into the kernels' switch
 def two_ball_post(t, y, p, log):  # pragma: no cover - compiled
     if p[0] - (y[1] - y[0]) <= 0.0:
         log[0] = 0.0

@@ -1,9 +1,9 @@
 """The trace's contact observables are written by the compiled force functions (models/observables.py).
 
 Checked against closed forms evaluated here in numpy from the state alone: the Hertz force K delta^1.5 of
-each contact (delta from the ball and ring positions), the race traction of the plain-numpy reference law
-(models/planar_reference.py, the tests' independent copy of the traction curve) at the contact's sliding and
-entrainment speeds, with the ring speed of the ramp at the sample's time, and the Hamrock-Dowson film
+each contact (delta from the ball and ring positions), the race traction law (through the plain-numpy
+reference, models/planar_reference.py, which maps the models' own law; the law itself is checked against its
+stated curve in test_parameters_ensemble.py) at the contact's sliding and entrainment speeds recomputed here, with the ring speed of the ramp at the sample's time, and the Hamrock-Dowson film
 c_h u^0.67 Q^-0.067 (Hamrock & Dowson, J. Lubr. Technol. 99 (1977) 264; its coefficient from
 simulation/traction.py). Under pure radial load and one strip per contact the spatial model's observables
 are the planar model's (the two models' equivalence, simulation/models/spatial.py).
