@@ -80,3 +80,20 @@ def test_cvode_is_stopped_ahead_of_contact_onsets():
     assert free.success and held.success and held.n_contact_changes > 100
     assert free.extra["long_onset_steps"] > 0 and held.extra["long_onset_steps"] == 0
     assert held.n_steps < 1.1 * free.n_steps
+
+
+@pytest.mark.parametrize("coeffs", [(-1.0, 0.0, 1.0), (1.0, -3.0, 2.0), (-2e-10, 1e-4, 5.0), (1.0, 1.0, 1.0),
+                                    (2.0, -1.0, 0.0), (1e-9, 2e-4, -8.0), (3.0, 0.0, -1e-30)])
+def test_onset_prediction_first_positive_root(coeffs):
+    """The curvature term of CVODE's onset prediction (simulation.solve._first_root) gives the smallest positive
+    root of c0 + c1 s + c2 s^2, as numpy's companion-matrix roots do, and inf when there is none."""
+    from cageless.simulation.solve import _first_root
+
+    c0, c1, c2 = coeffs
+    roots = np.roots([c2, c1, c0]) if c2 != 0.0 else np.roots([c1, c0])
+    real = [r.real for r in roots if abs(r.imag) <= 1e-12 * max(1.0, abs(r)) and r.real > 0.0]
+    got = _first_root(c0, c1, c2)
+    if real:
+        assert got == pytest.approx(min(real), rel=1e-9)
+    else:
+        assert got == np.inf
