@@ -14,8 +14,14 @@ the default parameter set. The film thickness h_0 is swept twice: with the Hamro
 default, where h_0 is only the critical film of the ball-ball squeeze film) and with the fixed film h_0 in the
 race contacts (``--effect ehl_film=off``), which is how the paper's model uses it.
 
+The "+-" beside each change is its standard error from the seed spread: sqrt(s_lo^2 / n + s_hi^2 / n) / mean_lo,
+with s the standard deviation of the per-seed peak slips at each end and n the seeds. At 1800 rpm the ring of
+balls is chaotic and one seed's peak spreads by about 1 pp, so a change smaller than twice its standard error
+is not resolved.
+
     python benchmarks/lubricant_sensitivity.py               # 2 seeds, 0.1 s each: about 10 min, 2 loaded cores
     python benchmarks/lubricant_sensitivity.py --seeds 1 --duration 0.05
+    python benchmarks/lubricant_sensitivity.py --rows cho_n_s_m film_thickness_m --seeds 4 --duration 0.2
 """
 
 from __future__ import annotations
@@ -40,22 +46,33 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--duration", type=float, default=0.1)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--speed-rpm", type=float, default=1800.0)
+    ap.add_argument("--rows", nargs="*", default=None, help="only the rows of these parameters (default: all)")
     args = ap.parse_args(argv)
+    known = {row[0] for row in STUDY}
+    if args.rows and not set(args.rows) <= known:
+        ap.error(f"--rows: unknown {sorted(set(args.rows) - known)}; the rows are {sorted(known)}")
     from cageless.simulation.sweep import parse_vary, run_sweep, summarise
 
-    out = ["| parameter | low -> high | peak slip (%) low -> high | change (relative) | paper (%) | paper change |",
-           "|---|---|---|---|---|---|"]
+    out = ["| parameter | low -> high | peak slip (%) low -> high | change (relative) +- its standard error | "
+           "paper (%) | paper change |", "|---|---|---|---|---|---|"]
     start = time.perf_counter()
     for name, lo, hi, effects, paper_pct in STUDY:
+        if args.rows and name not in args.rows:
+            continue
         vary = parse_vary([f"{name}={lo:g},{hi:g}"])
         runs = run_sweep(vary, args.seeds, args.speed_rpm, 500.0, duration_s=args.duration, workers=args.workers,
                          progress=False, effects=effects)
         summ = summarise(runs, list(vary)).reset_index(drop=True)
         s_lo, s_hi = summ.peak_slip_mean_pct.iloc[0], summ.peak_slip_mean_pct.iloc[-1]
+        n_lo, n_hi = summ.runs.iloc[0], summ.runs.iloc[-1]
+        # the std of summarise is the population one (ddof 0); the standard error wants the sample one
+        sd_lo, sd_hi = (summ.peak_slip_std_pct.iloc[i] * (n / max(n - 1, 1)) ** 0.5
+                        for i, n in ((0, n_lo), (-1, n_hi)))
+        se = (sd_lo ** 2 / n_lo + sd_hi ** 2 / n_hi) ** 0.5 / s_lo
         label = name + (" (ehl_film off)" if effects else "")
         paper = "— | —" if paper_pct is None else \
             f"{paper_pct[0]} -> {paper_pct[1]} | {(paper_pct[1] - paper_pct[0]) / paper_pct[0]:+.0%}"
-        out.append(f"| {label} | {lo:g} -> {hi:g} | {s_lo:.2f} -> {s_hi:.2f} | {(s_hi - s_lo) / s_lo:+.0%} | "
+        out.append(f"| {label} | {lo:g} -> {hi:g} | {s_lo:.2f} -> {s_hi:.2f} | {(s_hi - s_lo) / s_lo:+.0%} +- {se:.0%} | "
                    f"{paper} |")
         cmd = (f"cageless sweep --speed-rpm {args.speed_rpm:g} --radial-load-n 500 --vary {name}={lo:g},{hi:g} "
                f"--seeds {args.seeds} --duration {args.duration:g}"

@@ -30,6 +30,7 @@ statistics; a failure is a result with ``success = False``, never an exception.
 
 from __future__ import annotations
 
+import math
 import time
 import warnings
 from collections.abc import Callable
@@ -297,9 +298,12 @@ class CvodeSession:
     #: Jacobians evaluated by the structured routine (CVODE's own difference quotients are not counted here).
     n_jac: int = 0
     #: Onset control (see :func:`step_cvode`): the contact overlaps (:func:`cageless.simulation.kernels.model_gaps`)
-    #: at the last step end and before it, and the predicted time from there to the next contact change.
+    #: at the last three step ends, the length of the step before the last (0 until there is one), and the
+    #: predicted time from the last step end to the next contact change.
     gaps: FloatArray | None = None
     gaps_before: FloatArray | None = None
+    gaps_older: FloatArray | None = None
+    dt_before: float = 0.0
     tau: float = np.inf
     onset_step: float = 0.0
     onset_control: bool = False
@@ -329,6 +333,7 @@ class CvodeSession:
             session.gaps = np.empty(pr.n_gaps)
             model_gaps(pr.model_id, session.state, pr.params, session.gaps)
             session.gaps_before = session.gaps.copy()
+            session.gaps_older = session.gaps.copy()
         with warnings.catch_warnings():  # sparsity with a jacfn: scikit-sundae notes its own routine is unused
             warnings.filterwarnings("ignore", message="Custom sparse Jacobian approximation")
             session.solver = CVODE(rhs, method="BDF", rtol=rtol, atol=pr.atol.astype(np.float64),
@@ -355,29 +360,60 @@ class CvodeSession:
         if self.gaps is None:
             self.t, self.state = t, state
             return False
-        self.gaps_before, self.gaps = self.gaps, self.gaps_before
+        self.gaps_older, self.gaps_before, self.gaps = self.gaps_before, self.gaps, self.gaps_older
         changed, self.tau = _onset_update(self.model_id, state, self.params, self.gaps, self.gaps_before,
-                                          t - self.t)
+                                          self.gaps_older, t - self.t, self.dt_before)
+        self.dt_before = t - self.t
         self.t, self.state = t, state
         return changed
 
 
 @numba.njit(cache=True)
-def _onset_update(model_id, y, p, gaps, before, dt):  # pragma: no cover - compiled
+def _onset_update(model_id, y, p, gaps, before, older, dt, dt_before):  # pragma: no cover - compiled
     """Fill ``gaps`` with the contact overlaps at ``y``; return whether a contact changed since
-    ``before`` (``dt`` earlier) and the earliest time at which a linearly extrapolated overlap changes sign
-    (inf if none)."""
+    ``before`` (``dt`` earlier) and the earliest time at which an extrapolated overlap changes sign (inf if none).
+
+    Each overlap is extrapolated linearly from the last two step ends and, once there is a third (``older``,
+    ``dt_before`` before ``before``), also with its second divided difference: a contact's approach speeds up
+    or slows down under the forces on the two bodies (a ball pushed into its neighbour by the race traction),
+    which a straight line through the last two points misses. The earlier of the two predicted sign changes
+    counts, so the curvature only ever shortens a step."""
     model_gaps(model_id, y, p, gaps)
     changed, tau = False, np.inf
     for i in range(gaps.shape[0]):
         if (gaps[i] > 0.0) != (before[i] > 0.0):
             changed = True
-        rate = (gaps[i] - before[i]) / dt if dt > 0.0 else 0.0
+        if dt <= 0.0:
+            continue
+        rate = (gaps[i] - before[i]) / dt
         if rate != 0.0:
             t_i = -gaps[i] / rate
             if 0.0 < t_i < tau:
                 tau = t_i
+        if dt_before > 0.0:
+            # quadratic through the three step ends: g(s) = g + v s + a s^2 / 2, s from the last end
+            acc = 2.0 * (rate - (before[i] - older[i]) / dt_before) / (dt + dt_before)
+            v = rate + 0.5 * acc * dt
+            t_q = _first_root(gaps[i], v, 0.5 * acc)
+            if 0.0 < t_q < tau:
+                tau = t_q
     return changed, tau
+
+
+@numba.njit(cache=True, inline="always")
+def _first_root(c0, c1, c2):  # pragma: no cover - compiled
+    """The smallest positive root of c0 + c1 s + c2 s^2 (inf if none)."""
+    if c2 == 0.0:
+        return -c0 / c1 if c1 != 0.0 and -c0 / c1 > 0.0 else np.inf
+    disc = c1 * c1 - 4.0 * c2 * c0
+    if disc < 0.0:
+        return np.inf
+    q = -0.5 * (c1 + math.copysign(math.sqrt(disc), c1))  # the stable pair of roots q / c2 and c0 / q
+    best = np.inf
+    for root in (q / c2, c0 / q if q != 0.0 else np.inf):
+        if 0.0 < root < best:
+            best = root
+    return best
 
 
 def step_cvode(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float = np.inf,

@@ -58,10 +58,12 @@ def test_cvode_is_stopped_ahead_of_contact_onsets():
     """CVODE cannot take a step back, so it is stopped ahead of predicted contact changes
     (simulation.solve.CvodeSession.stop_time) and the step that crosses one stays within the onset step
     t_H/20 that DP5 retries at. From the packed start at 1800 rpm over 10 ms (balls bunching and
-    spreading): measured 204 contact changes, 9 of them inside longer steps without the control, 0 of 194
-    with it, for 2.6 % more steps. With the traction by film regime on (the default since issue 16) 1 change
-    in the controlled run still fell inside a longer step (measured), so this check runs on the traction curve
-    it was tuned on."""
+    spreading): measured with the traction curve, 204 contact changes, 9 of them inside longer steps without
+    the control, 0 of 194 with it, for 2.6 % more steps. With the traction by film regime (the default) a
+    straight-line prediction still let 1 of 156 changes fall inside a longer step (a neighbour pair closing
+    faster and faster, 0.42 nm apart: predicted in 4.1 us, closed in 2.9); with the overlaps' curvature in the
+    prediction (simulation.solve._onset_update), 0 of 155, for 0.8 % more steps. This check runs on the
+    default effects."""
     from cageless.conditions import OperatingConditions
     from cageless.simulation.effects import choose_model
     from cageless.simulation.parameters import ModelParameters
@@ -70,10 +72,28 @@ def test_cvode_is_stopped_ahead_of_contact_onsets():
     from cageless.simulation.solve import step_cvode
 
     scene = Scene(conditions=OperatingConditions(1800.0, 500.0))
-    pr = build_problem(scene, choose_model(scene, effects={"film_traction": False}, force=True), ModelParameters())
+    pr = build_problem(scene, choose_model(scene), ModelParameters())
+    assert "film_traction" in pr.effects
     t = np.linspace(0.0, 0.01, 101)
     free = step_cvode(pr, t, 3e-8, max_step=5e-6, onset_control=False)
     held = step_cvode(pr, t, 3e-8, max_step=5e-6)
     assert free.success and held.success and held.n_contact_changes > 100
     assert free.extra["long_onset_steps"] > 0 and held.extra["long_onset_steps"] == 0
     assert held.n_steps < 1.1 * free.n_steps
+
+
+@pytest.mark.parametrize("coeffs", [(-1.0, 0.0, 1.0), (1.0, -3.0, 2.0), (-2e-10, 1e-4, 5.0), (1.0, 1.0, 1.0),
+                                    (2.0, -1.0, 0.0), (1e-9, 2e-4, -8.0), (3.0, 0.0, -1e-30)])
+def test_onset_prediction_first_positive_root(coeffs):
+    """The curvature term of CVODE's onset prediction (simulation.solve._first_root) gives the smallest positive
+    root of c0 + c1 s + c2 s^2, as numpy's companion-matrix roots do, and inf when there is none."""
+    from cageless.simulation.solve import _first_root
+
+    c0, c1, c2 = coeffs
+    roots = np.roots([c2, c1, c0]) if c2 != 0.0 else np.roots([c1, c0])
+    real = [r.real for r in roots if abs(r.imag) <= 1e-12 * max(1.0, abs(r)) and r.real > 0.0]
+    got = _first_root(c0, c1, c2)
+    if real:
+        assert got == pytest.approx(min(real), rel=1e-9)
+    else:
+        assert got == np.inf

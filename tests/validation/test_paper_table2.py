@@ -4,7 +4,8 @@ Reference: Wang, Zhao, Wang, Jin, Appl. Sci. 2026, 16, 9284, Table 2, measured p
 11.77 % at 1800 rpm and 4.58 % at 6000 rpm, 500 N. The default parameter set was fitted once, at 3000 rpm /
 500 N (simulation/parameter_sets.py); these two conditions are predictions. The issue's aim is a miss of at
 most 3 pp (the paper's own model misses them by 11.0 and 3.8 pp). Measured with the full benchmark (2 seeds x
-0.1 s, traction by film regime on): 12.05 % and 3.27 %, misses +0.28 and -1.31 pp.
+0.1 s, traction by film regime on): 11.82 % and 3.27 %, misses +0.05 and -1.31 pp; with 4 seeds x 0.2 s 10.09 % and
+3.27 % (-1.68 and -1.31 pp).
 """
 
 from __future__ import annotations
