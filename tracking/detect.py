@@ -18,7 +18,8 @@ background frame, which in the ball band switches between ball and gap levels
 across a window and biases the centroid (2.1-2.4 x the Cramér-Rao bound against
 1.1-1.15 x, measured on rendered video). Static defects (hot pixels) are taken
 out of the mask by :func:`static_defects`; a masked pixel leaves the centroid together with its mirror image
-through the window's centre (:func:`_pass`), so a hole does not push it. The centroid of the binary mask is kept only as the ``"mask"``
+through the window's centre (:func:`_pass`), so a hole does not push it. The centroid of the binary mask is
+kept only as the ``"mask"``
 detector, for the accuracy-versus-time comparison.
 """
 
@@ -195,15 +196,20 @@ def _fill_holes(binary: np.ndarray) -> np.ndarray:
 
 def centroid_windows(frame: np.ndarray, background: np.ndarray, mask: np.ndarray, u0: npt.ArrayLike,
                      v0: npt.ArrayLike, half: npt.ArrayLike | float, threshold: float,
-                     iterations: int = 2) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                     iterations: int = 2, mirror: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Weighted centroids in circular windows of radius ``half`` around (u0, v0), re-centred ``iterations`` times.
+
+    With ``mirror`` (the default) a masked pixel leaves a window together with its mirror image through the
+    window's centre (:func:`_pass`); without it, alone (the candidates of the ball selection, where a still
+    highlight must stay still: on a noisy still clip, mirrored holes at the band's edge made a few static
+    highlights wander enough to pass for moving balls).
 
     Returns ``(u, v, mass)``; mass 0 where nothing rose above the threshold (u, v are then NaN).
     """
     u0 = np.ascontiguousarray(u0, dtype=np.float64)
     v0 = np.ascontiguousarray(v0, dtype=np.float64)
     half_arr = np.broadcast_to(np.asarray(half, dtype=np.float64), u0.shape).copy()
-    return _centroids(frame, background, mask, u0, v0, half_arr, float(threshold), int(iterations))
+    return _centroids_core(frame, background, mask, u0, v0, half_arr, float(threshold), int(iterations), bool(mirror))
 
 
 #: The window re-centring stops once it moves less than this (px).
@@ -294,6 +300,12 @@ def _pass(frame, background, mask, u, v, r, local, threshold, mirror):  # pragma
 
 @numba.njit(cache=True, nogil=True)
 def _centroids(frame, background, mask, u0, v0, half, threshold, iterations):  # pragma: no cover - compiled
+    """:func:`centroid_windows` with mirrored holes, for compiled callers."""
+    return _centroids_core(frame, background, mask, u0, v0, half, threshold, iterations, True)
+
+
+@numba.njit(cache=True, nogil=True)
+def _centroids_core(frame, background, mask, u0, v0, half, threshold, iterations, mirror):  # pragma: no cover
     n = u0.shape[0]
     h, w = frame.shape
     out_u = np.full(n, np.nan)
@@ -313,7 +325,7 @@ def _centroids(frame, background, mask, u0, v0, half, threshold, iterations):  #
         pdu, pdv = 0.0, 0.0
         for it in range(iterations):
             su, sv, m, holes = _pass(frame, background, mask, u, v, r, local, threshold, False)
-            if holes:
+            if holes and mirror:
                 su, sv, m, _ = _pass(frame, background, mask, u, v, r, local, threshold, True)
             if m <= 0.0:
                 break
