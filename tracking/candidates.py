@@ -183,7 +183,7 @@ def refine_candidates(c: Candidates, frame: np.ndarray, background: np.ndarray, 
 
     if len(c) == 0:
         return c
-    u, v, m = centroid_windows(frame, background, mask, c.u, c.v, radius_px, threshold, iterations)
+    u, v, m = centroid_windows(frame, background, mask, c.u, c.v, radius_px, threshold, iterations, mirror=False)
     bad = ~(m > 0)
     u[bad], v[bad] = c.u[bad], c.v[bad]
     near = np.hypot(u[:, None] - u[None, :], v[:, None] - v[None, :]) <= merge_px

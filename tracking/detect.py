@@ -17,7 +17,9 @@ a few noise standard deviations. A local constant works better than the median
 background frame, which in the ball band switches between ball and gap levels
 across a window and biases the centroid (2.1-2.4 x the Cramér-Rao bound against
 1.1-1.15 x, measured on rendered video). Static defects (hot pixels) are taken
-out of the mask by :func:`static_defects`. The centroid of the binary mask is kept only as the ``"mask"``
+out of the mask by :func:`static_defects`; a masked pixel leaves the centroid together with its mirror image
+through the window's centre (:func:`_pass`), so a hole does not push it. The centroid of the binary mask is
+kept only as the ``"mask"``
 detector, for the accuracy-versus-time comparison.
 """
 
@@ -194,15 +196,20 @@ def _fill_holes(binary: np.ndarray) -> np.ndarray:
 
 def centroid_windows(frame: np.ndarray, background: np.ndarray, mask: np.ndarray, u0: npt.ArrayLike,
                      v0: npt.ArrayLike, half: npt.ArrayLike | float, threshold: float,
-                     iterations: int = 2) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                     iterations: int = 2, mirror: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Weighted centroids in circular windows of radius ``half`` around (u0, v0), re-centred ``iterations`` times.
+
+    With ``mirror`` (the default) a masked pixel leaves a window together with its mirror image through the
+    window's centre (:func:`_pass`); without it, alone (the candidates of the ball selection, where a still
+    highlight must stay still: on a noisy still clip, mirrored holes at the band's edge made a few static
+    highlights wander enough to pass for moving balls).
 
     Returns ``(u, v, mass)``; mass 0 where nothing rose above the threshold (u, v are then NaN).
     """
     u0 = np.ascontiguousarray(u0, dtype=np.float64)
     v0 = np.ascontiguousarray(v0, dtype=np.float64)
     half_arr = np.broadcast_to(np.asarray(half, dtype=np.float64), u0.shape).copy()
-    return _centroids(frame, background, mask, u0, v0, half_arr, float(threshold), int(iterations))
+    return _centroids_core(frame, background, mask, u0, v0, half_arr, float(threshold), int(iterations), bool(mirror))
 
 
 #: The window re-centring stops once it moves less than this (px).
@@ -237,8 +244,68 @@ def _local_background(frame, mask, u, v, r, ring):  # pragma: no cover - compile
     return np.median(ring[:cnt]) if cnt >= 8 else np.nan
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _kept(mask, x, y):  # pragma: no cover - compiled
+    """Bilinear interpolation of ``mask`` (as 0/1, 0 outside the image) at the point (x, y)."""
+    h, w = mask.shape
+    ix, iy = int(np.floor(x)), int(np.floor(y))
+    fx, fy = x - ix, y - iy
+    out = 0.0
+    for dy, wy in ((0, 1.0 - fy), (1, fy)):
+        yy = iy + dy
+        if wy <= 0.0 or yy < 0 or yy >= h:
+            continue
+        for dx, wx in ((0, 1.0 - fx), (1, fx)):
+            xx = ix + dx
+            if wx > 0.0 and 0 <= xx < w and mask[yy, xx]:
+                out += wx * wy
+    return out
+
+
+@numba.njit(cache=True, nogil=True)
+def _pass(frame, background, mask, u, v, r, local, threshold, mirror):  # pragma: no cover - compiled
+    """One weighted-centroid pass over the window of radius r at (u, v): sums (su, sv, m) and whether the
+    window holds a masked pixel. With ``mirror``, each pixel's weight is also multiplied by how much of its
+    mirror image through the window's centre is unmasked (bilinear, so it varies smoothly with the centre):
+    a masked pixel is then left out with its mirror image, and the centroid of a centrally symmetric spot
+    stays at its centre. Leaving out a hole on one side only pushes the centroid away from it: the static
+    defects masked on the highlights' path (hot pixels, and pixels the highlights leave bright in three
+    quarters of the sampled frames) made 1.32 mrad RMS on corpus seed 1029 and 0.55 on seed 1024, against
+    0.35 and 0.41 with mirrored holes (and 0.38 and 0.41 with the mirror pixel rounded to the grid instead of
+    interpolated, which pulls the centre towards the grid)."""
+    h, w = frame.shape
+    su = 0.0
+    sv = 0.0
+    m = 0.0
+    holes = False
+    for y in range(max(int(np.floor(v - r)), 0), min(int(np.ceil(v + r)) + 1, h)):
+        dy2 = (y - v) * (y - v)
+        x0, x1 = _span(u, r * r, dy2, 0, w)
+        for x in range(x0, x1 + 1):
+            if not mask[y, x]:
+                holes = True
+                continue
+            base = local if np.isfinite(local) else background[y, x]
+            wgt = np.float64(frame[y, x]) - base - threshold
+            if wgt > 0.0:
+                taper = 1.0 - ((x - u) * (x - u) + dy2) / (r * r)  # biweight: 0 at the edge
+                wgt *= taper * taper
+                if mirror:
+                    wgt *= _kept(mask, 2.0 * u - x, 2.0 * v - y)
+                su += wgt * x
+                sv += wgt * y
+                m += wgt
+    return su, sv, m, holes
+
+
 @numba.njit(cache=True, nogil=True)
 def _centroids(frame, background, mask, u0, v0, half, threshold, iterations):  # pragma: no cover - compiled
+    """:func:`centroid_windows` with mirrored holes, for compiled callers."""
+    return _centroids_core(frame, background, mask, u0, v0, half, threshold, iterations, True)
+
+
+@numba.njit(cache=True, nogil=True)
+def _centroids_core(frame, background, mask, u0, v0, half, threshold, iterations, mirror):  # pragma: no cover
     n = u0.shape[0]
     h, w = frame.shape
     out_u = np.full(n, np.nan)
@@ -257,23 +324,9 @@ def _centroids(frame, background, mask, u0, v0, half, threshold, iterations):  #
         m = 0.0
         pdu, pdv = 0.0, 0.0
         for it in range(iterations):
-            su = 0.0
-            sv = 0.0
-            m = 0.0
-            for y in range(max(int(np.floor(v - r)), 0), min(int(np.ceil(v + r)) + 1, h)):
-                dy2 = (y - v) * (y - v)
-                x0, x1 = _span(u, r * r, dy2, 0, w)
-                for x in range(x0, x1 + 1):
-                    if not mask[y, x]:
-                        continue
-                    base = local if np.isfinite(local) else background[y, x]
-                    wgt = np.float64(frame[y, x]) - base - threshold
-                    if wgt > 0.0:
-                        taper = 1.0 - ((x - u) * (x - u) + dy2) / (r * r)  # biweight: 0 at the edge
-                        wgt *= taper * taper
-                        su += wgt * x
-                        sv += wgt * y
-                        m += wgt
+            su, sv, m, holes = _pass(frame, background, mask, u, v, r, local, threshold, False)
+            if holes and mirror:
+                su, sv, m, _ = _pass(frame, background, mask, u, v, r, local, threshold, True)
             if m <= 0.0:
                 break
             du, dv = su / m - u, sv / m - v

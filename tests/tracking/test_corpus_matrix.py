@@ -34,31 +34,89 @@ ALL = [("TUNING", s) for s in TUNING] + [("HOLDOUT", s) for s in HOLDOUT]
 #: corpus of format 8, TUNING 13 and HOLDOUT 14; with the tapered centroid window TUNING 18 and HOLDOUT 16;
 #: with the selection's tracklet gates, blob-centred candidates, hysteresis and low-quantile background, the
 #: centroid mask on the highlight circle, window re-centring to convergence and the robust track fit
-#: TUNING 25 and HOLDOUT 24, every clip with all Z balls; with the brighter of two lights' circles TUNING 26 and HOLDOUT 24).
+#: TUNING 25 and HOLDOUT 24, every clip with all Z balls; with the brighter of two lights' circles TUNING 26 and HOLDOUT 24;
+#: with masked pixels left out of the centroid together with their mirror images TUNING 28 and HOLDOUT 23:
+#: 1024, 1029, 7005, 7013 pass, 7026 2.22 -> 0.68 mrad, while 7011, 7012 and 7025 fail by 2-14 % of a bar
+#: and 7020 goes from 0.78 to 1.12 mrad).
 #: Remove a seed when it passes.
 KNOWN_FAILURES: dict[int, str] = {
-    1011: "angle_rms 0.806 mrad > 0.5; speed_rms 0.98 % of cage speed > 0.5; slip_mae 0.581 pp > 0.3",
+    1011: "angle_rms 0.623 mrad > 0.5; speed_rms 0.689 % of cage speed > 0.5; slip_mae 0.484 pp > 0.3",
     1012: "angle_rms 0.536 mrad > 0.5; speed_rms 0.762 % of cage speed > 0.5",
-    1014: "angle_rms 0.832 mrad > 0.5",
-    1022: "angle_rms 0.511 mrad > 0.5",
-    1024: "angle_rms 0.55 mrad > 0.5",
-    1029: "angle_rms 1.32 mrad > 0.5; speed_rms 0.857 % of cage speed > 0.5; slip_mae 0.377 pp > 0.3",
-    7004: "speed_rms 0.71 % of cage speed > 0.5",
-    7005: "angle_rms 0.548 mrad > 0.5",
+    1014: "angle_rms 0.831 mrad > 0.5",
+    1022: "angle_rms 0.55 mrad > 0.5",
+    7004: "speed_rms 0.697 % of cage speed > 0.5",
     7008: "angle_rms 0.588 mrad > 0.5; speed_rms 0.503 % of cage speed > 0.5",
     7009: "angle_rms 0.614 mrad > 0.5",
-    7013: "angle_rms 0.667 mrad > 0.5",
-    7018: "angle_rms 1.45 mrad > 0.5",
-    7020: "angle_rms 0.779 mrad > 0.5",
-    7026: "angle_rms 2.22 mrad > 0.5; speed_rms 0.783 % of cage speed > 0.5; slip_mae 0.428 pp > 0.3",
+    7011: "speed_rms 0.533 % of cage speed > 0.5",
+    7012: "angle_rms 0.562 mrad > 0.5",
+    7018: "angle_rms 1.46 mrad > 0.5",
+    7020: "angle_rms 1.12 mrad > 0.5",
+    7025: "angle_rms 0.532 mrad > 0.5",
+    7026: "angle_rms 0.678 mrad > 0.5",
 }
 
-#: The same for the long variants (one cage revolution each; baseline the same day: TUNING 4 of 32 pass,
-#: HOLDOUT 1 of 32; not yet re-run with the ball selection nor on the corpus of format 8). Seeds 1005, 1019, 1021, 1025, 7001 pass long
-#: (1018 passes only short, 1019 only long).
-_LONG_PASS = {1005, 1019, 1021, 1025, 7001}
+#: The same for the long variants (one cage revolution each). Re-measured with the tracker of commit d8b5436 on the
+#: seeds of :data:`_LONG_MEASURED` (a benchmark run over the long clips, TUNING and HOLDOUT interleaved, stopped
+#: at the session's deadline: 37 of 49 pass, "" = passes); the other seeds were last run long in the
+#: morning's baseline (before the ball selection: TUNING 4 and HOLDOUT 1 of 32, seeds 1005, 1019, 1021, 1025
+#: and 7001, passed) and stay listed as then until they are re-run.
+_LONG_MEASURED: dict[int, str] = {
+    1000: "",
+    1001: "",
+    1002: "",
+    1003: "",
+    1004: "",
+    1005: "",
+    1006: "",
+    1007: "",
+    1008: "",
+    1009: "",
+    1010: "",
+    1011: "angle_rms 0.613 mrad > 0.5; speed_rms 0.574 % of cage speed > 0.5; slip_mae 0.39 pp > 0.3",
+    1012: "angle_rms 0.539 mrad > 0.5; speed_rms 0.714 % of cage speed > 0.5",
+    1013: "",
+    1014: "angle_rms 0.821 mrad > 0.5",
+    1015: "",
+    1016: "",
+    1017: "",
+    1018: "",
+    1019: "",
+    1020: "",
+    1021: "",
+    1022: "angle_rms 0.571 mrad > 0.5",
+    1023: "",
+    1024: "",
+    7000: "",
+    7001: "",
+    7002: "",
+    7003: "",
+    7004: "angle_rms 0.632 mrad > 0.5; speed_rms 1.23 % of cage speed > 0.5",
+    7005: "",
+    7006: "",
+    7007: "",
+    7008: "angle_rms 0.579 mrad > 0.5",
+    7009: "angle_rms 0.61 mrad > 0.5",
+    7010: "error: no 16 highlights moving together along one circle near the cage speed were found",
+    7011: "",
+    7012: "angle_rms 0.535 mrad > 0.5",
+    7013: "",
+    7014: "",
+    7015: "",
+    7016: "",
+    7017: "",
+    7018: "angle_rms 1.61 mrad > 0.5",
+    7019: "",
+    7020: "angle_rms 1.12 mrad > 0.5",
+    7021: "error: found 6 balls moving together along one circle, but the bearing has 18",
+    7022: "",
+    7023: "",
+}
+_LONG_PASS_BASELINE = {1005, 1019, 1021, 1025, 7001}
 KNOWN_FAILURES_LONG: dict[int, str] = {
-    s: KNOWN_FAILURES.get(s, "baseline: wrong ball count on the long clip") for _, s in ALL if s not in _LONG_PASS}
+    s: (_LONG_MEASURED[s] if s in _LONG_MEASURED
+        else KNOWN_FAILURES.get(s, "baseline: wrong ball count on the long clip"))
+    for _, s in ALL
+    if (_LONG_MEASURED[s] if s in _LONG_MEASURED else s not in _LONG_PASS_BASELINE)}
 
 _REASON = "tracker not yet robust to this footage (issue 14)"
 
