@@ -73,7 +73,10 @@ class ParameterError(CagelessError, ValueError):
         self.value = value
         self.hint = hint
         shown = "" if value is None else f" = {value!r}"
-        text = f"{parameter}{shown}: {rule}."
+        head, sep, tail = rule.partition(" Did you mean")  # a suggestion appended to the rule is a sentence
+        if sep:
+            rule = f"{head.rstrip('.;')}.{sep}{tail}"
+        text = f"{parameter}{shown}: {rule}{'' if rule.endswith(('.', '?')) else '.'}"
         if hint:
             text += f" {hint}"
         super().__init__(text)

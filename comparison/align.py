@@ -62,7 +62,9 @@ def profiles(trace: Trace, bin_deg: float = 1.0, settle_s: float = 0.0) -> Profi
     keep = (trace.time >= trace.time[0] + settle_s)[:, None] & trace.valid
     if not keep.any():
         raise CagelessError(f"no valid samples after the first {settle_s:g} s of the {trace.source} trace "
-                            f"({trace.time[-1] - trace.time[0]:.4g} s long): lower the start-up left out (--settle) or use a longer trace.")
+                            f"({trace.time[-1] - trace.time[0]:.4g} s long). Simulate longer than the start-up left out (e.g. "
+                            f"`cageless simulate --duration {settle_s + 0.1:.2g}`), or, to compare the start-up "
+                            "itself, lower --settle.")
     slip = angle_profile(trace.angle, trace.slip, bin_deg, valid=keep)
     speed = angle_profile(trace.angle, trace.speed, bin_deg, valid=keep)
     per_ball = np.column_stack([

@@ -165,3 +165,15 @@ def test_a_vary_range_that_breaks_a_parameter_rule_is_refused_before_any_run(tmp
     err = capsys.readouterr().err
     assert "at 0.2, traction_peak_coefficient=0.06 must exceed traction_sliding_coefficient" in err
     assert not (tmp_path / "fit.toml").exists()
+
+
+def test_a_closed_pipe_ends_quietly(tmp_path):
+    """`cageless info --json | head -c 10`: the reader leaves early; no 'unexpected BrokenPipeError' line."""
+    import subprocess
+    import sys
+
+    code = ("import sys; from cageless.app.cli import main\n"
+            "sys.stdout.write = lambda *a: (_ for _ in ()).throw(BrokenPipeError(32, 'Broken pipe'))\n"
+            "sys.exit(main(['info', '--speed-rpm', '1800', '--json']))")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 141 and run.stderr == "", run.stderr

@@ -123,6 +123,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     except CagelessError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return EXIT_FAILED
+    except BrokenPipeError:  # the reader went away (`cageless info --json | head`): stop quietly, as Unix tools do
+        import os
+
+        try:  # no second error when Python flushes standard output at exit
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError, AttributeError):
+            pass
+        return 141
     except KeyboardInterrupt:
         print("error: interrupted; outputs that were complete are kept, nothing partial is left "
               "(a report re-run skips the finished jobs).", file=sys.stderr)
