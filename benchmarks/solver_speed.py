@@ -13,7 +13,7 @@ Cases (every effect of a lubricated scene):
   axial (spatial, 5 strips), 6000 rpm 500 N and 3000 rpm 5 N, from the start, 30 ms (``--duration``).
 
 ``--candidates`` picks rows by key (:data:`CANDIDATES`); ``auto-before`` is the automatic switch as it was
-before it probed from the first chunk (probes at chunks 5 and 20, a way back for good, the earlier cost
+before it probed from the start (no pilot, probes at chunks 5 and 20, a way back for good, the earlier cost
 figures: :data:`cageless.simulation.auto_switch.RHS_COST_US_BEFORE`), run in the same process.
 
 The settled cases measure the slip error as ``cageless bench accuracy`` does (largest difference of the
@@ -71,14 +71,15 @@ DEFAULT_CANDIDATES = "auto,dp5,rosw6,rosw7,rosw3e-7,rosw8"
 @contextmanager
 def _switch_before():  # noqa: ANN202
     """The automatic switch as it was: probes at chunks 5 and 20 only, a way back for good, the earlier costs."""
-    saved = (switch.PROBE_CHUNKS, switch.PROBE_BACKOFF, switch.RHS_COST_US, switch.STEP_COST_US, switch.SWITCH_GAIN)
-    switch.PROBE_CHUNKS, switch.PROBE_BACKOFF, switch.SWITCH_GAIN = (5, 20), None, 0.6
+    saved = (switch.PROBE_CHUNKS, switch.PROBE_BACKOFF, switch.RHS_COST_US, switch.STEP_COST_US, switch.SWITCH_GAIN,
+             switch.PILOT_FRACTION)
+    switch.PROBE_CHUNKS, switch.PROBE_BACKOFF, switch.SWITCH_GAIN, switch.PILOT_FRACTION = (5, 20), None, 0.6, None
     switch.RHS_COST_US, switch.STEP_COST_US = switch.RHS_COST_US_BEFORE, switch.STEP_COST_US_BEFORE
     try:
         yield
     finally:
         (switch.PROBE_CHUNKS, switch.PROBE_BACKOFF, switch.RHS_COST_US, switch.STEP_COST_US,
-         switch.SWITCH_GAIN) = saved
+         switch.SWITCH_GAIN, switch.PILOT_FRACTION) = saved
 
 
 def _from_start(rpm: float, load_n: float, axial_n: float = 0.0, level: str | None = None):  # noqa: ANN202

@@ -80,10 +80,26 @@ def test_the_default_scene_switches_once_past_its_start_up():
     process's CPU time."""
     sol = _run(500.0, duration=0.05).solution
     assert sol.method == "auto: dp5 -> CVODE at 0.003 s -> dp5 at 0.006 s -> CVODE at 0.009 s"
-    probes = sol.extra["switches"]
+    pilot, *probes = sol.extra["switches"]  # the pilot over 0.1 ms: CVODE's cold start costs DP5's rate there
+    assert not pilot["switch"] and pilot["pilot_s"] == pytest.approx(1e-4) and 0.9 < pilot["cost_ratio"] < 1.1
     assert [p["to"] for p in probes] == ["CVODE", "dp5", "CVODE"]
     assert 0.25 < probes[0]["cost_ratio"] < 0.35 and probes[1]["cost_ratio"] > 1.0
     assert 0.3 < probes[2]["cost_ratio"] < 0.4 and probes[0]["stiff_fraction"] > 0.6
+
+
+def test_a_scene_stiff_from_the_start_starts_on_cvode(monkeypatch):
+    """Under 20 kN DP5 is held by stability from the first step (stiff fraction 0.98 on the first chunk): the
+    pilot over a tenth of the first chunk finds CVODE far cheaper and the run starts on it, instead of paying
+    DP5 for the whole first chunk (about half of the run's time over 20 ms with CVODE after it)."""
+    import cageless.simulation.auto_switch
+
+    sol = _run(20000.0, duration=0.005).solution
+    pilot = sol.extra["switches"][0]
+    assert sol.method == "auto: dp5 -> CVODE at 0 s" and pilot["switch"] and pilot["time_s"] == 0.0
+    assert pilot["pilot_s"] == pytest.approx(0.1 * 0.005 / 50) and pilot["cost_ratio"] < 0.8
+    monkeypatch.setattr(cageless.simulation.auto_switch, "PILOT_FRACTION", None)
+    later = _run(20000.0, duration=0.005).solution  # without the pilot: the first chunk's probe
+    assert later.method == "auto: dp5 -> CVODE at 0.0001 s" and later.n_rhs > sol.n_rhs
 
 
 def test_a_dry_scene_stays_on_dp5():
