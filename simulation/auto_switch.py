@@ -12,7 +12,8 @@ switch is DP5's. The first probe runs on the first chunk (:data:`PROBE_CHUNKS`);
 switch makes the next one wait twice as many chunks as the last (:data:`PROBE_BACKOFF`: 1, 2, 4, ...), so
 a run where CVODE never pays spends a handful of chunks on probes, and one where it pays once the violent
 start is over (a BDF restarting from order 1 costs 2-2.7 times DP5 over the first 1.2 ms of a 30 ms run at
-3000 rpm, 0.2-0.4 times after) still finds it.
+3000 rpm, 0.2-0.4 times after) still finds it. Before the first chunk, a pilot over a tenth of it
+(:data:`PILOT_FRACTION`) starts the run on CVODE where DP5 is held by stability from the first step.
 
 The decision must not depend on timing, or the same scene would give different traces on a busy
 machine (the determinism rule of the project). It compares a cost model instead: each solver's
