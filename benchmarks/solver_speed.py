@@ -1,14 +1,20 @@
 """Simulator speed: today's `auto` and DP5 against the compiled Rosenbrock-W method, in one run.
 
     python benchmarks/solver_speed.py [--repeats 3] [--window 0.005] [--cases planar,spatial,bunching,20kN]
-                                      [--json out.json]
+                                      [--candidates auto,dp5,rosw6,...] [--json out.json]
 
 Cases (every effect of a lubricated scene):
 
 * ``planar``: 3000 rpm, 500 N, from the state 30 ms after the start, a ``--window`` long;
 * ``spatial``: 3000 rpm, 500 N radial + 400 N axial, 5 strips, the same;
 * ``bunching``: 1800 rpm, 500 N, from the packed start (the balls bunch), 20 ms;
-* ``20kN``: 3000 rpm, 20 kN, from the start, 20 ms.
+* ``20kN``: 3000 rpm, 20 kN, from the start, 20 ms;
+* ``planar-start``, ``spatial-start``, ``6000rpm``, ``lowload``: 3000 rpm 500 N (planar), 500 N + 400 N
+  axial (spatial, 5 strips), 6000 rpm 500 N and 3000 rpm 5 N, from the start, 30 ms (``--duration``).
+
+``--candidates`` picks rows by key (:data:`CANDIDATES`); ``auto-before`` is the automatic switch as it was
+before it probed from the start (no pilot, probes at chunks 5 and 20, a way back for good, the earlier cost
+figures: :data:`cageless.simulation.auto_switch.RHS_COST_US_BEFORE`), run in the same process.
 
 The settled cases measure the slip error as ``cageless bench accuracy`` does (largest difference of the
 balls' orbital speed over all balls and samples, in percentage points of the cage speed) against a DP5
@@ -28,12 +34,14 @@ import argparse
 import json
 import logging
 import time
+from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+import cageless.simulation.auto_switch as switch
 from cageless.atomic import atomic_write_text
 from cageless.conditions import OperatingConditions
 from cageless.kinematics import theoretical_cage_speed
@@ -46,15 +54,32 @@ from cageless.simulation.solve import solve
 
 log = logging.getLogger("solver_speed")
 
-#: (label, method, rtol, max_step; None: the method's default as ``simulate`` runs it).
-CANDIDATES = (
-    ("auto (today's default)", "auto", 1e-6, None),
-    ("dp5, rtol 1e-6, cap 2 us", "dp5", 1e-6, 2e-6),
-    ("rosw, rtol 1e-6 (cap 10 us)", "rosw", 1e-6, None),
-    ("rosw, rtol 1e-7 (cap 10 us)", "rosw", 1e-7, None),
-    ("rosw, rtol 3e-7 (cap 10 us)", "rosw", 3e-7, None),
-    ("rosw, rtol 1e-8 (cap 10 us)", "rosw", 1e-8, None),
-)
+#: key: (label, method, rtol, max_step; None: the method's default as ``simulate`` runs it).
+CANDIDATES = {
+    "auto": ("auto (today's default)", "auto", 1e-6, None),
+    "auto-before": ("auto before (probes at chunks 5, 20)", "auto-before", 1e-6, None),
+    "dp5": ("dp5, rtol 1e-6, cap 2 us", "dp5", 1e-6, 2e-6),
+    "CVODE": ("CVODE throughout (rtol 3e-8, cap 5 us)", "CVODE", 1e-6, None),
+    "rosw6": ("rosw, rtol 1e-6 (cap 10 us)", "rosw", 1e-6, None),
+    "rosw7": ("rosw, rtol 1e-7 (cap 10 us)", "rosw", 1e-7, None),
+    "rosw3e-7": ("rosw, rtol 3e-7 (cap 10 us)", "rosw", 3e-7, None),
+    "rosw8": ("rosw, rtol 1e-8 (cap 10 us)", "rosw", 1e-8, None),
+}
+DEFAULT_CANDIDATES = "auto,dp5,rosw6,rosw7,rosw3e-7,rosw8"
+
+
+@contextmanager
+def _switch_before():  # noqa: ANN202
+    """The automatic switch as it was: probes at chunks 5 and 20 only, a way back for good, the earlier costs."""
+    saved = (switch.PROBE_CHUNKS, switch.PROBE_BACKOFF, switch.RHS_COST_US, switch.STEP_COST_US, switch.SWITCH_GAIN,
+             switch.PILOT_FRACTION)
+    switch.PROBE_CHUNKS, switch.PROBE_BACKOFF, switch.SWITCH_GAIN, switch.PILOT_FRACTION = (5, 20), None, 0.6, None
+    switch.RHS_COST_US, switch.STEP_COST_US = switch.RHS_COST_US_BEFORE, switch.STEP_COST_US_BEFORE
+    try:
+        yield
+    finally:
+        (switch.PROBE_CHUNKS, switch.PROBE_BACKOFF, switch.RHS_COST_US, switch.STEP_COST_US,
+         switch.SWITCH_GAIN, switch.PILOT_FRACTION) = saved
 
 
 def _from_start(rpm: float, load_n: float, axial_n: float = 0.0, level: str | None = None):  # noqa: ANN202
@@ -63,19 +88,27 @@ def _from_start(rpm: float, load_n: float, axial_n: float = 0.0, level: str | No
     return pr, theoretical_cage_speed(scene.bearing.geometry, scene.conditions.speed_rad_s)
 
 
-def _cases(window: float, names: list[str]) -> dict[str, tuple[Any, float, np.ndarray]]:
+def _cases(window: float, names: list[str], duration: float = 0.03) -> dict[str, tuple[Any, float, np.ndarray]]:
+    start = np.linspace(0, duration, int(round(duration / 1e-4)) + 1)
     table = {
         "planar": lambda: (*_settled_problem(3000, 500, 0.03, level="planar"), np.linspace(0, window, 51)),
         "spatial": lambda: (*_settled_problem(3000, 500, 0.03, axial_n=400, level="spatial", strips=5),
                             np.linspace(0, window, 51)),
         "bunching": lambda: (*_from_start(1800, 500), np.linspace(0, 0.02, 201)),
         "20kN": lambda: (*_from_start(3000, 20000), np.linspace(0, 0.02, 201)),
+        "planar-start": lambda: (*_from_start(3000, 500), start),
+        "spatial-start": lambda: (*_from_start(3000, 500, 400, level="spatial"), start),
+        "6000rpm": lambda: (*_from_start(6000, 500), start),
+        "lowload": lambda: (*_from_start(3000, 5), start),
     }
     return {name: table[name]() for name in names}
 
 
 def _run(pr: Any, t: np.ndarray, method: str, rtol: float, cap: float | None) -> Any:
     kw = {} if cap is None else {"max_step": cap}
+    if method == "auto-before":
+        with _switch_before():
+            return solve(pr, t, method="auto", rtol=rtol)
     if method == "auto" and cap is None:
         return solve(pr, t, method="auto", rtol=rtol)
     if cap is None:
@@ -84,8 +117,11 @@ def _run(pr: Any, t: np.ndarray, method: str, rtol: float, cap: float | None) ->
     return solve(pr, t, method=method, rtol=rtol, **kw)
 
 
-def measure(case: str, pr: Any, cage: float, t: np.ndarray, repeats: int) -> list[dict[str, Any]]:
-    """Every candidate on one case, interleaved, best of ``repeats``."""
+def measure(case: str, pr: Any, cage: float, t: np.ndarray, repeats: int,
+            keys: list[str] | None = None) -> list[dict[str, Any]]:
+    """The candidates ``keys`` (the first is the base of the ratios) on one case, interleaved, best of
+    ``repeats``."""
+    chosen = [CANDIDATES[k] for k in (keys or DEFAULT_CANDIDATES.split(","))]
     ref = solve(pr, t, rtol=1e-10, max_step=2.5e-7)
     z = pr.n_balls
     radius = float(np.mean(pr.y0[:z]))
@@ -94,7 +130,7 @@ def measure(case: str, pr: Any, cage: float, t: np.ndarray, repeats: int) -> lis
     cpu: dict[str, float] = {}
     sols: dict[str, Any] = {}
     for _ in range(repeats):
-        for label, method, rtol, cap in CANDIDATES:
+        for label, method, rtol, cap in chosen:
             start = time.process_time()
             sol = _run(pr, t, method, rtol, cap)
             cpu[label] = min(cpu.get(label, np.inf), time.process_time() - start)
@@ -102,7 +138,7 @@ def measure(case: str, pr: Any, cage: float, t: np.ndarray, repeats: int) -> lis
             best[label] = min(best.get(label, np.inf), sol.wall_s)
     rows = []
     span = float(t[-1] - t[0])
-    for label, *_ in CANDIDATES:
+    for label, *_ in chosen:
         sol = sols[label]
         slip, pos = _errors(sol.y, ref.y, z, cage, radius)
         slip_early = _errors(sol.y[early], ref.y[early], z, cage, radius)[0]
@@ -119,7 +155,7 @@ def measure(case: str, pr: Any, cage: float, t: np.ndarray, repeats: int) -> lis
 
 
 def format_rows(rows: list[dict[str, Any]]) -> str:
-    lines = ["| case | solver | wall s / sim s | CPU s / sim s | speed-up vs auto (CPU) | slip error (pp) | "
+    lines = ["| case | solver | wall s / sim s | CPU s / sim s | speed-up vs first row (CPU) | slip error (pp) | "
              "first 2 ms (pp) | energy drift | steps | RHS |", "|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         flag = "" if r["ok"] else " (failed)"
@@ -135,14 +171,17 @@ def main() -> None:
     ap.add_argument("--window", type=float, default=0.005, help="simulated seconds of the settled cases")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--cases", default="planar,spatial,bunching,20kN")
+    ap.add_argument("--candidates", default=DEFAULT_CANDIDATES, help="keys of CANDIDATES; the first is the base")
+    ap.add_argument("--duration", type=float, default=0.03, help="simulated seconds of the 30 ms cases")
     ap.add_argument("--json", type=Path)
     args = ap.parse_args()
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     rows = []
-    for case, (pr, cage, t) in _cases(args.window, args.cases.split(",")).items():
+    keys = args.candidates.split(",")
+    for case, (pr, cage, t) in _cases(args.window, args.cases.split(","), args.duration).items():
         pr = replace(pr)
         log.info("case %s", case)
-        rows += measure(case, pr, cage, t, args.repeats)
+        rows += measure(case, pr, cage, t, args.repeats, keys)
         log.info("%s", format_rows(rows))
     print(format_rows(rows))
     if args.json:

@@ -7,12 +7,13 @@ When most steps of a chunk sit at the stability edge (fraction >= :data:`STIFF_F
 step is set by stiffness rather than accuracy, as the paper's "Adams-GSTIFF" scheme switches to its
 stiff branch once contacts stiffen. The driver then probes the stiff backend,
 SUNDIALS CVODE's variable-order BDF (:data:`STIFF_METHOD`), on the same chunk from the same state, and
-switches for the rest of the run if its cost is clearly smaller. The probe's result is discarded, so
-the trajectory up to the switch is DP5's. Probes run only at the chunks in :data:`PROBE_CHUNKS` (10 %
-and 40 % into a 50-chunk run): the first chunks are the violent start at full speed, where a BDF
-restarting from order 1 is not representative (measured with LSODA and R = 0: work ratio 2.7 on the
-first millisecond, 0.46 over 50 ms), and each probe costs about a chunk and a half of a run that does
-not switch.
+switches if its cost is clearly smaller. The probe's result is discarded, so the trajectory up to the
+switch is DP5's. The first probe runs on the first chunk (:data:`PROBE_CHUNKS`); a probe that does not
+switch makes the next one wait twice as many chunks as the last (:data:`PROBE_BACKOFF`: 1, 2, 4, ...), so
+a run where CVODE never pays spends a handful of chunks on probes, and one where it pays once the violent
+start is over (a BDF restarting from order 1 costs 2-2.7 times DP5 over the first 1.2 ms of a 30 ms run at
+3000 rpm, 0.2-0.4 times after) still finds it. Before the first chunk, a pilot over a tenth of it
+(:data:`PILOT_FRACTION`) starts the run on CVODE where DP5 is held by stability from the first step.
 
 The decision must not depend on timing, or the same scene would give different traces on a busy
 machine (the determinism rule of the project). It compares a cost model instead: each solver's
@@ -24,15 +25,15 @@ trace's solver statistics.
 
 A probe sees one chunk only. After a switch, the stiff backend's mean cost per simulated second over
 its last :data:`BACK_WINDOW` chunks is compared with DP5's on the probed chunk; once it costs more, the
-run goes back to DP5 for good (no more probes). The first chunk after the switch is not judged: it holds
-the integrator's cold start (order 1, small steps, a first Jacobian), which the probe already paid and
-judged. Single chunks are not judged either: a burst of contacts can double one chunk's cost (the
-default scene over 50 ms: 1.13 times DP5's rate at 44 ms, between chunks at 0.5-0.65). Measured on a
-dry scene at the spatial level (allowed to switch for the measurement, see :data:`SWITCH_WHEN_DRY`): the
-probe inside the start-up finds CVODE at 0.52 of DP5's cost, then its chunks grow dearer (Newton
-failures on the steep dry friction law) and the run goes back at 4.8 ms, 4.9 s against 4.7 s with DP5
-throughout; with no way back CVODE ran to the end at 1.7 times DP5's
-wall time.
+run goes back to DP5, and probes again later on the same growing waits. The first chunk after the switch
+is not judged: it holds the integrator's cold start (order 1, small steps, a first Jacobian), which the
+probe already paid and judged. Single chunks are not judged either: a burst of contacts can double one
+chunk's cost. CVODE's cost per chunk varies more than DP5's, which the race damping holds at its stability
+limit: over 30 ms from the start at 3000 rpm, 500 N it ran at 0.2-0.4 of DP5's cost between bursts of
+contacts that cost it 1.2-3.3 times DP5's for a few chunks, and 0.66 times DP5 overall. A way back for
+good after such a burst left the run on DP5 for the rest of it. The way back still matters where the
+stiff backend stops paying: a dry scene at the spatial level (allowed to switch for the measurement, see
+:data:`SWITCH_WHEN_DRY`) makes CVODE's Newton iterations fail on the steep dry friction law.
 
 The stiff backend cannot take a step back; after a switch it is stopped ahead of predicted contact
 onsets instead (see :func:`cageless.simulation.solve.step_cvode`).
@@ -53,7 +54,7 @@ from cageless.simulation.solve import CvodeSession, Solution, solve, step_cvode
 
 __all__ = ["solve_chunks", "default_max_step", "CONTACT_MAX_STEP_S", "MAX_STEP_S", "RTOL_FACTOR", "STIFF_FRACTION",
            "RHS_COST_US", "STEP_COST_US", "SWITCH_GAIN", "STIFF_METHOD", "PROBE_CHUNKS",
-           "BACK_WINDOW", "SWITCH_WHEN_DRY"]
+           "BACK_WINDOW", "SWITCH_WHEN_DRY", "PROBE_BACKOFF", "PILOT_FRACTION"]
 
 #: The progress bar shows simulated seconds without tqdm's rate, which for a simulation slower than real
 #: time reads as an inverted "s/s" figure; {n:.4g} also hides float noise of the summed step lengths.
@@ -65,27 +66,39 @@ _BAR_FORMAT = "{desc}: {percentage:3.0f}%|{bar}| {n:.4g}/{total:.4g} s [{elapsed
 STIFF_FRACTION = 0.6
 #: The stiff backend the switch goes to.
 STIFF_METHOD = "CVODE"
-#: Cost of one right-hand-side evaluation by model id (us), measured inside the compiled DP5 loop on this
-#: 2-core machine (wall time over evaluations, 3000 rpm): planar 1.83, spatial with 5 strips 5.8-6.1.
+#: Cost of one right-hand-side evaluation by model id (us), the compiled DP5 loop's own work included (its
+#: step overhead is spread over its six evaluations a step). Measured as the process's CPU time over
+#: evaluations, chunk by chunk, over 30 ms from the start of six lubricated scenes (3000 rpm 500 N, 1800 rpm,
+#: 6000 rpm, 20 kN, 5 N at the planar level: 4.04-4.29; 500 N + 400 N axial with 5 strips: 8.9), in the same
+#: run as :data:`STEP_COST_US`, on the shared 2-core machine (loaded; only the ratio of the two matters).
 #: Models without an entry (the test models) count 1 us.
-RHS_COST_US: dict[int, float] = {PLANAR: 1.8, SPATIAL: 6.0}
-#: Overhead of one accepted step by (method, model id) in us, beyond the right-hand sides the solve counted:
-#: measured as (wall - evaluations x RHS cost) / steps, best of 3 over 5 ms windows at 3000 rpm from a
-#: settled state. CVODE with the structured Jacobian (:mod:`cageless.simulation.jacobian`, its evaluations counted
-#: with the right-hand sides): planar 15.6 (20 kN) and 17.2 (500 N), taken as 17; spatial 29.2 (500 N) and
-#: 30.5 (500 N + 400 N axial; a 138-state dense LU and back-substitutions), taken as 30. scipy's LSODA ~21
-#: (its Python step loop). The compiled DP5 0 (its loop overhead is inside its per-evaluation cost).
+RHS_COST_US: dict[int, float] = {PLANAR: 4.1, SPATIAL: 8.9}
+#: Overhead of one accepted step by (method, model id) in us, beyond its right-hand sides at the cost above.
+#: CVODE with the structured Jacobian (:mod:`cageless.simulation.jacobian`, its evaluations counted with the
+#: right-hand sides; the step's Python side, the onset control and the bookkeeping): 22 planar, 34 spatial,
+#: from the same chunks (CPU time per step 27-30 us planar, 51 us spatial, at 1.85-1.93 evaluations a step).
+#: With these the modelled CVODE/DP5 cost over the 30 ms matched the CPU-time ratio within 0.06 on all six
+#: scenes (modelled 0.03, 0.72, 0.27, 0.66, 0.51, 0.50; CPU 0.03, 0.73, 0.27, 0.66, 0.46, 0.44). scipy's LSODA
+#: ~21 (its Python step loop; measured against the earlier figures below). The compiled DP5 0.
 #: Pairs without an entry count 30.
 STEP_COST_US: dict[tuple[str, int], float] = {
+    ("CVODE", PLANAR): 22.0, ("CVODE", SPATIAL): 34.0, ("LSODA", PLANAR): 21.0, ("LSODA", SPATIAL): 21.0,
+    ("dp5", PLANAR): 0.0, ("dp5", SPATIAL): 0.0,
+}
+#: The figures the switch used before, from wall time over 5 ms settled windows on a quieter machine and
+#: before the rolling losses and drag made each evaluation dearer: they put DP5's evaluation at 1.8 us
+#: (planar) and CVODE's step at 17 us, which made CVODE look 1.6 times dearer relative to DP5 than the
+#: CPU time says. Kept for ``benchmarks/solver_speed.py``, which runs the switch as it was beside it.
+RHS_COST_US_BEFORE: dict[int, float] = {PLANAR: 1.8, SPATIAL: 6.0}
+STEP_COST_US_BEFORE: dict[tuple[str, int], float] = {
     ("CVODE", PLANAR): 17.0, ("CVODE", SPATIAL): 30.0, ("LSODA", PLANAR): 21.0, ("LSODA", SPATIAL): 21.0,
     ("dp5", PLANAR): 0.0, ("dp5", SPATIAL): 0.0,
 }
-#: Switch only when the stiff backend's modelled cost is below this share of DP5's, a clear gain: a switch
-#: gives up DP5's contact-onset and force-jump control, and the model is off by 10-25 % (the default planar
-#: scene on a settled 5 ms window: modelled 0.54, measured 0.61). Probes over 50 ms at 3000 rpm with the
-#: structured Jacobian: R = 0 0.13, 20 kN 0.24, the default 500 N scene 0.46 (it switches at 21 ms and
-#: the run takes 0.37-0.43 s against DP5's 0.48).
-SWITCH_GAIN = 0.6
+#: Switch only when the stiff backend's modelled cost is below this share of DP5's: a switch gives up DP5's
+#: contact-onset and force-jump control (CVODE is stopped ahead of onsets instead, and keeps the slip within
+#: 0.01 pp), and the model is off by up to 0.06 of the ratio. A probe is a cold start (order 1, a first
+#: Jacobian), so it overstates the backend's cost on the chunks that follow.
+SWITCH_GAIN = 0.8
 #: Default step cap (s) for contact resolution: ~t_H / 15 for a ball-ball impact (t_H = 29 us at 0.1 m/s).
 #: DP5 never reaches it in practice (the race damping holds its step at ~1.2 us) and checks onsets itself.
 CONTACT_MAX_STEP_S = 2e-6
@@ -111,8 +124,22 @@ RTOL_FACTOR: dict[str, float] = {"CVODE": 0.03}
 SWITCH_WHEN_DRY = False
 #: Stiff-backend chunks averaged by the way back to DP5 (see the module text).
 BACK_WINDOW = 2
-#: The chunks (0-based) after which a stiff DP5 chunk is probed.
-PROBE_CHUNKS = (5, 20)
+#: The chunks (0-based) after which a stiff DP5 chunk is probed; with :data:`PROBE_BACKOFF` only the first
+#: counts. The first chunk: a run that starts where DP5 is held by stability (20 kN: CVODE at 0.24 of its cost
+#: there, 0.02 later) otherwise pays DP5 until the first probe (with the first probe at chunk 5 of 50, most of
+#: its time).
+PROBE_CHUNKS: tuple[int, ...] = (0,)
+#: Share of the first chunk over which a pilot runs before it (None: no pilot). DP5 runs the pilot; if it is
+#: held by stability there, CVODE is probed on the same piece, and if that pays the run starts on CVODE. Both
+#: results are discarded: the first chunk then runs from the start. Under 20 kN, where DP5 is held at ~0.1 us
+#: from the start, its first chunk (1/50 of the run) was about half of the run's time with CVODE after it;
+#: where DP5 is not held by stability at the start (the balls spread: 500 N scenes, stiff fraction 0.1-0.24
+#: on the first chunk) the pilot costs a tenth of a DP5 chunk and nothing else.
+PILOT_FRACTION: float | None = 0.1
+#: After a probe that does not switch, or a way back to DP5, the next probe waits this many times as many
+#: chunks as the last wait (1, 2, 4, ... chunks: at most about log2 of the chunk count of probes). None:
+#: probe only at :data:`PROBE_CHUNKS`, and a way back is for good (the switch before).
+PROBE_BACKOFF: int | None = 2
 
 
 def _cost(sol: Solution, model_id: int) -> float:
@@ -127,6 +154,22 @@ def _probe(part: Problem, t: npt.NDArray[np.float64], sol: Solution, time_s: flo
     ratio = _cost(trial, part.model_id) / max(_cost(sol, part.model_id), 1.0)
     return {"time_s": time_s, "stiff_fraction": sol.n_stiff_steps / max(sol.n_steps, 1), "cost_ratio": ratio,
             "switch": bool(trial.success and ratio < SWITCH_GAIN), "to": STIFF_METHOD, "wall_s": trial.wall_s}
+
+
+def _pilot(pr: Problem, t_first: float, kw: dict[str, Any]) -> dict[str, Any] | None:
+    """A DP5 pilot over :data:`PILOT_FRACTION` of the first chunk (ending at ``t_first``) and, where DP5 is held by
+    stability there, the stiff backend's probe on it; None when no probe ran."""
+    if not PILOT_FRACTION or not _may_switch(pr):
+        return None
+    t_end = np.array([pr.t0 + PILOT_FRACTION * (t_first - pr.t0)])
+    sol = solve(pr, t_end, method="dp5", **_settings("dp5", kw))
+    if not sol.success or sol.n_stiff_steps < STIFF_FRACTION * max(sol.n_steps, 1):
+        return None
+    probe = _probe(pr, t_end, sol, float(pr.t0), kw)
+    probe["wall_s"] += sol.wall_s
+    probe["pilot_s"] = float(t_end[0] - pr.t0)
+    probe["dp5_rate"] = _cost(sol, pr.model_id) / probe["pilot_s"]
+    return probe
 
 
 def _may_switch(pr: Problem) -> bool:
@@ -168,6 +211,30 @@ def _go_back(stiff_rates: list[float], dp5_rate: float, time_s: float) -> dict[s
     return None
 
 
+class _Schedule:
+    """When the next probe may run (see :data:`PROBE_CHUNKS` and :data:`PROBE_BACKOFF`)."""
+
+    def __init__(self) -> None:
+        self.next, self.wait, self.listed = (PROBE_CHUNKS[0] if PROBE_CHUNKS else -1), 1, list(PROBE_CHUNKS[1:])
+
+    def due(self, i: int) -> bool:
+        """Whether a stiff DP5 chunk ``i`` is probed."""
+        return i == self.next
+
+    def not_stiff(self, i: int) -> None:
+        """Chunk ``i`` was due but not stiff: with a backoff the next stiff chunk is probed."""
+        if i == self.next:
+            self.next = i + 1 if PROBE_BACKOFF else (self.listed.pop(0) if self.listed else -1)
+
+    def wait_longer(self, i: int, for_good: bool = False) -> None:
+        """After a probe that did not switch (or, ``for_good``, a way back) at chunk ``i``."""
+        if PROBE_BACKOFF:
+            self.wait *= PROBE_BACKOFF
+            self.next = i + self.wait
+        else:
+            self.next = -1 if for_good else (self.listed.pop(0) if self.listed else -1)
+
+
 def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: str, max_step: float | None,
                  chunks: int, progress: bool, max_steps: int, force_jump: float) -> Solution:
     """Integrate ``pr`` over the samples ``t`` in about ``chunks`` pieces; ``method`` is a key of
@@ -182,10 +249,15 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
     y0, log, t0 = pr.y0.copy(), pr.log.copy(), float(t[0])
     auto, current = method == "auto", "dp5" if method == "auto" else method
     probes: list[dict[str, Any]] = []
-    dp5_rate, switched_back = np.inf, False
-    stiff_rates: list[float] = []  # cost per simulated second of each stiff chunk since the switch
+    dp5_rate, schedule, sol = np.inf, _Schedule(), None
     session: CvodeSession | None = None
-    sol = None
+    stiff_rates: list[float] = []  # cost per simulated second of each stiff chunk since the switch
+    pilot = _pilot(pr, float(t[edges[1]]), {"rtol": rtol, "max_step": max_step, "force_jump": force_jump,
+                                            "max_steps": max_steps}) if auto and len(edges) > 1 else None
+    if pilot is not None:
+        probes.append(pilot)
+        wall, rate = wall + pilot["wall_s"], pilot.pop("dp5_rate")
+        current, dp5_rate = (STIFF_METHOD, rate) if pilot["switch"] else (current, dp5_rate)
     with tqdm(total=float(t[-1] - t[0]), desc="simulated", disable=not progress, leave=False,
               bar_format=_BAR_FORMAT) as bar:
         for i, (a, b) in enumerate(zip(edges[:-1], edges[1:], strict=True)):
@@ -193,7 +265,7 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
             kw = {"rtol": rtol, "max_step": max_step, "force_jump": force_jump,
                   "max_steps": max(1, max_steps - totals["n_steps"] - totals["n_rejected"])}
             sol = _step_chunk(part, t[a + 1:b + 1], current, kw, session)
-            session = sol.extra.get("cvode", session) if current == "CVODE" else session
+            session = sol.extra.get("cvode", session) if current == "CVODE" else None
             ys.append(sol.y)
             for key in totals:
                 totals[key] += getattr(sol, key)
@@ -202,18 +274,23 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
             if not sol.success:
                 break
             rate = _cost(sol, pr.model_id) / float(t[b] - t[a])
-            if current == STIFF_METHOD and auto:
+            if auto and current == STIFF_METHOD:
                 stiff_rates.append(rate)
-            back = _go_back(stiff_rates, dp5_rate, float(t[b])) if current == STIFF_METHOD else None
-            if back is not None:
-                probes.append(back)
-                current, switched_back = "dp5", True
-            elif (auto and current == "dp5" and not switched_back and i in PROBE_CHUNKS
-                    and sol.n_stiff_steps >= STIFF_FRACTION * max(sol.n_steps, 1) and _may_switch(pr)):
-                probes.append(_probe(part, t[a + 1:b + 1], sol, float(t[b]), kw))
-                wall += probes[-1]["wall_s"]
-                if probes[-1]["switch"]:
-                    current, dp5_rate = STIFF_METHOD, rate
+                back = _go_back(stiff_rates, dp5_rate, float(t[b]))
+                if back is not None:
+                    probes.append(back)
+                    current, stiff_rates = "dp5", []
+                    schedule.wait_longer(i, for_good=True)
+            elif auto and current == "dp5" and schedule.due(i):
+                if sol.n_stiff_steps >= STIFF_FRACTION * max(sol.n_steps, 1) and _may_switch(pr):
+                    probes.append(_probe(part, t[a + 1:b + 1], sol, float(t[b]), kw))
+                    wall += probes[-1]["wall_s"]
+                    if probes[-1]["switch"]:
+                        current, dp5_rate = STIFF_METHOD, rate
+                    else:
+                        schedule.wait_longer(i)
+                else:
+                    schedule.not_stiff(i)
             y0, log, t0 = sol.y[-1].copy(), sol.extra.get("log", log), float(t[b])
     return _joined(t, ys, sol, method, probes, wall, log, totals)
 
