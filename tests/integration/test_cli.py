@@ -177,3 +177,11 @@ def test_a_closed_pipe_ends_quietly(tmp_path):
             "sys.exit(main(['info', '--speed-rpm', '1800', '--json']))")
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert run.returncode == 141 and run.stderr == "", run.stderr
+
+
+def test_info_on_a_trace_says_what_to_do_with_it(tmp_path, capsys):
+    trace = tmp_path / "run_1800.trace.h5"
+    trace.write_bytes(b"\x89HDF\r\n\x1a\n")
+    assert main(["info", str(trace)]) == 1
+    err = capsys.readouterr().err
+    assert "is a trace, not a video" in err and "cageless compare" in err and "read_trace" in err

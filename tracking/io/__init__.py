@@ -57,6 +57,10 @@ def open_video(path: str | Path, fps: float | None = None, allow_truncated: bool
     if not path.exists():
         raise VideoError(path, "no such file or folder.")
     reader = VIDEO_SUFFIXES.get(path.suffix.lower())
+    if reader is None and path.name.endswith(".trace.h5"):
+        raise VideoError(path, "is a trace, not a video.",
+                         hint="Compare it with `cageless compare VIDEO_TRACE SIM_TRACE`, or read it in Python with "
+                         "cageless.trace.read_trace.")
     if reader is None:
         raise VideoError(path, f"is not a video cageless reads (suffix '{path.suffix}').",
                          hint="Use .cine, .avi, .mp4, .mkv, or a folder of numbered .tif/.png images.")
