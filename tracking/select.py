@@ -42,6 +42,7 @@ import logging
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -437,6 +438,36 @@ def _context(z: int, ball_diameter_m: float, pitch_diameter_m: float, omega_i: f
                     pixel_threshold=pixel_threshold)
 
 
+def _collect_tracklets(frames: Callable[[int], np.ndarray], spans: list[tuple[int, int]], background: np.ndarray,
+                       mask: np.ndarray, ctx: _Context, times: np.ndarray) -> tuple[list[Tracklet], np.ndarray, Any]:
+    """Every burst's tracklets, the burst index of each, and the noise level the bursts measured."""
+    tracks: list[Tracklet] = []
+    burst: list[int] = []
+    noise = None
+    for b, span in enumerate(spans):
+        tr, noise = _burst_tracklets(frames, span, background, mask, ctx, times, noise)
+        tracks += tr
+        burst += [b] * len(tr)
+    return tracks, np.asarray(burst, dtype=int), noise
+
+
+def _ball_circle(tracks: list[Tracklet], feats: list[dict[str, Any]], movers: np.ndarray, burst_arr: np.ndarray,
+                 ctx: _Context, tol: float) -> tuple[float, float, float] | None:
+    """The highlights' circle (u, v, r) from the moving candidates (weighted RANSAC, then refitted on the
+    tracklets within 2 ``tol`` of it), or ``None`` when fewer than three move or no circle holds them."""
+    if movers.size < 3:
+        return None
+    pts = np.array([[feats[k]["u"], feats[k]["v"]] for k in movers])
+    wts = np.array([math.log1p(feats[k]["response"]) for k in movers])
+    circle = _ransac_circle(pts, burst_arr[movers], wts, ctx, tol)
+    if circle is None:
+        return None
+    inl = np.array([k for k in movers if np.mean(np.abs(np.hypot(tracks[k].arrays()[1] - circle[0],
+                                                                    tracks[k].arrays()[2] - circle[1]) - circle[2]))
+                    <= 2 * tol], dtype=int)
+    return _refit(tracks, inl, circle, 2 * tol) if inl.size else circle
+
+
 def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, background: np.ndarray,
                  mask: np.ndarray, *, z: int, ball_diameter_m: float, pitch_diameter_m: float, omega_i: float,
                  centre0: tuple[float, float], r_prior: float, path: object = "video", n_bursts: int = 6,
@@ -468,23 +499,12 @@ def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, backgro
     ctx = _context(z, ball_diameter_m, pitch_diameter_m, omega_i, centre0, r_prior, k_sigma,
                    prior_known=prior_known, pixel_threshold=pixel_threshold)
     spans = _burst_plan(len(times), times, ctx.omega_c, n_bursts)
-    tracks: list[Tracklet] = []
-    burst: list[int] = []
-    noise = None
-    for b, span in enumerate(spans):
-        tr, noise = _burst_tracklets(frames, span, background, mask, ctx, times, noise)
-        tracks += tr
-        burst += [b] * len(tr)
-    burst_arr = np.asarray(burst, dtype=int)
+    tracks, burst_arr, noise = _collect_tracklets(frames, spans, background, mask, ctx, times)
     feats = [_features(t, times, centre0) for t in tracks]
     reasons, direction = _classify(feats, tracks, spans, burst_arr, ctx, None)
     movers = np.array([k for k, r in enumerate(reasons) if not r], dtype=int)
     tol = max(1.5, RADIAL_TOL * ctx.ball_px)
-    circle = None
-    if movers.size >= 3:
-        pts = np.array([[feats[k]["u"], feats[k]["v"]] for k in movers])
-        wts = np.array([math.log1p(feats[k]["response"]) for k in movers])
-        circle = _ransac_circle(pts, burst_arr[movers], wts, ctx, tol)
+    circle = _ball_circle(tracks, feats, movers, burst_arr, ctx, tol)
     ring_args = dict(ball_px=ctx.ball_px, sigma_px=ctx.sigma_px, radial_tol_px=tol, response_sigma=float(noise or 1),
                      k_sigma=k_sigma, z=z, gap=ctx.gap, omega_c=ctx.omega_c, omega_i=omega_i,
                      pixel_threshold=pixel_threshold)
@@ -494,10 +514,6 @@ def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, backgro
                              "found (0 balls found).", "Check the lighting, the speed_rpm and the bearing "
                              "description; the QC image shows every candidate and why it was rejected.",
                              table=table, found=0)
-    inl = np.array([k for k in movers if np.mean(np.abs(np.hypot(tracks[k].arrays()[1] - circle[0],
-                                                                    tracks[k].arrays()[2] - circle[1]) - circle[2]))
-                    <= 2 * tol], dtype=int)
-    circle = _refit(tracks, inl, circle, 2 * tol) if inl.size else circle
     feats = [_features(t, times, (circle[0], circle[1])) for t in tracks]
     anchors, counts = _choose_bursts(tracks, feats, reasons, burst_arr, spans, times, circle, tol, ctx)
     table = _table(feats, reasons, burst_arr, ctx, direction)
