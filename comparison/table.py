@@ -36,14 +36,31 @@ def table_frame(rows: Sequence[ComparisonRow]) -> pd.DataFrame:
         drop=True)
 
 
+def _labelled(frame: pd.DataFrame) -> bool:
+    """Whether the rows carry labels (the report's video names): then the tables show them in a first column, so
+    two videos at one condition are told apart."""
+    return bool(frame["label"].fillna("").astype(str).str.len().gt(0).any())
+
+
+def _headers(frame: pd.DataFrame) -> list[str]:
+    return (["Video"] if _labelled(frame) else []) + list(HEADERS.values())
+
+
+def _number(value: float, fmt: str) -> str:
+    """A table cell: blank for a value that is not known (NaN), e.g. a failed video's unread speed."""
+    return format(value, fmt) if isinstance(value, int | float) and math.isfinite(value) else ""
+
+
 def _cells(frame: pd.DataFrame) -> list[list[str]]:
     out = []
+    labelled = _labelled(frame)
     for _, r in frame.iterrows():
-        cells = [f"{r[c]:g}" for c in ("speed_rpm", "radial_load_n", "axial_load_n")]
+        cells = [str(r["label"] or "")] if labelled else []
+        cells += [_number(r[c], "g") for c in ("speed_rpm", "radial_load_n", "axial_load_n")]
         if r["status"] == "failed":
             cells += ["failed"] + [""] * 4
         else:
-            cells += ["" if not math.isfinite(r[c]) else f"{r[c]:.2f}" for c in list(HEADERS)[3:]]
+            cells += [_number(r[c], ".2f") for c in list(HEADERS)[3:]]
         out.append(cells)
     return out
 
@@ -52,8 +69,9 @@ def _notes(frame: pd.DataFrame) -> list[str]:
     notes = [SLIP_RATE_DEFINITION, slip_reference_note(frame)]
     for _, r in frame.iterrows():
         if r["status"] != "ok":
-            notes.append(f"{r['label'] or 'condition'} ({r['speed_rpm']:g} r/min, {r['radial_load_n']:g} N): "
-                         f"{r['status']}: {r['message']}")
+            where = (f" ({_number(r['speed_rpm'], 'g')} r/min, {_number(r['radial_load_n'], 'g')} N)"
+                     if math.isfinite(r["speed_rpm"]) else "")
+            notes.append(f"{r['label'] or 'condition'}{where}: {r['status']}: {r['message']}")
     return notes
 
 
@@ -73,7 +91,8 @@ def to_csv(frame: pd.DataFrame) -> str:
 
 def to_markdown(frame: pd.DataFrame) -> str:
     """A Markdown table with the definition and any failures as notes."""
-    lines = ["| " + " | ".join(HEADERS.values()) + " |", "|" + "---|" * len(HEADERS)]
+    headers = _headers(frame)
+    lines = ["| " + " | ".join(headers) + " |", "|" + "---|" * len(headers)]
     lines += ["| " + " | ".join(c) + " |" for c in _cells(frame)]
     return "\n".join(lines + [""] + [f"Note: {n}" for n in _notes(frame)]) + "\n"
 
@@ -86,16 +105,18 @@ def _tex(text: str) -> str:
 
 def to_latex(frame: pd.DataFrame) -> str:
     """A LaTeX ``tabular`` (booktabs) with the notes below."""
-    head = " & ".join(_tex(h) for h in HEADERS.values())
+    headers = _headers(frame)
+    head = " & ".join(_tex(h) for h in headers)
     body = "\n".join(" & ".join(_tex(c) for c in cells) + r" \\" for cells in _cells(frame))
     notes = "\n".join(r"\par\footnotesize " + _tex(n) for n in _notes(frame))
-    return (r"\begin{tabular}{" + "r" * len(HEADERS) + "}\n\\toprule\n" + head + r" \\" + "\n\\midrule\n" + body
+    columns = ("l" if len(headers) > len(HEADERS) else "") + "r" * len(HEADERS)
+    return (r"\begin{tabular}{" + columns + "}\n\\toprule\n" + head + r" \\" + "\n\\midrule\n" + body
             + "\n\\bottomrule\n\\end{tabular}\n" + notes + "\n")
 
 
 def to_html(frame: pd.DataFrame) -> str:
     """An HTML table (a fragment for the report, escaped)."""
-    head = "".join(f"<th>{html.escape(h)}</th>" for h in HEADERS.values())
+    head = "".join(f"<th>{html.escape(h)}</th>" for h in _headers(frame))
     rows = []
     for (_, r), cells in zip(frame.iterrows(), _cells(frame), strict=True):
         cls = "" if r["status"] == "ok" else f' class="{html.escape(r["status"])}"'

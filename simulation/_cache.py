@@ -27,7 +27,7 @@ from typing import Any
 
 from numba.core import caching
 
-__all__ = ["PackageSourcesLocator", "clear_cache", "install", "source_digest"]
+__all__ = ["PackageSourcesLocator", "clear_cache", "compile_notice", "install", "is_compiled", "source_digest"]
 
 _ROOT = Path(__file__).resolve().parent
 #: numba's cache implementation (renamed from ``_CacheImpl`` in numba 0.61).
@@ -118,3 +118,28 @@ def clear_cache() -> int:
                     stale.unlink(missing_ok=True)
                     removed += 1
     return removed
+
+
+def is_compiled(dispatcher: Any) -> bool | None:
+    """Whether ``dispatcher`` (a numba ``njit`` function with ``cache=True``) is compiled in this process or has an
+    up-to-date entry in its on-disk cache; ``None`` when numba's cache cannot be read.
+
+    numba's index file of a function records the source stamp it was written under; an index written under
+    another stamp (other sources, another version) loads as empty, and the function will compile on its first
+    call.
+    """
+    try:
+        return bool(dispatcher.signatures) or bool(dispatcher._cache._cache_file._load_index())
+    except Exception:  # noqa: BLE001 - a private numba interface: when it moves, say nothing rather than fail
+        return None
+
+
+def compile_notice() -> str | None:
+    """A line for the user when the next simulation compiles the integrator first (after an install or an
+    upgrade, about one to five minutes on two cores), else ``None``."""
+    from cageless.simulation.integrators.dp5 import dp5_integrate
+
+    if is_compiled(dp5_integrate) is False:
+        return ("compiling the simulator (first run after an install or upgrade only; 1-5 min, then it is "
+                "cached)")
+    return None

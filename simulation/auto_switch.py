@@ -41,6 +41,7 @@ onsets instead (see :func:`cageless.simulation.solve.step_cvode`).
 
 from __future__ import annotations
 
+import sys
 from dataclasses import replace
 from typing import Any
 
@@ -48,6 +49,7 @@ import numpy as np
 import numpy.typing as npt
 from tqdm.auto import tqdm
 
+from cageless.simulation._cache import compile_notice
 from cageless.simulation.kernels import PLANAR, SPATIAL
 from cageless.simulation.problem import Problem
 from cageless.simulation.solve import CvodeSession, Solution, solve, step_cvode
@@ -252,6 +254,9 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
     dp5_rate, schedule, sol = np.inf, _Schedule(), None
     session: CvodeSession | None = None
     stiff_rates: list[float] = []  # cost per simulated second of each stiff chunk since the switch
+    notice = compile_notice() if progress else None
+    if notice:
+        tqdm.write(notice, file=sys.stderr)
     pilot = _pilot(pr, float(t[edges[1]]), {"rtol": rtol, "max_step": max_step, "force_jump": force_jump,
                                             "max_steps": max_steps}) if auto and len(edges) > 1 else None
     if pilot is not None:

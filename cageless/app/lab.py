@@ -28,6 +28,7 @@ import json
 import logging
 import math
 import os
+import sys
 import time
 from collections.abc import Callable, Iterable
 from concurrent.futures import Future
@@ -428,5 +429,11 @@ def _simulate_all(pool: Any, entries: list[LabEntry], traces: dict[Path, Any], b
                                      str(out / "simulations" / _sim_name(k)))))
         keys.append(key)
         pending.append(k)
+    if jobs and progress:
+        from cageless.simulation._cache import compile_notice
+
+        notice = compile_notice()
+        if notice:
+            tqdm.write(notice, file=sys.stderr)
     _collect(sims, pending, keys, _run_jobs(pool, jobs, "simulation", progress), cache)
     return sims, len(conditions) - len(jobs)

@@ -99,6 +99,14 @@ def test_compare_row_and_table_formats(tmp_path):
     assert "| 3000 | 500 | 0 | 4.00 | 6.00 |" in md and "run_1800" in md and "peak of the mean slip" in md
     assert r"\toprule" in to_latex(frame) and "<table" in to_html(frame) and "failed" in to_html(frame)
     assert "theoretical_slip_pct" in to_csv(frame).splitlines()[0]
+    assert md.splitlines()[0].startswith("| Video | Speed (r/min) |") and "| n3000 | 3000 | 500 |" in md
+    unread = ComparisonRow(float("nan"), float("nan"), float("nan"), *[float("nan")] * 5, label="broken.cine",
+                           status="failed", message="no such file")
+    md = to_markdown(table_frame([c.row, unread]))
+    assert "| broken.cine |  |  |  | failed |" in md and "nan" not in md  # an unknown condition is blank
+    assert "Note: broken.cine: failed: no such file" in md
+    unlabelled = to_markdown(table_frame([compare(measured, simulated, settle_s=0.05).row]))
+    assert unlabelled.startswith("| Speed (r/min) |")  # a single comparison without a label has no video column
     paths = write_tables([c.row, failed], tmp_path / "slip_table")
     assert sorted(paths) == ["csv", "html", "md", "tex"] and all(p.exists() for p in paths.values())
 

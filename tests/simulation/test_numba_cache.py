@@ -48,3 +48,36 @@ def test_clear_cache_removes_the_package_caches_only(tmp_path, monkeypatch):
         f.write_text("")
     assert _cache.clear_cache() >= 2
     assert not any(f.exists() for f in ours) and other.exists()
+
+
+def test_is_compiled_reads_the_on_disk_cache(tmp_path, monkeypatch):
+    """A cached function whose index is missing will compile (False); once called and saved it is compiled (True),
+    and a fresh dispatcher over the same source finds it on disk; an object without numba's cache gives None."""
+    import importlib.util
+    import sys
+
+    monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path / "cache"))
+    src = tmp_path / "somekernel.py"
+    src.write_text("import numba\n\n@numba.njit(cache=True)\ndef f(x):\n    return x + 1.0\n")
+
+    def load():
+        spec = importlib.util.spec_from_file_location("somekernel", src)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules.pop("somekernel", None)
+        spec.loader.exec_module(module)
+        return module.f
+
+    f = load()
+    assert _cache.is_compiled(f) is False
+    assert f(1.0) == 2.0
+    assert _cache.is_compiled(f) is True
+    assert _cache.is_compiled(load()) is True  # a new process would load it from the index on disk
+    assert _cache.is_compiled(object()) is None
+
+
+def test_the_compile_notice_is_silent_when_the_integrator_is_cached():
+    from cageless.simulation.integrators.dp5 import dp5_integrate
+
+    expected = None if _cache.is_compiled(dp5_integrate) else "first run"
+    notice = _cache.compile_notice()
+    assert (notice is None) if expected is None else ("first run" in notice)

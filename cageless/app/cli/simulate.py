@@ -40,7 +40,9 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--speed-rpm", type=finite_float, required=True, help="inner-ring speed (rpm)")
     p.add_argument("--radial-load-n", type=finite_float, default=0.0, help="radial load (N, default 0)")
     p.add_argument("--axial-load-n", type=finite_float, default=0.0, help="axial load (N, default 0)")
-    p.add_argument("--duration", type=finite_float, default=0.05, help="simulated time (s, default 0.05)")
+    p.add_argument("--duration", type=finite_float, default=None,
+                   help="simulated time (s; default: the start-up that compare and report leave out, three cage "
+                   "revolutions, then one more revolution: 0.2 s at 3000 rpm)")
     p.add_argument("--gravity", type=finite_float, default=9.81, help="gravity (m/s^2, default 9.81; 0 for none)")
     p.add_argument("--orientation", choices=("horizontal", "vertical"), default="horizontal", help="shaft orientation")
     p.add_argument("--misalignment-rad", type=finite_float, default=0.0,
@@ -89,6 +91,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     from cageless.simulation.scene import Scene
 
     bearing = bearing_from_config(config)
+    _default_duration(args, bearing)
     _validate(args, bearing)
     if args.dry:
         bearing = dataclasses.replace(bearing, lubricant=None)
@@ -111,6 +114,23 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
 _CHECKED = ("speed_rpm", "radial_load_n", "axial_load_n", "duration", "gravity", "misalignment_rad", "moment_load_nm",
             "oil_air_density", "clearance_um", "seed", "rtol", "max_step", "restitution", "speed_ramp", "ensemble",
             "sample_rate")
+
+
+def _default_duration(args: argparse.Namespace, bearing: Any) -> None:
+    """Without ``--duration``: the start-up that ``compare`` leaves out plus one cage revolution, so that a
+    default run can be compared (a shorter run holds no settled slip)."""
+    import math
+
+    from cageless.kinematics import startup_duration
+
+    args.duration_default = args.duration is None
+    if args.duration is not None or not (math.isfinite(args.speed_rpm) and args.speed_rpm > 0):
+        return
+    geometry = bearing.geometry
+    startup = startup_duration(args.speed_rpm, geometry.ball_diameter_m, geometry.pitch_diameter_m)
+    revolution = startup_duration(args.speed_rpm, geometry.ball_diameter_m, geometry.pitch_diameter_m,
+                                  revolutions=1.0, minimum_s=0.0)
+    args.duration = float(f"{startup + revolution:.3g}")
 
 
 def _validate(args: argparse.Namespace, bearing: Any) -> None:
@@ -173,6 +193,9 @@ def _run(args: argparse.Namespace, scene: Any, choice: Any, config: dict[str, An
     if args.scheduler and args.ensemble == 1:
         raise UsageError("--scheduler runs an ensemble on a Dask cluster: give --ensemble N as well")
     print(f"parameters: {note}" if note else line)
+    if getattr(args, "duration_default", False):
+        print(f"duration: {args.duration:g} s (the start-up that compare leaves out, then one cage revolution; "
+              "--duration changes it)")
     if args.ensemble == 1:
         trace = sim.run(out=out, progress=not args.quiet, config=config)
         print(f"effects: {', '.join(choice.active)}")
