@@ -80,13 +80,17 @@ def test_config_file(tmp_path, capsys):
         ("[info]\nspeed_rmp = 1\n", "Did you mean 'speed_rpm'"),
         ("[bearing.geometry]\nn_balls = 16\n", "at most 15 fit"),
         ("[info\n", "not valid TOML"),
+        # a bad entry names the file and the entry, not the command-line option nobody typed
+        ('[info]\nspeed_rpm = "fast"\n', "bad.toml: [info] speed_rpm = 'fast': must be a number"),
+        ('[info]\njson = "yes"\n', "[info] json = 'yes': must be true or false."),
     ],
 )
 def test_bad_config_is_a_usage_error(tmp_path, capsys, text, match):
     cfg = tmp_path / "bad.toml"
     cfg.write_text(text)
     assert main(["info", "--config", str(cfg)]) == 2
-    assert match in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert match in err and "argument --" not in err
 
 
 def test_missing_config_file(capsys, tmp_path):

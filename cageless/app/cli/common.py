@@ -77,17 +77,41 @@ def apply_config_defaults(
     config = load_config(args.config)
     table = config.get(command, {})
     sub = parser._subparsers._group_actions[0].choices[command]  # type: ignore[union-attr]
-    dests = {a.dest for a in sub._actions if a.dest not in ("help", "config")}
+    actions = {a.dest: a for a in sub._actions if a.dest not in ("help", "config")}
     defaults = {}
     for key, value in table.items():
         dest = key.replace("-", "_")
-        if dest not in dests:
+        if dest not in actions:
             raise UsageError(
-                f"--config {args.config}: [{command}] has unknown option '{key}'." + suggest(dest, dests)
+                f"--config {args.config}: [{command}] has unknown option '{key}'." + suggest(dest, actions)
             )
-        defaults[dest] = value
+        defaults[dest] = _config_value(actions[dest], value, f"--config {args.config}: [{command}] {key}")
     sub.set_defaults(**defaults)
     return parser.parse_args(argv), config
+
+
+def _config_value(action: argparse.Action, value: Any, where: str) -> Any:
+    """A ``--config`` entry checked and converted as its command-line option would be, its error naming the file
+    and the entry (argparse would blame the command-line option the user never typed)."""
+    if isinstance(action, argparse._StoreConstAction | argparse._StoreTrueAction | argparse._StoreFalseAction):
+        if not isinstance(value, bool):
+            raise UsageError(f"{where} = {value!r}: must be true or false.")
+        return value
+    if isinstance(action, argparse._AppendAction):
+        if not isinstance(value, list):
+            raise UsageError(f"{where} = {value!r}: must be a list, e.g. [\"a\", \"b\"].")
+        return [_config_value(argparse.Action([], action.dest, type=action.type, choices=action.choices), v, where)
+                for v in value]
+    if value is None or isinstance(value, bool | dict | list):
+        raise UsageError(f"{where} = {value!r}: must be a single value.")
+    if action.type is not None:
+        try:
+            value = action.type(value if isinstance(value, str) else str(value))
+        except (argparse.ArgumentTypeError, TypeError, ValueError) as exc:
+            raise UsageError(f"{where} = {value!r}: {str(exc).rstrip('.') or 'invalid value'}.") from None
+    if action.choices is not None and value not in action.choices:
+        raise UsageError(f"{where} = {value!r}: must be one of {', '.join(map(str, action.choices))}.")
+    return value
 
 
 def setup_logging(quiet: bool, verbose: int) -> None:
