@@ -48,6 +48,7 @@ __all__ = [
     "OperatingConditions",
     "ResolvedConditions",
     "LabEntry",
+    "is_qc_folder",
     "read_sidecar",
     "read_conditions_csv",
     "parse_file_name",
@@ -426,9 +427,19 @@ def bearing_with_keys(bearing: Bearing, resolved: ResolvedConditions) -> Bearing
 
 
 def _is_image_sequence(folder: Path) -> bool:
+    if is_qc_folder(folder):
+        return False
     return any(
         p.suffix.lower() in IMAGE_SUFFIXES and re.search(r"\d", p.stem) for p in folder.iterdir()
     )
+
+
+def is_qc_folder(folder: Path) -> bool:
+    """Whether ``folder`` is the QC folder of a cageless output (its PNGs are QC images, not a video's frames):
+    a folder holding a tracker's ``*.candidates.csv`` beside ``*.frameNNNNNN.png`` images."""
+    names = [p.name for p in folder.iterdir()] if folder.is_dir() else []
+    return any(n.endswith(".candidates.csv") for n in names) and any(
+        re.search(r"\.frame\d+\.png$", n) for n in names)
 
 
 def find_videos(folder: str | Path) -> list[Path]:

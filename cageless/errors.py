@@ -131,7 +131,8 @@ class VideoError(_PathError):
     ) -> None:
         self.offset = offset
         if offset is not None:
-            message = f"{message} (at byte offset {offset})"
+            end = "." if message.endswith(".") else ""
+            message = f"{message.removesuffix('.')} (at byte offset {offset}){end}"
         super().__init__(path, message, hint)
 
 

@@ -189,3 +189,32 @@ def test_info_on_a_trace_says_what_to_do_with_it(tmp_path, capsys):
     assert main(["info", str(trace)]) == 1
     err = capsys.readouterr().err
     assert "is a trace, not a video" in err and "cageless compare" in err and "read_trace" in err
+
+
+def test_tracking_an_output_folder_says_so(tmp_path, capsys):
+    """`cageless track out` (an output folder by mistake): its QC PNGs are not read as an image sequence."""
+    out = tmp_path / "out"
+    (out / "qc").mkdir(parents=True)
+    (out / "clip.trace.h5").write_bytes(b"")
+    (out / "qc" / "clip.candidates.csv").write_text("frame,x,y\n")
+    (out / "qc" / "clip.frame000086.png").write_bytes(b"")
+    assert main(["track", str(out), "-o", str(tmp_path / "o1"), "-q"]) == 1
+    err = capsys.readouterr().err
+    assert err == f"FAILED {out}: no videos found in this folder. It holds cageless traces: point at the folder of " \
+                  "videos instead.\n"
+    assert main(["track", str(out / "qc"), "-o", str(tmp_path / "o2"), "-q"]) == 1
+    assert "is the QC folder of a cageless output" in capsys.readouterr().err
+
+
+def test_failed_lines_name_videos_relative_to_their_folder(tmp_path, capsys):
+    """Every line of a folder run names the video as the report does (relative to the folder); a video given
+    on its own is named as typed."""
+    lab = tmp_path / "lab"
+    lab.mkdir()
+    (lab / "n3000_Fr500.cine").write_bytes(b"NOPE" * 20)  # fails while tracking
+    (lab / "mystery.cine").write_bytes(b"NOPE" * 20)  # fails before: no conditions
+    assert main(["track", str(lab), "-o", str(tmp_path / "o"), "-q"]) == 1
+    err = capsys.readouterr().err.splitlines()
+    assert sorted(line.split(":")[0] for line in err) == ["FAILED mystery.cine", "FAILED n3000_Fr500.cine"]
+    assert main(["track", str(lab / "n3000_Fr500.cine"), "-o", str(tmp_path / "o"), "-q"]) == 1
+    assert capsys.readouterr().err.startswith(f"FAILED {lab / 'n3000_Fr500.cine'}: wrong magic bytes")

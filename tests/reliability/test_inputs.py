@@ -313,3 +313,14 @@ def test_a_cine_renamed_avi_gives_one_clean_line(tmp_path, capsys):
                           "--workers", "1", "-q"], capture_output=True, text=True, timeout=300)
     assert run.returncode == 1 and "n6000_Fr500.avi" in run.stdout + run.stderr
     assert "[ WARN" not in run.stderr and "Traceback" not in run.stderr
+
+
+def test_an_empty_mp4_gives_one_line_not_ffmpegs_too(tmp_path):
+    """FFmpeg's own "moov atom not found" went to the terminal before cageless's error about the same file."""
+    from faultlib import cli_subprocess
+
+    empty = tmp_path / "empty.mp4"
+    empty.write_bytes(b"")
+    run = cli_subprocess("info", empty)
+    assert_clean(run, 1, "OpenCV cannot open this video")
+    assert run.err.count("\n") == 1 and "moov atom" not in run.err, run.err

@@ -211,8 +211,7 @@ class CineReader(FrameSource):
                 raise VideoError(self.path, f"is truncated: frame {complete} of {n} starts at or runs past the end of "
                                  f"the file ({self._size} bytes).", offset=bad,
                                  hint="Re-copy the file, or re-run with --allow-truncated to use the complete frames.")
-            logging.getLogger(__name__).warning("%s: truncated; using its %d complete frames of %d (%d dropped).",
-                                                self.path, complete, n, n - complete)
+            _warn_once(f"{self.path}: truncated; using its {complete} complete frames of {n} ({n - complete} dropped).")
         self._data_start = data_start[:complete]
         self._n = complete
 
@@ -374,3 +373,13 @@ def _time64_to_iso(t: int) -> str:
         return datetime.fromtimestamp(secs + frac, UTC).isoformat()
     except (OverflowError, OSError, ValueError):
         return ""
+
+
+_WARNED: set[str] = set()
+
+
+def _warn_once(message: str) -> None:
+    """Log ``message`` once per process: a tracked video is opened more than once (hashing, segments)."""
+    if message not in _WARNED:
+        _WARNED.add(message)
+        logging.getLogger(__name__).warning("%s", message)

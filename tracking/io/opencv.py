@@ -16,10 +16,10 @@ through OpenCV; use ``.cine`` or 16-bit TIFF/PNG sequences.
 
 from __future__ import annotations
 
+import logging
+import os
 from collections.abc import Iterable
 from pathlib import Path
-
-import logging
 
 import cv2
 import numpy as np
@@ -28,6 +28,10 @@ import numpy.typing as npt
 from cageless.atomic import atomic_path
 from cageless.errors import ParameterError, VideoError
 from cageless.tracking.io.base import FrameSource, VideoMetadata
+
+# FFmpeg's own log lines ("moov atom not found") would reach the terminal before cageless's one-line error about
+# the same file; OpenCV reads this when it first opens a video. Set OPENCV_FFMPEG_LOGLEVEL yourself to see them.
+os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
 
 __all__ = ["OpenCVReader", "write_ffv1"]
 

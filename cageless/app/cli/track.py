@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -20,6 +21,7 @@ from cageless.conditions import (
     OperatingConditions,
     bearing_with_keys,
     discover_lab,
+    is_qc_folder,
     resolve_conditions,
 )
 from cageless.config import bearing_from_config
@@ -76,10 +78,15 @@ def collect_inputs(inputs: list[str], speed_rpm: float | None) -> list[LabEntry]
         p = Path(raw)
         if not p.exists():
             entries.append(LabEntry(video=p, error=CagelessError(f"{p}: no such file or folder.")))
+        elif p.is_dir() and is_qc_folder(p):
+            entries.append(LabEntry(video=p, error=CagelessError(
+                f"{p}: is the QC folder of a cageless output (its images are QC figures, not a video's frames).")))
         elif p.is_dir() and not any(f.suffix.lower() in IMAGE_SUFFIXES for f in p.iterdir()):
             found = discover_lab(p)
             if not found:
-                entries.append(LabEntry(video=p, error=CagelessError(f"{p}: no videos found in this folder.")))
+                traces = " It holds cageless traces: point at the folder of videos instead." if any(
+                    p.glob("*.trace.h5")) else ""
+                entries.append(LabEntry(video=p, error=CagelessError(f"{p}: no videos found in this folder.{traces}")))
             entries.extend(_with_speed(e, speed_rpm) for e in found)
         else:
             try:
@@ -151,12 +158,12 @@ def _validate(args: argparse.Namespace) -> None:
 
 
 def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bearing, options: Any, out: Path) -> int:
-    failed = 0
+    failed, _shown = 0, _namer(args.inputs)
     for e in entries:
         if not e.ok:
             hint = (" For a single video, `--speed-rpm` gives its speed on the command line."
                     if isinstance(e.error, MissingConditionsError) else "")
-            print(failed_line(e.video, e.error) + hint, file=sys.stderr)
+            print(failed_line(e.video, e.error, shown=_shown(e.video)) + hint, file=sys.stderr)
             failed += 1
     jobs = []
     for e in entries:
@@ -164,7 +171,7 @@ def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bear
             try:  # a sidecar may describe another bearing (n_balls, ball_diameter_mm, pitch_diameter_mm)
                 jobs.append((e.video, e.resolved.conditions, bearing_with_keys(bearing, e.resolved), options, out))
             except CagelessError as exc:
-                print(failed_line(e.video, exc), file=sys.stderr)
+                print(failed_line(e.video, exc, shown=_shown(e.video)), file=sys.stderr)
                 failed += 1
     workers = max(1, min(args.workers, len(jobs)))
     with tqdm(total=len(jobs), desc="videos", unit="video", disable=args.quiet or not jobs) as bar:
@@ -172,13 +179,29 @@ def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bear
         for (video, *_), (status, info) in zip(jobs, results, strict=True):
             if status == "ok":
                 warn = f"; QC: {'; '.join(info['warnings'])}" if info["warnings"] else ""
-                tqdm.write(f"ok     {video.name}: {info['frames']} frames, {info['balls']} balls, "
+                tqdm.write(f"ok     {_shown(video)}: {info['frames']} frames, {info['balls']} balls, "
                            f"{100 * info['detected']:.1f}% detected, peak unloaded slip "
                            f"{100 * info['peak_slip']:.2f}% -> {info['path']}{warn}")
             else:
-                tqdm.write(failed_line(video, info, shown=video.name), file=sys.stderr)
+                tqdm.write(failed_line(video, info, shown=_shown(video)), file=sys.stderr)
                 failed += 1
     return 1 if failed else 0
+
+
+def _namer(inputs: list[str]) -> Callable[[Path], str]:
+    """How a video is named on its ``ok``/``FAILED`` line, the same way on every line of a run: relative to the
+    input folder it was found in (as the report names it), else as given on the command line."""
+    folders = [Path(i).resolve() for i in inputs if Path(i).is_dir()]
+    given = {Path(i).resolve(): i for i in inputs if not Path(i).is_dir()}
+
+    def shown(video: Path) -> str:
+        full = Path(video).resolve()
+        for folder in folders:
+            if full != folder and full.is_relative_to(folder):
+                return full.relative_to(folder).as_posix()
+        return given.get(full, next((i for i in inputs if Path(i).resolve() == full), str(video)))
+
+    return shown
 
 
 def _prefetch_first_hash(entries: list[LabEntry], workers: int) -> None:
