@@ -164,9 +164,10 @@ def _readme(preset: str, seed: int, revs: float, results: list[dict[str, Any]]) 
     lines += [
         "",
         "Ground truth beside each clip: `<clip>.truth.csv` (one row per frame and ball: frame, time_s, ball,",
-        "angle_rad, radius_m, centre and highlight pixel positions, highlight_visible) and `<clip>.truth.json`",
-        "(camera, appearance, motion law, dropped frames). Pixel centres are at integer (u, v); angles are",
-        "unwrapped orbital angles in the bearing frame (counter-clockwise as the camera sees it).",
+        "angle_rad, radius_m, centre and highlight pixel positions, highlight_visible, highlight_peak) and",
+        "`<clip>.truth.json` (camera, appearance, motion law, dropped frames). Pixel centres are at integer",
+        "(u, v); angles are unwrapped orbital angles in the bearing frame (x along the shaft toward the camera,",
+        "z up, angle counter-clockwise as the camera sees it).",
         "",
     ]
     return "\n".join(lines)
