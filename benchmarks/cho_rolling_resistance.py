@@ -98,7 +98,8 @@ def winkler_kv_rolling(load_n: float, a_m: float, b_m: float, delta_h_m: float, 
             "b_eff": math.sqrt(2.0 * r_x * delta), "power": m * v_m_s / r_x}
 
 
-def contact_rows(speed_rpm: float = 1800.0, radial_load_n: float = 500.0) -> list[dict[str, float | str]]:
+def contact_rows(speed_rpm: float = 1800.0, radial_load_n: float = 500.0,
+                 cho_values: tuple[float, ...] = CHO_N_S_M) -> list[dict[str, float | str]]:
     """The damped-rolling term at the unloaded outer contact and the most loaded ones, for each C_ho.
 
     Loads: the unloaded outer contact carries the centrifugal force m (d_m / 2) w_c^2; the most loaded ones
@@ -137,7 +138,7 @@ def contact_rows(speed_rpm: float = 1800.0, radial_load_n: float = 500.0) -> lis
         f_r = chiu_rolling_forces(lub.dynamic_viscosity_pa_s, u, 0.0, h, r_x, r_y, par.meniscus_distance_m, d)[0]
         p_chiu = 2.0 * abs(f_r) * u
         k_lin = 1.5 * hc.stiffness ** (2.0 / 3.0) * q ** (1.0 / 3.0)
-        for cho in CHO_N_S_M:
+        for cho in cho_values:
             r = winkler_kv_rolling(q, a, bb, hc.deflection(q), cho, u)
             p_h = r["power"]
             rows.append({"contact": label, "load_n": q, "u_m_s": u, "b_um": bb * 1e6, "cho": cho,
@@ -209,6 +210,15 @@ def main(argv: list[str] | None = None) -> int:
     for cho in CHO_N_S_M[1:]:
         t = bearing_torque(cho, args.speed_rpm, args.radial_load_n)
         out.append(f"| {cho:g} | {t:.3g} | {t / bound:.1f} |")
+    scan = tuple(float(c) for c in np.geomspace(10.0, 10000.0, 13))
+    unl = [r for r in contact_rows(args.speed_rpm, args.radial_load_n, scan) if r["contact"] == "unloaded outer"]
+    best = max(unl, key=lambda r: r["p_h_mw"])
+    sys.stdout.write(f"\nAny C_ho (10-10000 N s/m, 13 values): the unloaded outer contact's damped-rolling loss is "
+                     f"largest at C_ho = {best['cho']:.3g} N s/m (De = {best['de']:.2f}): {best['p_h_mw']:.3g} mW, "
+                     f"{best['p_h_mw'] / best['p_chiu_mw']:.1%} of the Chiu loss\n")
+    for c in (25.0, 50.0, 100.0):
+        t = bearing_torque(c, args.speed_rpm, args.radial_load_n)
+        sys.stdout.write(f"C_ho = {c:g} N s/m: drive torque {t:.3g} N m\n")
     sys.stdout.write(f"\nBearing friction torque: catalogue bound 0.5 mu F_r d_m = {bound:.3g} N m "
                      f"(mu = {SKF_MU_DEEP_GROOVE}, SKF)\n\n" + "\n".join(out) + "\n")
     return 0

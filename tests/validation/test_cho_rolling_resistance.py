@@ -84,3 +84,12 @@ def test_in_the_loaded_zone_the_term_exceeds_the_catalogue_friction_tenfold(mod)
     bound = 0.5 * mod.SKF_MU_DEEP_GROOVE * 500.0 * default_bearing().geometry.pitch_diameter_m
     assert bound == pytest.approx(0.0173, abs=1e-4)
     assert mod.bearing_torque(2500.0) > 10.0 * bound
+
+
+def test_no_damping_makes_the_unloaded_term_more_than_a_tenth_of_the_chiu_loss(mod):
+    # x_bar / b = phi(De) peaks near De ~ 1.7 (C_ho ~ 180 N s/m here): measured 3.38 mW, 10.6 % of 31.8 mW. So no
+    # C_ho range can move the unloaded-zone losses, which set the slip beyond gravity's 5.6 %, by more than ~11 %.
+    scan = tuple(float(c) for c in __import__("numpy").geomspace(10.0, 10000.0, 13))
+    rows = [r for r in mod.contact_rows(cho_values=scan) if r["contact"] == "unloaded outer"]
+    ratio = max(r["p_h_mw"] / r["p_chiu_mw"] for r in rows)
+    assert 0.08 < ratio < 0.11, ratio
