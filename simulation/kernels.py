@@ -9,13 +9,13 @@ from __future__ import annotations
 
 import numba
 
-from cageless.simulation.models import planar, spatial, textbook, two_balls
+from cageless.simulation.models import implicit_damping, planar, spatial, textbook, two_balls
 
-__all__ = ["PLANAR", "SPATIAL", "TWO_BALLS", "OSCILLATOR", "RICCATI", "model_rhs", "model_post", "model_signature",
-           "model_ring_share", "model_gaps"]
+__all__ = ["PLANAR", "SPATIAL", "TWO_BALLS", "OSCILLATOR", "RICCATI", "DAMPED", "model_rhs", "model_post",
+           "model_signature", "model_ring_share", "model_gaps", "model_implicit"]
 
 PLANAR, TWO_BALLS, SPATIAL = planar.MODEL_ID, two_balls.MODEL_ID, spatial.MODEL_ID
-OSCILLATOR, RICCATI = textbook.OSCILLATOR, textbook.RICCATI
+OSCILLATOR, RICCATI, DAMPED = textbook.OSCILLATOR, textbook.RICCATI, textbook.DAMPED
 
 
 @numba.njit(cache=True)
@@ -29,6 +29,8 @@ def model_rhs(model_id, t, y, p, log, dydt):  # pragma: no cover - compiled
         two_balls.two_ball_rhs(t, y, p, log, dydt)
     elif model_id == OSCILLATOR:
         textbook.oscillator_rhs(t, y, p, log, dydt)
+    elif model_id == DAMPED:
+        textbook.damped_rhs(t, y, p, log, dydt)
     else:
         textbook.riccati_rhs(t, y, p, log, dydt)
 
@@ -70,3 +72,20 @@ def model_ring_share(model_id, t, y, p, log, j, out):  # pragma: no cover - comp
         planar.planar_ring_share(t, y, p, log, j, out)
     elif model_id == SPATIAL:
         spatial.spatial_ring_share(t, y, p, log, j, out)
+
+
+@numba.njit(cache=True)
+def model_implicit(model_id, t, y, p, hg, k_i, work):  # pragma: no cover - compiled
+    """The implicit part f_I of the model's IMEX split into ``k_i`` (see
+    :mod:`cageless.simulation.models.implicit_damping`); with ``hg > 0`` the stage equation
+    y = y_Z + hg f_I(y) is solved first, in place on ``y`` (the predictor y_Z on entry). ``work`` (12) is scratch.
+    A model without a split has f_I = 0 (every term explicit)."""
+    if model_id == PLANAR:
+        implicit_damping.planar_implicit(y, p, hg, k_i, work)
+    elif model_id == SPATIAL:
+        implicit_damping.spatial_implicit(y, p, hg, k_i, work)
+    elif model_id == DAMPED:
+        textbook.damped_implicit(y, p, hg, k_i)
+    else:
+        for i in range(k_i.shape[0]):
+            k_i[i] = 0.0

@@ -5,6 +5,9 @@
 * ``"rosw"``: the Rosenbrock-W method ROS34PW2 with its whole loop compiled, linearly implicit in each ball's
   states and the ring's (:mod:`cageless.simulation.integrators.rosw`), with DP5's controls; its step is set by
   accuracy, not by the race damping's stability limit;
+* ``"ark4"``: the additive Runge-Kutta IMEX method ARK4(3)6L[2]SA with its whole loop compiled, the race
+  damping implicit per ball in closed form, everything else explicit
+  (:mod:`cageless.simulation.integrators.ark`), with DP5's controls;
 * ``"dp5"``: Dormand-Prince 5(4) with its whole loop compiled (the default); it rejects and retries
   any step longer than ``Problem.onset_step`` in which a contact opens or closes, or across which a
   force jumps by more than the fraction ``force_jump`` (see :func:`solve`), and counts both;
@@ -43,6 +46,7 @@ import numpy.typing as npt
 from scipy.integrate import BDF, DOP853, LSODA, RK45, Radau
 
 from cageless.errors import ParameterError, suggest
+from cageless.simulation.integrators.ark import ark_integrate
 from cageless.simulation.integrators.dp5 import STATUS_OK, dp5_integrate
 from cageless.simulation.integrators.rosw import JAC_EVERY, LU_RATIO, rosw_integrate
 from cageless.simulation.jacobian import JacobianStructure
@@ -504,6 +508,7 @@ class Method(Protocol):
 METHODS: dict[str, Method] = {
     "dp5": _compiled("dp5", dp5_integrate),
     "rosw": _rosw,
+    "ark4": _compiled("ark4", ark_integrate),
     "CVODE": lambda pr, t, rtol, max_step, first_step, max_steps, force_jump: step_cvode(pr, t, rtol, max_step,
                                                                                        first_step, max_steps),
     **{m: _scipy(m) for m in ("RK45", "DOP853", "LSODA", "BDF", "Radau")},

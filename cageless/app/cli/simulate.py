@@ -63,10 +63,12 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--explain", action="store_true", help="print the level and effects with reasons; do not solve")
     p.add_argument("--json", action="store_true", help="with --explain: print JSON")
     p.add_argument("--solver", default="auto", help="integrator: auto (default: compiled dp5, switching to CVODE "
-                   "(BDF) when stiffness makes that cheaper), dp5, CVODE, RK45, DOP853, LSODA, BDF, Radau")
+                   "(BDF) when stiffness makes that cheaper), dp5, ark4 (compiled IMEX, the race damping implicit), rosw, "
+                   "CVODE, RK45, DOP853, LSODA, BDF, Radau")
     p.add_argument("--rtol", type=finite_float, default=1e-6, help="relative tolerance (default 1e-6)")
     p.add_argument("--max-step", type=finite_float, default=None,
-                   help="largest step (s; default 2e-6, and 5e-6 for CVODE, also after an automatic switch)")
+                   help="largest step (s; default 2e-6, and 5e-6 for CVODE, also after an automatic switch, "
+                   "1e-5 for rosw, 2e-5 for ark4)")
     p.add_argument("--restitution", type=finite_float,
                    help="ball-ball coefficient of restitution R, 0 <= R <= 1, 0 perfectly plastic (same as --set "
                    "restitution=R)")

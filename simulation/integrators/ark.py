@@ -1,0 +1,160 @@
+"""An additive Runge-Kutta IMEX method, ARK4(3)6L[2]SA, with its whole loop compiled (numba).
+
+Why: the explicit DP5's step is held at about 1.1 us by the race lubricant damping (2 C_ho / m = 2.8e6 1/s),
+a stability limit. Treated implicitly, per ball and in closed form
+(:mod:`cageless.simulation.models.implicit_damping`), that damping no longer limits the step; what is left
+explicit (Hertz contacts, traction, the ring, the ball-ball contacts) has its fastest modes near
+|lambda| = 2e5 1/s, oscillatory (3000 rpm, 500 N, planar, settled; benchmarks/ark_speed.py prints them).
+
+The method is Kennedy & Carpenter, "Additive Runge-Kutta schemes for convection-diffusion-reaction
+equations", Appl. Numer. Math. 44 (2003) 139-181, ARK4(3)6L[2]SA: six stages, order 4 with an embedded
+order 3, an explicit table (ERK) for f_E and an L-stable, stiffly accurate ESDIRK (diagonal 1/4) for f_I,
+sharing the stage times and weights. The coefficients are the paper's, as SUNDIALS ARKODE ships them
+(``ARKODE_ARK436L2SA_ERK_6_3_4`` and ``ARKODE_ARK436L2SA_DIRK_6_3_4``). Because the weights are shared, a
+step is y + h sum_i b_i f(Y_i) with the full right-hand side of each stage, and its error estimate is
+h sum_i (b_i - b_hat_i) f(Y_i).
+
+A stage is Y_i = Z_i + h/4 f_I(Y_i) with the explicit predictor
+Z_i = y + h sum_{j<i} (aE_ij f_E(Y_j) + aI_ij f_I(Y_j)); the model solves it (``model_implicit``), and
+f_E(Y_i) = f(Y_i) - f_I(Y_i). So a step costs five right-hand sides and five per-ball solves, plus the
+right-hand side at its end (the next step's first stage, the dense output and the force-jump test).
+
+Everything around the step is DP5's (:mod:`cageless.simulation.integrators.dp5`, reused, not changed):
+the contact-onset and force-jump retries, cubic Hermite samples between step ends, the model's bookkeeping
+after every accepted step (the contact log), the step-size bounds and the statistics layout. The step
+controller is Hairer's PI controller (Solving ODEs I, sect. II.4) with the exponents of an order-3 error
+estimate: 1/4 - 0.75 beta and beta = 0.04.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from cageless.simulation.integrators.dp5 import (STATUS_NONFINITE, STATUS_OK, _accept, _before_step, _controls,
+                                                 _retry_step, _samples_before, _write_stats)
+from cageless.simulation.kernels import model_implicit, model_rhs, model_signature
+
+__all__ = ["ark_integrate", "AE", "AI", "B", "B_HAT", "C", "GAMMA"]
+
+# Kennedy & Carpenter (2003), ARK4(3)6L[2]SA, tables as in SUNDIALS ARKODE (see the module docstring).
+GAMMA = 0.25
+C = np.array([0.0, 0.5, 83 / 250, 31 / 50, 17 / 20, 1.0])
+AE = np.zeros((6, 6))
+AE[1, 0] = 0.5
+AE[2, :2] = [13861 / 62500, 6889 / 62500]
+AE[3, :3] = [-116923316275 / 2393684061468, -2731218467317 / 15368042101831, 9408046702089 / 11113171139209]
+AE[4, :4] = [-451086348788 / 2902428689909, -2682348792572 / 7519795681897, 12662868775082 / 11960479115383,
+             3355817975965 / 11060851509271]
+AE[5, :5] = [647845179188 / 3216320057751, 73281519250 / 8382639484533, 552539513391 / 3454668386233,
+             3354512671639 / 8306763924573, 4040 / 17871]
+AI = np.zeros((6, 6))
+AI[1, :2] = [0.25, 0.25]
+AI[2, :3] = [8611 / 62500, -1743 / 31250, 0.25]
+AI[3, :4] = [5012029 / 34652500, -654441 / 2922500, 174375 / 388108, 0.25]
+AI[4, :5] = [15267082809 / 155376265600, -71443401 / 120774400, 730878875 / 902184768, 2285395 / 8070912, 0.25]
+B = np.array([82889 / 524892, 0.0, 15625 / 83664, 69875 / 102672, -2260 / 8211, 0.25])
+AI[5, :] = B
+B_HAT = np.array([4586570599 / 29645900160, 0.0, 178811875 / 945068544, 814220225 / 1159782912,
+                  -3700637 / 11593932, 61727 / 225920])
+_E = B - B_HAT
+
+# the statistics counters (dp5's layout)
+_STEPS, _REJ, _RHS = 0, 1, 2
+
+
+@numba.njit(cache=True)
+def ark_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_steps, out, stats, h_onset,
+                  jump_floor, force_jump):
+    """Integrate from ``t0`` and write ``y`` at each ``t_out[k]`` into ``out[k]``: the signature, controls,
+    statistics and status codes of :func:`cageless.simulation.integrators.dp5.dp5_integrate` (no stiffness
+    counter: ``stats[7]`` stays 0)."""  # noqa: D401
+    n = y0.shape[0]
+    y = y0.copy()
+    f = np.empty((6, n))  # f(Y_i), the full right-hand side of each stage
+    ki = np.empty((6, n))  # f_I(Y_i)
+    yt = np.empty(n)
+    ynew = np.empty(n)
+    f_end = np.empty(n)
+    work = np.empty(12)
+    cnt = np.zeros(8, dtype=np.int64)
+    t = t0
+    model_rhs(model_id, t, y, p, log, f[0])
+    model_implicit(model_id, t, y, p, 0.0, ki[0], work)
+    cnt[_RHS] = 1
+    sig = model_signature(model_id, y, p) if h_onset > 0.0 else 0.0
+    h = h0
+    err_old = 1e-4
+    k = _samples_before(t_out, t, y, out)
+    status = STATUS_OK
+    t_end = t_out[t_out.shape[0] - 1]
+    tiny = 1e-13 * max(abs(t_end), t_end - t0)
+    while k < t_out.shape[0]:
+        stop, h = _before_step(cnt, max_steps, t, t_end, h, h_max, tiny)
+        if stop >= 0:
+            if stop == STATUS_OK:
+                out[k:, :] = y
+            status = stop
+            break
+        _ark_stages(model_id, t, h, y, p, log, f, ki, yt, ynew, work)
+        model_rhs(model_id, t + h, ynew, p, log, f_end)
+        cnt[_RHS] += 6
+        err = _ark_error(h, y, ynew, f, atol, rtol)
+        if not np.isfinite(err) or err > 1.0:
+            cnt[_REJ] += 1
+            h = h * 0.25 if not np.isfinite(err) else h / min(5.0, err ** 0.25 / 0.9)
+            if h < tiny and not np.isfinite(err):
+                status = STATUS_NONFINITE
+                break
+            continue
+        verdict, sig = _controls(model_id, ynew, p, sig, h, h_onset, f[0], f_end, jump_floor, force_jump)
+        if verdict == 1 or verdict == 2:
+            h = _retry_step(verdict, h, h_onset, cnt)
+            continue
+        cnt[5] += verdict == 3  # contact changes (dp5's counter)
+        fac = max(0.1, min(5.0, err ** 0.22 / err_old ** 0.04 / 0.9))
+        err_old = max(err, 1e-4)
+        k = _accept(model_id, t, h, y, ynew, f[0], f_end, p, log, t_out, out, k)  # y, f[0] <- ynew, f_end
+        model_implicit(model_id, t + h, y, p, 0.0, ki[0], work)
+        t = t + h
+        cnt[_STEPS] += 1
+        h = h / fac
+    _write_stats(stats, cnt, h)
+    return status
+
+
+@numba.njit(cache=True, inline="always")
+def _ark_stages(model_id, t, h, y, p, log, f, ki, yt, ynew, work):  # pragma: no cover - compiled
+    """Stages 2 .. 6 of one step of length h from (t, y), with f[0] = f(y) and ki[0] = f_I(y): f(Y_i) into f[i],
+    f_I(Y_i) into ki[i], the new state y + h sum b_i f(Y_i) into ``ynew``."""
+    n = y.shape[0]
+    for i in range(1, 6):
+        for q in range(n):
+            acc = 0.0
+            for j in range(i):
+                acc += AE[i, j] * (f[j, q] - ki[j, q]) + AI[i, j] * ki[j, q]
+            yt[q] = y[q] + h * acc
+        model_implicit(model_id, t + C[i] * h, yt, p, h * GAMMA, ki[i], work)
+        model_rhs(model_id, t + C[i] * h, yt, p, log, f[i])
+    for q in range(n):
+        acc = 0.0
+        for j in range(6):
+            acc += B[j] * f[j, q]
+        ynew[q] = y[q] + h * acc
+
+
+@numba.njit(cache=True, inline="always")
+def _ark_error(h, y, ynew, f, atol, rtol):  # pragma: no cover - compiled
+    """The RMS of err_i / (atol_i + rtol max(|y_i|, |ynew_i|)) of the embedded order-3 estimate
+    h sum_j (b_j - b_hat_j) f(Y_j); inf when the new state is not finite."""
+    n = y.shape[0]
+    err = 0.0
+    for q in range(n):
+        if not np.isfinite(ynew[q]):
+            return np.inf
+        e = 0.0
+        for j in range(6):
+            e += _E[j] * f[j, q]
+        sc = atol[q] + rtol * max(abs(y[q]), abs(ynew[q]))
+        err += (h * e / sc) ** 2
+    return np.sqrt(err / n)

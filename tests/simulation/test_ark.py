@@ -1,0 +1,151 @@
+"""The compiled IMEX method ARK4(3)6L[2]SA (``solve(method="ark4")``).
+
+Checked against what it was not built from: the published order conditions of additive Runge-Kutta
+methods (Kennedy & Carpenter, Appl. Numer. Math. 44 (2003) 139-181, sect. 2, and Hairer, Norsett & Wanner,
+Solving ODEs I, sect. II.2, the Butcher trees to order 4), the closed-form solution of a damped oscillator,
+and the tight DP5 reference (rtol 1e-10, 0.25 us cap) on a settled bearing scene.
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+
+from cageless.simulation.integrators.ark import AE, AI, B, B_HAT, C, GAMMA
+from cageless.simulation.models.textbook import damped_exact, damped_problem
+from cageless.simulation.solve import METHODS, solve
+
+
+def test_tables_satisfy_the_published_conditions():
+    """Row sums, the stiffly accurate ESDIRK, and every order condition of the additive pair: order 4 for b
+    (including the coupling conditions between the two tables), order 3 for b_hat."""
+    one = np.ones(6)
+    assert np.allclose(AE @ one, C, atol=1e-15) and np.allclose(AI @ one, C, atol=1e-15)
+    assert np.allclose(np.diag(AI)[1:], GAMMA) and AI[0, 0] == 0.0 and np.allclose(AI[5], B)
+    assert np.allclose(np.triu(AE), 0.0)
+    for w, order in ((B, 4), (B_HAT, 3)):
+        assert abs(w @ one - 1) < 1e-14
+        for q in range(1, order):  # bushy trees: sum b c^q = 1 / (q + 1)
+            assert abs(w @ C**q - 1 / (q + 1)) < 1e-13
+        for a in (AE, AI):  # b A c = 1/6 (the order-3 tree), each table
+            assert abs(w @ a @ C - 1 / 6) < 1e-13
+        if order == 4:
+            for a in (AE, AI):
+                assert abs(w @ (C * (a @ C)) - 1 / 8) < 1e-13
+                assert abs(w @ a @ C**2 - 1 / 12) < 1e-13
+            for a1, a2 in itertools.product((AE, AI), repeat=2):  # the coupling conditions: b A1 A2 c = 1/24
+                assert abs(w @ a1 @ a2 @ C - 1 / 24) < 1e-13
+    assert abs(B @ AE @ AE @ C - 1 / 24) < 1e-13 and abs(B_HAT @ AE @ AI @ C - 1 / 24) > 1e-6  # embedded: order 3
+
+
+def test_implicit_table_is_l_stable_at_infinity():
+    """R(z) = 1 + z b^T (I - z A)^-1 1 of the ESDIRK tends to 0 as z -> -inf (stiffly accurate, L-stable)."""
+    zz = -1e8
+    r = 1 + zz * B @ np.linalg.solve(np.eye(6) - zz * AI, np.ones(6))
+    assert abs(r) < 1e-6
+
+
+def _fixed_step_error(k, c, n_steps, t_end=2.0):
+    pr = damped_problem(k, c)
+    h = t_end / n_steps
+    sol = solve(pr, np.array([t_end]), method="ark4", rtol=0.5, max_step=h, first_step=h)
+    assert sol.n_steps == n_steps and sol.n_rejected == 0
+    return abs(sol.y[-1, 0] - damped_exact(k, c, np.array([t_end]))[0, 0])
+
+
+def test_observed_order_four_on_a_damped_oscillator():
+    """x'' = -x - 0.5 x' (damping implicit, spring explicit), fixed steps halved: the error falls by 2^4."""
+    errors = [_fixed_step_error(1.0, 0.5, n) for n in (20, 40, 80, 160)]
+    orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+    assert np.all((orders > 3.8) & (orders < 4.2)), orders
+
+
+def test_embedded_order_three_on_the_linear_split():
+    """The embedded weights alone, stepped on the same linear split in exact linear algebra (the ARK's stage
+    equations for y' = (E + I) y): error falls by 2^3 per halving."""
+    k, c, t_end = 1.0, 0.5, 2.0
+    e_mat, i_mat = np.array([[0.0, 1.0], [-k, 0.0]]), np.array([[0.0, 0.0], [0.0, -c]])
+
+    def run(weights, n):
+        h, y = t_end / n, np.array([1.0, 0.0])
+        for _ in range(n):
+            fe, fi = [], []
+            for i in range(6):
+                z = y + h * sum(AE[i, j] * fe[j] + AI[i, j] * fi[j] for j in range(i))
+                yi = np.linalg.solve(np.eye(2) - h * AI[i, i] * i_mat, z)
+                fe.append(e_mat @ yi)
+                fi.append(i_mat @ yi)
+            y = y + h * sum(weights[j] * (fe[j] + fi[j]) for j in range(6))
+        return abs(y[0] - damped_exact(k, c, np.array([t_end]))[0, 0])
+
+    for weights, expect in ((B, 4), (B_HAT, 3)):
+        errors = [run(weights, n) for n in (20, 40, 80)]
+        orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+        assert np.all(np.abs(orders - expect) < 0.25), (expect, orders)
+
+
+def test_stiff_damping_does_not_limit_the_step():
+    """c = 1e6 1/s: the slow mode x ~ exp(-k t / c) is followed to 1e-12 in a few hundred steps, where DP5's
+    stability region (3.3 on the real axis) needs at least c T / 3.3 = 6e5."""
+    k, c, t_end = 1.0, 1e6, 2.0
+    pr = damped_problem(k, c)
+    t = np.linspace(0.0, t_end, 11)[1:]
+    sol = solve(pr, t, method="ark4", rtol=1e-8)
+    assert sol.success
+    assert np.max(np.abs(sol.y[:, 0] - damped_exact(k, c, t)[:, 0])) < 1e-12
+    assert sol.n_steps < 1000 < c * t_end / 3.3 / 100
+
+
+def test_registered():
+    assert "ark4" in METHODS
+
+
+@pytest.fixture(scope="module")
+def settled():
+    from cageless.simulation.bench import _settled_problem
+
+    return _settled_problem(3000.0, 500.0, 0.01)
+
+
+def test_bearing_against_the_tight_reference(settled):
+    """3000 rpm, 500 N, every effect of a lubricated scene, past the start-up: over 1 ms the slip stays within
+    0.01 pp of DP5 at rtol 1e-10 and 0.25 us, the energy balance closes, with steps several times DP5's."""
+    from cageless.simulation.models.planar import planar_energy
+
+    pr, cage = settled
+    z = pr.n_balls
+    t = np.linspace(0.0, 1e-3, 21)[1:]
+    ref = solve(pr, t, method="dp5", rtol=1e-10, max_step=0.25e-6)
+    sol = solve(pr, t, method="ark4", rtol=1e-6)
+    assert sol.success and np.all(np.isfinite(sol.y))
+    slip_pp = 100 * np.max(np.abs(sol.y[:, 3 * z:4 * z] - ref.y[:, 3 * z:4 * z])) / cage
+    assert slip_pp < 0.01
+    e_ref = planar_energy(pr, ref.y) + ref.y[:, -1] - ref.y[:, -2]
+    e_ark = planar_energy(pr, sol.y) + sol.y[:, -1] - sol.y[:, -2]
+    work = np.max(np.abs(ref.y[:, -2]))
+    assert np.max(np.abs(e_ark - e_ref)) < 1e-4 * work  # the same balance as the reference's, to 1e-4 of the input
+    dp5 = solve(pr, t, method="dp5", rtol=1e-6)
+    assert sol.n_steps < dp5.n_steps / 3
+
+
+def test_deterministic(settled):
+    pr, _ = settled
+    t = np.array([2e-4, 4e-4])
+    a, b = (solve(pr, t, method="ark4") for _ in range(2))
+    assert np.array_equal(a.y, b.y) and a.n_steps == b.n_steps
+
+
+def test_spatial_bearing_against_the_tight_reference():
+    """500 N + 400 N axial, 5 strips (the spatial model, 3 x 3 solves per ball), past 5 ms of start-up: over
+    0.5 ms the slip stays within 0.01 pp of DP5 at rtol 1e-10 and 0.25 us, all finite."""
+    from cageless.simulation.bench import _settled_problem
+
+    pr, cage = _settled_problem(3000.0, 500.0, 0.005, axial_n=400.0, level="spatial", strips=5)
+    z = pr.n_balls
+    t = np.linspace(0.0, 5e-4, 11)[1:]
+    ref = solve(pr, t, method="dp5", rtol=1e-10, max_step=0.25e-6)
+    sol = solve(pr, t, method="ark4", rtol=1e-6)
+    assert sol.success and np.all(np.isfinite(sol.y))
+    assert 100 * np.max(np.abs(sol.y[:, 3 * z:4 * z] - ref.y[:, 3 * z:4 * z])) / cage < 0.01
