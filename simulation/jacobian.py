@@ -106,14 +106,31 @@ def grouped_fd(model_id, t, y, p, log, f0, ball_cols, groups, ring_rows, ring_co
                 h = y_work[col] - y[col]  # the increment as stored, so the quotient is exact in it
                 _ball_columns(ball_cols, f0, f1, j, f, h, dense, jac, jb)
                 if n_ring > 0:
-                    model_ring_share(model_id, t, y_work, p, log, j, share1)
-                    for q in range(n_ring):
-                        d = (share1[q] - share0[j, q]) / h
-                        if dense:
-                            jac[ring_rows[q], col] = d
-                        else:
-                            js[j, q, f] = d
+                    _ring_share_rows(model_id, t, y_work, p, log, j, f, col, h, ring_rows, share0, share1,
+                                     dense, jac, js)
                 y_work[col] = y[col]
+    _ring_columns(model_id, t, y, p, log, f0, ring_cols, floor, y_work, f1, dense, jac, g)
+    return n_fields * groups.shape[0] + ring_cols.shape[0]
+
+
+@numba.njit(cache=True, inline="always")
+def _ring_share_rows(model_id, t, y_work, p, log, j, f, col, h, ring_rows, share0, share1, dense, jac,
+                     js):  # pragma: no cover - compiled
+    """Field f of ball j's column in the ring rows, from the change of ball j's own share (see :func:`grouped_fd`)."""
+    model_ring_share(model_id, t, y_work, p, log, j, share1)
+    for q in range(ring_rows.shape[0]):
+        d = (share1[q] - share0[j, q]) / h
+        if dense:
+            jac[ring_rows[q], col] = d
+        else:
+            js[j, q, f] = d
+
+
+@numba.njit(cache=True, inline="always")
+def _ring_columns(model_id, t, y, p, log, f0, ring_cols, floor, y_work, f1, dense, jac,
+                  g):  # pragma: no cover - compiled
+    """The ring's columns, one right-hand side each, in every row (see :func:`grouped_fd`)."""
+    n = y.shape[0]
     for c in range(ring_cols.shape[0]):
         col = ring_cols[c, 0]
         y_work[col] = y[col] + _SRUR * max(abs(y[col]), floor[col])
@@ -126,7 +143,6 @@ def grouped_fd(model_id, t, y, p, log, f0, ball_cols, groups, ring_rows, ring_co
             else:
                 g[c, i] = d
         y_work[col] = y[col]
-    return n_fields * groups.shape[0] + ring_cols.shape[0]
 
 
 @numba.njit(cache=True, inline="always")

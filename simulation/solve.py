@@ -170,6 +170,33 @@ def _rosw(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float, first_s
     return sol
 
 
+def _scipy_steps(solver: Any, pr: Problem, t_eval: FloatArray, log: FloatArray,
+                 max_steps: int) -> tuple[FloatArray, int, int, str]:
+    """:func:`step_scipy`'s loop: step ``solver`` to the last sampling time, running the model's accepted-step
+    bookkeeping after each step and sampling its dense output; returns the samples, steps, status and message."""
+    y = np.full((len(t_eval), len(pr.y0)), np.nan)
+    k, steps, status, message = 0, 0, STATUS_OK, "reached the end"
+    while k < len(t_eval) and t_eval[k] <= pr.t0:
+        y[k] = pr.y0
+        k += 1
+    while k < len(t_eval):
+        if steps >= max_steps:
+            status, message = 1, _MESSAGES[1]
+            break
+        msg = solver.step()
+        if solver.status == "failed":
+            status, message = 3, str(msg)
+            break
+        steps += 1
+        model_post(pr.model_id, solver.t, solver.y, pr.params, log)  # accepted-step bookkeeping
+        if k < len(t_eval) and (t_eval[k] <= solver.t or solver.status == "finished"):
+            dense = solver.dense_output()
+            while k < len(t_eval) and (t_eval[k] <= solver.t or solver.status == "finished"):
+                y[k] = dense(t_eval[k])
+                k += 1
+    return y, steps, status, message
+
+
 def step_scipy(pr: Problem, t_eval: FloatArray, method: str, rtol: float, max_step: float = np.inf,
                first_step: float | None = None, max_steps: int = 50_000_000,
                fun: Callable[[float, FloatArray, FloatArray], FloatArray] | None = None) -> Solution:
@@ -206,26 +233,7 @@ def step_scipy(pr: Problem, t_eval: FloatArray, method: str, rtol: float, max_st
     start = time.perf_counter()
     solver = _SCIPY[method](counted, pr.t0, pr.y0.astype(np.float64), float(t_eval[-1]), rtol=rtol, atol=pr.atol,
                             **kw)
-    y = np.full((len(t_eval), len(pr.y0)), np.nan)
-    k, steps, status, message = 0, 0, STATUS_OK, "reached the end"
-    while k < len(t_eval) and t_eval[k] <= pr.t0:
-        y[k] = pr.y0
-        k += 1
-    while k < len(t_eval):
-        if steps >= max_steps:
-            status, message = 1, _MESSAGES[1]
-            break
-        msg = solver.step()
-        if solver.status == "failed":
-            status, message = 3, str(msg)
-            break
-        steps += 1
-        model_post(pr.model_id, solver.t, solver.y, pr.params, log)  # accepted-step bookkeeping
-        if k < len(t_eval) and (t_eval[k] <= solver.t or solver.status == "finished"):
-            dense = solver.dense_output()
-            while k < len(t_eval) and (t_eval[k] <= solver.t or solver.status == "finished"):
-                y[k] = dense(t_eval[k])
-                k += 1
+    y, steps, status, message = _scipy_steps(solver, pr, t_eval, log, max_steps)
     return Solution(t=t_eval, y=y, status=status, message=message, method=method, n_steps=steps, n_rhs=count[0],
                     wall_s=time.perf_counter() - start, extra={"log": log})
 

@@ -432,6 +432,37 @@ def _step(model_id, t, h, p, log, atol, rtol, vec, u, st, wk, fresh_w, cnt, lu_a
     return _error_norm(vec[0], vec[5], vec[6], atol, rtol)
 
 
+@numba.njit(cache=True, inline="always")
+def _counters():  # pragma: no cover - compiled
+    """:func:`rosw_integrate`'s step counters (the first right-hand side counted) and 1 / (h gamma) of the
+    current factors (0: none yet)."""
+    cnt = np.zeros(8, dtype=np.int64)
+    cnt[_RHS] = 1
+    return cnt, np.zeros(1)
+
+
+@numba.njit(cache=True, inline="always")
+def _reject(err, h, tiny, age, jac_every, rejected, cnt):  # pragma: no cover - compiled
+    """A rejected (or non-finite) step of :func:`rosw_integrate`: count it, mark W stale after a second rejection
+    in a row and shrink the step; returns (h, age, failed), failed when a non-finite step fell below ``tiny``."""
+    cnt[_REJ] += 1
+    if rejected and age > 0:  # a second rejection in a row: a stale W may be why, evaluate it afresh
+        age = jac_every
+    h *= max(0.2, 0.9 * err ** (-1.0 / 3.0)) if np.isfinite(err) else 0.25
+    return h, age, not np.isfinite(err) and h < tiny
+
+
+@numba.njit(cache=True, inline="always")
+def _accept_sampled(model_id, t, h, y, ynew, k1, k7, p, log, t_out, out, k, t_end,
+                    tiny):  # pragma: no cover - compiled
+    """Accept the step from t to t + h and write the samples it passes; returns the next sample's index."""
+    k = _accept(model_id, t, h, y, ynew, k1, k7, p, log, t_out, out, k)
+    if t_end - (t + h) <= tiny:  # only round-off left: the remaining samples are this state
+        out[k:, :] = ynew
+        k = t_out.shape[0]
+    return k
+
+
 @numba.njit(cache=True)
 def rosw_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_steps, out, stats, h_onset,
                    jump_floor, force_jump, st, jac_every, lu_ratio):  # pragma: no cover - compiled
@@ -452,13 +483,11 @@ def rosw_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_s
     """
     vec, u, wk = _workspace(y0.shape[0], st[0], st[2], st[4])
     y, k1, k7, ynew = vec[0], vec[1], vec[2], vec[5]
-    cnt = np.zeros(8, dtype=np.int64)
-    cnt[_RHS] = 1
-    lu_at = np.zeros(1)  # 1 / (h gamma) of the current factors (0: none yet)
+    cnt, lu_at = _counters()
     k = _start(model_id, t0, y0, p, log, t_out, out, atol, rtol, vec)
-    t, h, age, status = t0, h0, jac_every, STATUS_OK  # age >= jac_every: evaluate W before the next step
+    # age >= jac_every: evaluate W before the next step
+    t, h, age, status, rejected = t0, h0, jac_every, STATUS_OK, False
     sig = model_signature(model_id, y, p) if h_onset > 0.0 else 0.0
-    rejected = False
     t_end = t_out[t_out.shape[0] - 1]
     tiny = 1e-13 * max(abs(t_end), t_end - t0)  # round-off scale of the time axis
     while k < t_out.shape[0]:
@@ -469,12 +498,9 @@ def rosw_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_s
         err = _step(model_id, t, h, p, log, atol, rtol, vec, u, st, wk, 0 < jac_every <= age, cnt, lu_at, lu_ratio)
         age = 0 if 0 < jac_every <= age else age
         if not err <= 1.0:  # rejected, or not finite
-            cnt[_REJ] += 1
-            if rejected and age > 0:  # a second rejection in a row: a stale W may be why, evaluate it afresh
-                age = jac_every
+            h, age, failed = _reject(err, h, tiny, age, jac_every, rejected, cnt)
             rejected = True
-            h *= max(0.2, 0.9 * err ** (-1.0 / 3.0)) if np.isfinite(err) else 0.25
-            if not np.isfinite(err) and h < tiny:
+            if failed:
                 status = STATUS_NONFINITE
                 break
             continue
@@ -488,10 +514,7 @@ def rosw_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_s
             continue
         cnt[_CHANGES] += verdict == 3
         age = jac_every if verdict == 3 else age + 1  # a contact opened or closed: a damping term switched
-        k = _accept(model_id, t, h, y, ynew, k1, k7, p, log, t_out, out, k)
-        if t_end - (t + h) <= tiny:  # only round-off left: the remaining samples are this state
-            out[k:, :] = ynew
-            k = t_out.shape[0]
+        k = _accept_sampled(model_id, t, h, y, ynew, k1, k7, p, log, t_out, out, k, t_end, tiny)
         t += h
         cnt[_STEPS] += 1
         h *= min(grow, max(0.2, 0.9 * max(err, 1e-10) ** (-1.0 / 3.0)))

@@ -16,6 +16,8 @@ import os
 import subprocess
 import sys
 
+import pytest
+
 _SCRIPT = r"""
 import json, numba, numpy as np
 from cageless.simulation.effects import EffectSpec
@@ -63,12 +65,34 @@ print(json.dumps({"active": list(on.model.active), "k_x": pr_on.parameter("K_X")
                   "ok": bool(on.solution.success and off.solution.success)}))
 """
 
+_SPATIAL = _SCRIPT[:_SCRIPT.index("from cageless.conditions import OperatingConditions")] + r"""
+from cageless.conditions import OperatingConditions
+from cageless.simulation.scene import Scene
+from cageless.simulation.simulation import Choices, Simulation
+
+scene = Scene(conditions=OperatingConditions(3000.0, 500.0, 200.0), duration_s=5e-4)  # the axial load: spatial
+on = Simulation(scene)
+off = Simulation(scene, choices=Choices(effects={"race_spring": False}, force=True))
+pr_on, pr_off = on.build(), off.build()
+y = pr_on.y0.copy()
+a_on, a_off = pr_on.rhs(0.0, y), pr_off.rhs(0.0, y)
+on.run(), off.run()
+print(json.dumps({"level": on.model.level, "active": list(on.model.active), "k_x": pr_on.parameter("K_X"),
+                  "rhs_change": float(np.max(np.abs(a_on - a_off))),
+                  "final_change": float(np.max(np.abs(on.solution.y[-1] - off.solution.y[-1]))),
+                  "ok": bool(on.solution.success and off.solution.success)}))
+"""
+
+
+def _run(script: str, tmp_path) -> dict:
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba-cache")}
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, timeout=900)
+    assert out.returncode == 0, out.stderr[-2000:]
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
 
 def test_an_example_race_law_enters_the_forces(tmp_path):
-    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba-cache")}
-    out = subprocess.run([sys.executable, "-c", _SCRIPT], capture_output=True, text=True, env=env, timeout=900)
-    assert out.returncode == 0, out.stderr[-2000:]
-    r = json.loads(out.stdout.strip().splitlines()[-1])
+    r = _run(_SCRIPT, tmp_path)
     assert "race_spring" in r["active"] and r["k_x"] == 2.0e6 and r["ok"]
     k, m = r["k_x"], r["m"]
     loaded = 0
@@ -79,3 +103,13 @@ def test_an_example_race_law_enters_the_forces(tmp_path):
         loaded += d_o > 0
     assert loaded >= 3 and max(abs(v) for v in r["dr_acc"]) > 1.0  # the law acts where balls are loaded
     assert r["ring_z_on"] != r["ring_z_off"]  # the stiffer contacts carry the load: the run differs
+
+
+@pytest.mark.slow  # a fresh compile of the spatial kernels
+def test_the_example_law_runs_at_the_spatial_level(tmp_path):
+    """The same law, the same single definition, in the spatial model's race contacts: on, it changes the
+    right-hand side at the packed start (the loaded balls' contacts) and the state after 0.5 ms."""
+    r = _run(_SPATIAL, tmp_path)
+    assert r["level"] == "spatial" and "race_spring" in r["active"] and r["k_x"] == 2.0e6 and r["ok"]
+    assert r["rhs_change"] > 1.0  # m/s^2 (or rad/s^2): k_x delta / m at a loaded contact is of order 1e3
+    assert r["final_change"] > 0.0
