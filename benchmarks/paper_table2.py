@@ -14,7 +14,7 @@ use (:func:`cageless.profiles.unloaded_zone_peak`, sigma :data:`cageless.profile
 raw maximum over 1 deg bins is printed beside it. ``--also 2x0.1`` adds a table from the first seeds and the
 first part of each run (the same simulations, cut). ``--no-calibrate`` predicts with ``--parameter-set`` as is.
 
-    python benchmarks/paper_table2.py --seeds 4 --duration 0.2 --also 2x0.1     # about an hour on 2 loaded cores
+    python benchmarks/paper_table2.py          # = --seeds 4 --duration 0.2 --also 2x0.1: about 10 min, 2 loaded cores
     python benchmarks/paper_table2.py --no-calibrate --seeds 1 --duration 0.05 --speeds 1800 6000 --loads 500
 """
 
@@ -140,10 +140,11 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--speeds", type=int, nargs="+", default=[1800, 3000, 6000])
     ap.add_argument("--loads", type=int, nargs="+", default=[500, 1000, 2000])
-    ap.add_argument("--seeds", type=int, default=2)
-    ap.add_argument("--duration", type=float, default=0.1)
-    ap.add_argument("--also", type=_also, nargs="*", default=[],
-                    help="further tables from the first SEEDS runs cut to DURATION s, e.g. 2x0.1")
+    ap.add_argument("--seeds", type=int, default=4)
+    ap.add_argument("--duration", type=float, default=0.2)
+    ap.add_argument("--also", type=_also, nargs="*", default=None,
+                    help="further tables from the first SEEDS runs cut to DURATION s (default 2x0.1 when the runs "
+                    "are longer)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--parameter-set", default="paper-table2")
     ap.add_argument("--no-calibrate", action="store_true", help="predict with --parameter-set as it is")
@@ -160,6 +161,8 @@ def main(argv: list[str] | None = None) -> int:
     unknown = [(s, lo) for s in args.speeds for lo in args.loads if (s, lo) not in TABLE2]
     if unknown:
         ap.error(f"no Table 2 value for {unknown}; speeds 1800/3000/6000, loads 500/1000/2000")
+    if args.also is None:
+        args.also = [(2, 0.1)] if args.seeds >= 2 and args.duration > 0.1 else []
     if any(n > args.seeds or d > args.duration for n, d in args.also):
         ap.error("--also tables cut the main runs: their seeds and duration cannot exceed --seeds and --duration")
     from cageless.simulation.parameter_sets import set_values
