@@ -170,7 +170,8 @@ def main(argv: list[str] | None = None) -> int:
     start = time.perf_counter()
     params, fitted = set_values(args.parameter_set), f", parameter set {args.parameter_set}"
     if args.meniscus_mm is not None:
-        params, fitted = {**params, "meniscus_distance_m": 1e-3 * args.meniscus_mm}, f", r_s = {args.meniscus_mm:.4f} mm"
+        params = {**params, "meniscus_distance_m": 1e-3 * args.meniscus_mm}
+        fitted = f", r_s = {args.meniscus_mm:.4f} mm"
     elif not args.no_calibrate:
         cal = recalibrate(args.cal_budget, args.cal_seeds, args.workers, 1e-3 * args.cal_range_mm[0],
                           1e-3 * args.cal_range_mm[1])

@@ -81,7 +81,8 @@ def angle_profile(
     })
 
 
-def smooth_profile(mean: npt.ArrayLike, bin_deg: float, sigma_deg: float = PEAK_SMOOTHING_DEG) -> npt.NDArray[np.float64]:
+def smooth_profile(mean: npt.ArrayLike, bin_deg: float,
+                   sigma_deg: float = PEAK_SMOOTHING_DEG) -> npt.NDArray[np.float64]:
     """A full-circle profile smoothed by a periodic Gaussian of ``sigma_deg`` (deg).
 
     Empty (NaN) bins are left out by normalised convolution (the smoothed values over the smoothed

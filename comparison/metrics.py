@@ -21,8 +21,8 @@ SLIP_RATE_DEFINITION = (
     "Slip rate s = 1 - (ball orbital speed) / (pure-rolling cage speed w_i (1 - D/d_m) / 2). The theoretical "
     "(simulated) and experimental (measured) slip rate of a condition is the peak of the mean slip profile "
     f"(1 deg bins, all balls, smoothed by a periodic Gaussian of sigma {PEAK_SMOOTHING_DEG:g} deg) in the unloaded "
-    "zone, 0-180 deg; the smoothing keeps bin noise from raising the peak of short runs. MAE, RMSE and maximum error compare the two mean "
-    "profiles point by point over every bin where both have data, in percentage points."
+    "zone, 0-180 deg; the smoothing keeps bin noise from raising the peak of short runs. MAE, RMSE and maximum "
+    "error compare the two mean profiles point by point over every bin where both have data, in percentage points."
 )
 
 

@@ -117,7 +117,8 @@ def test_compare_cli_takes_the_reference(tmp_path, capsys):
     assert theoretical == pytest.approx(6.0 * shrink, abs=0.1) and experimental == pytest.approx(theoretical, abs=0.02)
     assert main(args) == 0
     out = capsys.readouterr().out
-    assert _row(out)[4] == pytest.approx(3.0 + 0.97 * 6.0 * shrink, abs=0.2) and "pure-rolling cage speed of the stated" in out
+    assert _row(out)[4] == pytest.approx(3.0 + 0.97 * 6.0 * shrink, abs=0.2)
+    assert "pure-rolling cage speed of the stated" in out
 
 
 def _row(markdown: str) -> list[float]:
