@@ -152,7 +152,7 @@ class ModelParameters:
     min_entrainment_m_s: float = 0.1
     min_approach_speed_m_s: float = 0.01
     strips: int = 5
-    meniscus_distance_m: float = 0.2313082303752839e-3  # fitted: simulation/parameter_sets.py
+    meniscus_distance_m: float = 0.21028806973714847e-3  # fitted: simulation/parameter_sets.py
     surface_roughness_m: float = 0.1e-6
     limiting_shear_coefficient: float = 0.07
     boundary_friction_coefficient: float = 0.1

@@ -19,7 +19,7 @@ import numpy.typing as npt
 
 from cageless.errors import UsageError
 from cageless.kinematics import slip_rate, theoretical_cage_speed
-from cageless.profiles import angle_profile
+from cageless.profiles import PEAK_SMOOTHING_DEG, UNLOADED_ZONE_DEG, angle_profile, unloaded_zone_peak
 from cageless.trace import SimulationInfo, Trace
 from cageless.simulation.effects import ModelChoice
 from cageless.simulation.hertz import compliance, hertz_contact, race_curvatures
@@ -38,8 +38,6 @@ __all__ = ["SimulationResult", "EnergyBalance", "build_problem", "check_supporte
            "peak_unloaded_slip",
            "UNLOADED_ZONE_DEG"]
 
-#: The unloaded zone: the upper half of the bearing, opposite the radial load.
-UNLOADED_ZONE_DEG = (0.0, 180.0)
 
 
 
@@ -52,17 +50,16 @@ class SimulationResult:
     problem: Problem
 
 
-def peak_unloaded_slip(trace: Trace, settle_s: float = 0.0, bin_deg: float = 1.0) -> float:
-    """The peak of the mean slip profile in the unloaded zone, as a fraction.
+def peak_unloaded_slip(trace: Trace, settle_s: float = 0.0, bin_deg: float = 1.0,
+                       sigma_deg: float = PEAK_SMOOTHING_DEG) -> float:
+    """The peak slip of the unloaded zone, as a fraction (:func:`cageless.profiles.unloaded_zone_peak`).
 
     Samples before ``settle_s`` (the start-up) and invalid samples are left out; the profile is
-    the mean over all balls per ``bin_deg`` orbital-angle bin. NaN when no bin of the zone has data.
+    the mean over all balls per ``bin_deg`` orbital-angle bin, smoothed by a periodic Gaussian of
+    ``sigma_deg`` before its maximum over the zone is taken. NaN when no bin of the zone has data.
     """
     keep = (trace.time >= settle_s)[:, None] & trace.valid
-    prof = angle_profile(trace.angle, trace.slip, bin_deg, valid=keep)
-    lo, hi = UNLOADED_ZONE_DEG
-    zone = prof[(prof.angle_deg > lo) & (prof.angle_deg < hi)]["mean"]
-    return float(zone.max()) if zone.notna().any() else float("nan")
+    return unloaded_zone_peak(angle_profile(trace.angle, trace.slip, bin_deg, valid=keep), sigma_deg)
 
 
 def check_supported(scene: Scene, choice: ModelChoice | None = None) -> None:

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from cageless.errors import ParameterError, suggest
+from cageless.profiles import peak_estimator
 from cageless.provenance import Provenance
 from cageless.trace import Trace, write_trace
 from cageless.simulation.effects import ModelChoice, choose_model
@@ -157,6 +158,7 @@ class Simulation:
         c = self.choices
         prov = Provenance.start(config={"scene": self.scene.to_dict(), "model": json.loads(self.model.to_json()),
                                         "solver": c.solver_config(), "parameters": self.parameters.to_dict(),
+                                        "peak_estimator": peak_estimator(),
                                         **(config or {})})
         pr = self.build()
         t = self.sample_times()

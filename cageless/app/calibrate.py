@@ -36,12 +36,11 @@ from tqdm.auto import tqdm
 from cageless import __version__
 from cageless.bearing import Bearing, default_bearing
 from cageless.errors import CagelessError, ParameterError, TraceFormatError, UsageError, suggest
+from cageless.profiles import UNLOADED_ZONE_DEG, peak_estimator, peak_of_mean
 
 __all__ = ["Target", "Bound", "CalibrationResult", "parse_bounds", "target_from_trace", "target_from_peak",
            "calibrate", "describe_calibration", "fit_warnings", "UNLOADED_ZONE_DEG", "PENALTY_PP"]
 
-#: The unloaded zone (deg) the objective covers (the report's definition).
-UNLOADED_ZONE_DEG = (0.0, 180.0)
 #: The objective of an evaluation whose runs failed (pp): larger than any real miss.
 PENALTY_PP = 100.0
 _BIN_DEG = 1.0
@@ -200,7 +199,7 @@ def _miss(target: Target, mean: np.ndarray, metric: str) -> tuple[float, float]:
     from cageless.comparison.metrics import profile_errors
 
     zone = _zone(mean)
-    peak = 100 * float(np.max(mean[zone])) if zone.any() else float("nan")
+    peak = 100 * peak_of_mean(mean, _BIN_DEG)
     if target.profile is None:
         return abs(peak - float(target.peak_slip_pct)), peak
     both = zone & _zone(target.profile)
@@ -453,6 +452,7 @@ def calibration_document(result: CalibrationResult, bearing_section: Mapping[str
         "condition": t.condition, "speed_rpm": t.speed_rpm, "radial_load_n": t.radial_load_n,
         "axial_load_n": t.axial_load_n, **t.identity,
         "metric": result.metric if t.profile is not None else "peak miss",
+        "peak_estimator": peak_estimator(),
         "objective_pp": result.objective_pp, "method": result.method, "budget": result.budget,
         "evaluations_used": len(result.evaluations), "seeds": result.seeds,
         "seed_values": list(range(result.seeds)), "simulated_s_after_startup": t.duration_s,

@@ -46,6 +46,7 @@ from cageless.errors import CagelessError
 from cageless.kinematics import startup_duration, theoretical_cage_speed
 from cageless.outputs import clean_stale_parts, output_lock
 from cageless.parallel import job_pool
+from cageless.profiles import peak_estimator
 from cageless.provenance import code_digest, hash_file, sha256_file
 from cageless.trace import read_trace
 from cageless.validate import plausible_entry
@@ -89,7 +90,7 @@ class LabOptions:
                 "bin_deg": self.bin_deg, "rtol": self.rtol,
                 "force": self.force, "parameter_set": self.parameter_set, "parameters": dict(self.parameters),
                 "n_balls": self.n_balls,
-                "slip_reference": self.slip_reference,
+                "slip_reference": self.slip_reference, "peak_estimator": peak_estimator(),
                 **({"calibration": self.calibration} if self.calibration else {})}
 
 

@@ -13,6 +13,7 @@ from typing import Any
 import matplotlib
 import numpy as np
 
+from cageless.profiles import PEAK_SMOOTHING_DEG, smooth_profile
 from cageless.comparison.report.describe import ConditionDescription
 
 matplotlib.use("Agg")
@@ -67,6 +68,10 @@ def slip_figure(d: ConditionDescription, size: tuple[float, float] = (5.6, 3.0))
         ax = fig.add_subplot()
         _profile(ax, c.measured.slip, 100.0, "measured", "C0")
         _profile(ax, c.simulated.slip, 100.0, "simulated", "C3")
+        for prof, colour in ((c.measured.slip, "C0"), (c.simulated.slip, "C3")):  # the curves the peaks are read on
+            ax.plot(prof["angle_deg"], 100.0 * smooth_profile(prof["mean"].to_numpy(), c.measured.bin_deg),
+                    color=colour, lw=1.6, ls="--")
+        ax.plot([], [], color="0.3", lw=1.6, ls="--", label=f"smoothed, sigma {PEAK_SMOOTHING_DEG:g} deg")
         ax.set(xlabel="orbital angle (deg)", ylabel="slip rate (%)", xlim=(0, 360))
         ax.legend(fontsize=7)
     return _svg(draw, size=size)

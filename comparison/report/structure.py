@@ -10,6 +10,7 @@ from typing import Any
 from cageless import __version__
 from cageless.comparison.compare import SLIP_REFERENCES, ComparisonRow
 from cageless.comparison.metrics import SLIP_RATE_DEFINITION
+from cageless.profiles import PEAK_SMOOTHING_DEG
 from cageless.comparison.report import figures
 from cageless.comparison.report.describe import ConditionDescription, tracking_verdict
 from cageless.comparison.table import slip_reference_note, table_frame, to_html
@@ -38,7 +39,8 @@ def _section(d: ConditionDescription) -> dict[str, Any]:
                         "the dip in the unloaded zone (0-180 deg, shaded) and whether the two curves share it.",
              "svg": figures.speed_figure(d)},
             {"caption": "Slip rate against orbital angle (mean and spread). The table's slip rates are the peaks "
-                        "of these curves in the unloaded zone; the MAE is their mean distance.",
+                        "of these curves in the unloaded zone, each smoothed by a periodic Gaussian of sigma "
+                        f"{PEAK_SMOOTHING_DEG:g} deg first; the MAE is their mean distance.",
              "svg": figures.slip_figure(d)},
             {"caption": "Ball-ball contact episodes (simulated): peak force by orbital angle. Collisions should "
                         "gather in the unloaded and transition zones, with none at 240-300 deg.",
@@ -52,7 +54,10 @@ def _section(d: ConditionDescription) -> dict[str, Any]:
                                                   "the paper's figure 13): how far the contact angle swings "
                                                   "around the orbit.", "svg": figures.contact_track_figure(d)})
         section["facts"] += [("settling time left out of the simulation", f"{d.comparison.settle_s:g} s"),
-                             ("slip reference", SLIP_REFERENCES.get(r.slip_reference, r.slip_reference))]
+                             ("slip reference", SLIP_REFERENCES.get(r.slip_reference, r.slip_reference)),
+                             ("peak slip estimator", f"maximum over 0-180 deg of the 1 deg mean profile smoothed by "
+                                                     f"a periodic Gaussian of sigma {PEAK_SMOOTHING_DEG:g} deg "
+                                                     "(measured and simulated alike)")]
     return section
 
 

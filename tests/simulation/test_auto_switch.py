@@ -73,9 +73,9 @@ def test_the_default_scene_switches_once_past_its_start_up():
     """The default lubricated scene over 50 ms (1 ms chunks): DP5 is not held by stability over the first two
     chunks, while the balls spread, so nothing is probed there; the first stiff chunk (ending at 3 ms) is
     probed and CVODE costs 0.30 of DP5 there: the run switches. A burst of contacts then makes CVODE's chunks
-    3.6 times dearer than DP5 on the probed chunk, the run goes back to DP5 at 6 ms, and the next stiff
-    chunk's probe (0.36) switches again at 9 ms for the rest of the run (measured; the cost model is
-    deterministic). Before the first-chunk probes (issue 18) the first probe came at 6 ms and the way back
+    3.7 times dearer than DP5 on the probed chunk, the run goes back to DP5 at 6 ms, and the next stiff
+    chunk's probe (0.52 with the default r_s = 0.2103 mm; 0.37 with the earlier 0.2313 mm, the same switches)
+    switches again at 9 ms for the rest of the run (measured; the cost model is deterministic). Before the first-chunk probes (issue 18) the first probe came at 6 ms and the way back
     was for good; CVODE throughout costs 0.66 times DP5 over 30 ms from the start at this scene, by the
     process's CPU time."""
     sol = _run(500.0, duration=0.05).solution
@@ -84,7 +84,7 @@ def test_the_default_scene_switches_once_past_its_start_up():
     assert not pilot["switch"] and pilot["pilot_s"] == pytest.approx(1e-4) and 0.9 < pilot["cost_ratio"] < 1.1
     assert [p["to"] for p in probes] == ["CVODE", "dp5", "CVODE"]
     assert 0.25 < probes[0]["cost_ratio"] < 0.35 and probes[1]["cost_ratio"] > 1.0
-    assert 0.3 < probes[2]["cost_ratio"] < 0.4 and probes[0]["stiff_fraction"] > 0.6
+    assert 0.45 < probes[2]["cost_ratio"] < 0.6 and probes[0]["stiff_fraction"] > 0.6
 
 
 def test_a_scene_stiff_from_the_start_starts_on_cvode(monkeypatch):

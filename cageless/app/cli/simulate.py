@@ -213,6 +213,7 @@ def _run(args: argparse.Namespace, scene: Any, choice: Any, config: dict[str, An
 
 
 def _summary_line(trace: Any, sol: Any, out: str) -> str:
+    from cageless.profiles import PEAK_SMOOTHING_DEG
     from cageless.simulation.run import peak_unloaded_slip
 
     ev = trace.events
@@ -221,7 +222,8 @@ def _summary_line(trace: Any, sol: Any, out: str) -> str:
     startup = startup_duration(trace.speed_rpm, trace.ball_diameter_m, trace.pitch_diameter_m)
     if float(trace.time[-1]) > startup:
         slip = (f"peak slip in the unloaded zone after {1e3 * startup:.0f} ms: "
-                f"{100 * peak_unloaded_slip(trace, settle_s=startup):.2f}%")
+                f"{100 * peak_unloaded_slip(trace, settle_s=startup):.2f}% "
+                f"(mean profile smoothed over {PEAK_SMOOTHING_DEG:g} deg)")
     else:  # a start-up transient's peak is not a slip anyone should quote
         slip = (f"no settled slip: the run is within the {1e3 * startup:.0f} ms start-up that compare and report "
                 f"leave out (simulate at least --duration {startup + 0.1:.2g})")
