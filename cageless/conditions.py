@@ -49,6 +49,7 @@ __all__ = [
     "ResolvedConditions",
     "LabEntry",
     "is_qc_folder",
+    "refuse_shared_names",
     "read_sidecar",
     "read_conditions_csv",
     "parse_file_name",
@@ -469,6 +470,27 @@ def _dangling_links(folder: Path) -> list[Path]:
     return [p for p in sorted(folder.iterdir()) if not p.name.startswith(".") and p.is_symlink() and not p.exists()]
 
 
+def refuse_shared_names(entries: list[LabEntry]) -> list[LabEntry]:
+    """Fail every video whose output name (``<stem>.trace.h5``) another video of the run shares, e.g. ``x.cine``
+    and ``x.mkv``: one trace would overwrite the other. The others are unaffected."""
+    def stem(p: Path) -> str:
+        return p.name if p.is_dir() else p.stem
+
+    by_stem: dict[str, list[Path]] = {}
+    for e in entries:
+        by_stem.setdefault(stem(e.video), []).append(e.video)
+    out = []
+    for e in entries:
+        others = [p for p in by_stem[stem(e.video)] if p != e.video]
+        if others and e.error is None:
+            e = LabEntry(video=e.video, error=ConditionsError(
+                e.video, f"has the same name as {', '.join(str(p) for p in others)}: their traces would overwrite "
+                f"each other ({stem(e.video)}.trace.h5).", "Rename one of them, or track them into separate "
+                "output folders."))
+        out.append(e)
+    return out
+
+
 def discover_lab(folder: str | Path) -> list[LabEntry]:
     """Find every video of a lab folder and resolve its conditions.
 
@@ -500,4 +522,4 @@ def discover_lab(folder: str | Path) -> list[LabEntry]:
             entries.append(LabEntry(video=video, resolved=resolve_conditions(video, table)))
         except ConditionsError as exc:
             entries.append(LabEntry(video=video, error=exc))
-    return entries
+    return refuse_shared_names(entries)

@@ -66,9 +66,17 @@ def bearing_from_config(config: Mapping[str, Any]) -> Bearing:
     """
     section = dict(config.get("bearing", {}))
     bearing = default_bearing()
-    if section.pop("lubricant", True) is False:
+    lubricant = section.pop("lubricant", True)
+    if not isinstance(lubricant, bool):
+        raise UsageError(f"[bearing] lubricant = {lubricant!r}: must be true or false (false makes the bearing dry).")
+    if lubricant is False:
         bearing = dataclasses.replace(bearing, lubricant=None)
     name = section.pop("name", None)
+    for key, value in section.items():
+        if not isinstance(value, Mapping):
+            raise UsageError(f"[bearing] {key} = {value!r}: bearing fields go in their table, e.g. "
+                             f"[bearing.geometry] n_balls = 14 ([bearing.geometry], [bearing.material], "
+                             "[bearing.masses], [bearing.lubricant]).")
     overrides = {
         f"{part}.{key}": value
         for part, values in section.items()

@@ -19,6 +19,8 @@ from typing import Any
 
 from tqdm.auto import tqdm
 
+from cageless.errors import CagelessError
+
 __all__ = ["job_pool", "gather", "die_with_parent"]
 
 
@@ -27,7 +29,11 @@ def job_pool(workers: int = 2, scheduler: str | None = None) -> Any:
     if scheduler:
         from distributed import Client
 
-        return Client(scheduler)
+        try:
+            return Client(scheduler, timeout="10s")
+        except (OSError, TimeoutError) as exc:
+            raise CagelessError(f"--scheduler {scheduler}: cannot reach the Dask scheduler ({exc}). Check the "
+                                "address and that the scheduler is running, or leave out --scheduler.") from None
     return ProcessPoolExecutor(max_workers=max(1, workers), mp_context=get_context("spawn"),
                                initializer=die_with_parent, initargs=(os.getpid(),))
 

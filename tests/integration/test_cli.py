@@ -83,6 +83,13 @@ def test_config_file(tmp_path, capsys):
         # a bad entry names the file and the entry, not the command-line option nobody typed
         ('[info]\nspeed_rpm = "fast"\n', "bad.toml: [info] speed_rpm = 'fast': must be a number"),
         ('[info]\njson = "yes"\n', "[info] json = 'yes': must be true or false."),
+        # unknown tables and keys are refused, not ignored
+        ("[reprot]\nrevolutions = 2\n", "bad.toml: unknown table 'reprot'"),
+        ("[geometry]\nn_balls = 13\n", "unknown table 'geometry'"),
+        ("revolutions = 2\n", "unknown key 'revolutions'"),
+        ('[bearing]\nlubricant = "no"\n', "bad.toml: [bearing] lubricant = 'no': must be true or false"),
+        ('[bearing]\nn_balls = "14"\n', "[bearing] n_balls = '14': bearing fields go in their table"),
+        ('[bearing.geometry]\nn_balls = "14"\n', "bad.toml: geometry.n_balls = '14': must be a whole number"),
     ],
 )
 def test_bad_config_is_a_usage_error(tmp_path, capsys, text, match):
@@ -218,3 +225,26 @@ def test_failed_lines_name_videos_relative_to_their_folder(tmp_path, capsys):
     assert sorted(line.split(":")[0] for line in err) == ["FAILED mystery.cine", "FAILED n3000_Fr500.cine"]
     assert main(["track", str(lab / "n3000_Fr500.cine"), "-o", str(tmp_path / "o"), "-q"]) == 1
     assert capsys.readouterr().err.startswith(f"FAILED {lab / 'n3000_Fr500.cine'}: wrong magic bytes")
+
+
+def test_a_scheduler_without_dask_distributed_is_a_usage_error(tmp_path, capsys, monkeypatch):
+    """`--scheduler` when Dask's distributed is missing: exit 2 before any work, no output folder."""
+    monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed -> ImportError
+    out = tmp_path / "r"
+    assert main(["report", str(tmp_path), "-o", str(out), "--scheduler", "tcp://10.0.0.5:8786"]) == 2
+    err = capsys.readouterr().err
+    assert "--scheduler tcp://10.0.0.5:8786: needs Dask's distributed package" in err and "cageless[dask]" in err
+    assert not out.exists()
+
+
+def test_two_videos_sharing_a_name_are_refused_not_overwritten(tmp_path, capsys):
+    """x.cine and x.mkv would both write x.trace.h5: both fail with the reason, nothing is overwritten."""
+    lab = tmp_path / "lab"
+    lab.mkdir()
+    for name in ("x.cine", "x.mkv"):
+        (lab / name).write_bytes(b"NOPE" * 20)
+    (lab / "conditions.csv").write_text("file,speed_rpm\nx.cine,6000\nx.mkv,3000\n")
+    assert main(["track", str(lab), "-o", str(tmp_path / "o"), "-q"]) == 1
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 2 and all("their traces would overwrite each other (x.trace.h5)" in line for line in err)
+    assert not list((tmp_path / "o").glob("*.trace.h5"))

@@ -13,6 +13,7 @@ Exit codes: 0 success, 1 some inputs failed (the rest done), 2 usage error.
 
 from __future__ import annotations
 
+import argparse
 import importlib
 import logging
 import sys
@@ -91,6 +92,17 @@ def _command_of(argv: Sequence[str]) -> str | None:
     return None
 
 
+def _check_scheduler(args: argparse.Namespace) -> None:
+    """``--scheduler`` needs Dask's ``distributed``: refuse before any work (and any output folder) if missing."""
+    if getattr(args, "scheduler", None):
+        try:
+            importlib.import_module("distributed")
+        except ImportError:
+            raise UsageError(f"--scheduler {args.scheduler}: needs Dask's distributed package, which is not "
+                             "installed. Install it with `pip install 'cageless[dask]'`, or leave out "
+                             "--scheduler to run on this machine.") from None
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI in-process and return its exit code.
 
@@ -113,6 +125,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             return EXIT_USAGE
         args, config = apply_config_defaults(parser, args.command, argv, args)
         setup_logging(args.quiet, args.verbose)
+        _check_scheduler(args)
         module = importlib.import_module(f"cageless.app.cli.{args.command}")
         return int(module.run(args, config))
     except SystemExit as exc:  # --help and --version exit through argparse

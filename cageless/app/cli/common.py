@@ -10,7 +10,7 @@ import re
 from collections.abc import Sequence
 from typing import Any, NoReturn
 
-from cageless.errors import UsageError, suggest
+from cageless.errors import CagelessError, UsageError, suggest
 
 __all__ = [
     "ArgumentParser", "common_options", "apply_config_defaults", "setup_logging", "finite_float", "parameter_values",
@@ -75,6 +75,7 @@ def apply_config_defaults(
     from cageless.config import load_config  # imported here: ``--version``/``--help`` do not need it
 
     config = load_config(args.config)
+    _check_config_tables(config, args.config)
     table = config.get(command, {})
     sub = parser._subparsers._group_actions[0].choices[command]  # type: ignore[union-attr]
     actions = {a.dest: a for a in sub._actions if a.dest not in ("help", "config")}
@@ -88,6 +89,30 @@ def apply_config_defaults(
         defaults[dest] = _config_value(actions[dest], value, f"--config {args.config}: [{command}] {key}")
     sub.set_defaults(**defaults)
     return parser.parse_args(argv), config
+
+
+#: Top-level tables of a configuration file besides one per command.
+CONFIG_TABLES = ("bearing", "parameters", "calibration")
+
+
+def _check_config_tables(config: dict[str, Any], path: str) -> None:
+    """Refuse an unknown top-level table or key (a misspelt ``[reprot]`` would otherwise be ignored) and a
+    ``[bearing]`` table that does not make a bearing, naming the file."""
+    from cageless.app.cli import SUBCOMMANDS
+    from cageless.config import bearing_from_config
+
+    known = (*SUBCOMMANDS, *CONFIG_TABLES)
+    for key, value in config.items():
+        if key not in known:
+            what = "table" if isinstance(value, dict) else "key"
+            raise UsageError(f"--config {path}: unknown {what} '{key}' (a file holds [bearing.*], [parameters], "
+                             f"[calibration] and one table per command)." + suggest(key, known))
+        if key in SUBCOMMANDS and not isinstance(value, dict):
+            raise UsageError(f"--config {path}: '{key}' must be a table ([{key}]).")
+    try:
+        bearing_from_config(config)
+    except CagelessError as exc:
+        raise UsageError(f"--config {path}: {exc}") from None
 
 
 def _config_value(action: argparse.Action, value: Any, where: str) -> Any:

@@ -22,6 +22,7 @@ from cageless.conditions import (
     bearing_with_keys,
     discover_lab,
     is_qc_folder,
+    refuse_shared_names,
     resolve_conditions,
 )
 from cageless.config import bearing_from_config
@@ -93,7 +94,7 @@ def collect_inputs(inputs: list[str], speed_rpm: float | None) -> list[LabEntry]
                 entries.append(LabEntry(video=p, resolved=resolve_conditions(p)))
             except CagelessError as exc:
                 entries.append(_with_speed(LabEntry(video=p, error=exc), speed_rpm))
-    return entries
+    return refuse_shared_names(entries)
 
 
 def _with_speed(entry: LabEntry, speed_rpm: float | None) -> LabEntry:
