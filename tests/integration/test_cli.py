@@ -248,3 +248,15 @@ def test_two_videos_sharing_a_name_are_refused_not_overwritten(tmp_path, capsys)
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 2 and all("their traces would overwrite each other (x.trace.h5)" in line for line in err)
     assert not list((tmp_path / "o").glob("*.trace.h5"))
+
+
+def test_a_config_entry_satisfies_a_required_option(tmp_path, capsys):
+    """`[simulate] speed_rpm = 3000` gives simulate's required --speed-rpm (the command line still wins:
+    test_config_file)."""
+    cfg = tmp_path / "c.toml"
+    cfg.write_text("[simulate]\nspeed_rpm = 3000\nradial_load_n = 500\n")
+    assert main(["simulate", "--config", str(cfg), "--explain", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["level"] == "planar"
+    assert main(["simulate", f"--config={cfg}", "--explain"]) == 0
+    assert main(["simulate", "--explain"]) == 2  # without the file it is still required
+    assert "--speed-rpm" in capsys.readouterr().err

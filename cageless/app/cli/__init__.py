@@ -21,7 +21,8 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from cageless._version import __version__
-from cageless.app.cli.common import ArgumentParser, apply_config_defaults, common_options, setup_logging
+from cageless.app.cli.common import (ArgumentParser, apply_config_defaults, common_options, config_path_of,
+                                     setup_logging)
 from cageless.errors import CagelessError, ParameterError, UsageError
 
 __all__ = ["main", "entry_point", "build_parser", "SUBCOMMANDS"]
@@ -117,13 +118,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         0 on success, 1 if some inputs failed, 2 on a usage error.
     """
     argv = list(sys.argv[1:] if argv is None else argv)
-    parser = build_parser(_command_of(argv) or "")  # "" registers no subcommand in full
+    command = _command_of(argv)
+    parser = build_parser(command or "")  # "" registers no subcommand in full
     try:
+        config = apply_config_defaults(parser, command, config_path_of(argv)) if command else {}
         args = parser.parse_args(argv)
         if args.command is None:
             parser.print_help()
             return EXIT_USAGE
-        args, config = apply_config_defaults(parser, args.command, argv, args)
         setup_logging(args.quiet, args.verbose)
         _check_scheduler(args)
         module = importlib.import_module(f"cageless.app.cli.{args.command}")

@@ -13,7 +13,7 @@ from typing import Any, NoReturn
 from cageless.errors import CagelessError, UsageError, suggest
 
 __all__ = [
-    "ArgumentParser", "common_options", "apply_config_defaults", "setup_logging", "finite_float", "parameter_values",
+    "ArgumentParser", "common_options", "apply_config_defaults", "config_path_of", "setup_logging", "finite_float", "parameter_values",
 ]
 
 
@@ -63,19 +63,27 @@ def add_parameter_set_option(parser: ArgumentParser) -> None:
                         "500 N against the paper's measured slip) or representative (the earlier, uncalibrated values)")
 
 
-def apply_config_defaults(
-    parser: argparse.ArgumentParser, command: str, argv: Sequence[str], args: argparse.Namespace
-) -> tuple[argparse.Namespace, dict[str, Any]]:
-    """Re-parse ``argv`` with the ``[command]`` table of ``--config`` as defaults.
+def config_path_of(argv: Sequence[str]) -> str | None:
+    """The value of ``--config`` in ``argv`` (``--config F`` or ``--config=F``), if given."""
+    for i, word in enumerate(argv):
+        if word == "--config" and i + 1 < len(argv):
+            return argv[i + 1]
+        if word.startswith("--config="):
+            return word.split("=", 1)[1]
+    return None
 
-    Returns the new namespace and the whole configuration (empty without ``--config``).
+
+def apply_config_defaults(parser: argparse.ArgumentParser, command: str, path: str | None) -> dict[str, Any]:
+    """Make the ``[command]`` table of the ``--config`` file ``path`` the defaults of ``command``'s options,
+    before the command line is parsed (so a file entry also satisfies a required option; the command line
+    wins). Returns the whole configuration (empty without ``--config``).
     """
-    if not getattr(args, "config", None):
-        return args, {}
+    if not path:
+        return {}
     from cageless.config import load_config  # imported here: ``--version``/``--help`` do not need it
 
-    config = load_config(args.config)
-    _check_config_tables(config, args.config)
+    config = load_config(path)
+    _check_config_tables(config, path)
     table = config.get(command, {})
     sub = parser._subparsers._group_actions[0].choices[command]  # type: ignore[union-attr]
     actions = {a.dest: a for a in sub._actions if a.dest not in ("help", "config")}
@@ -83,12 +91,11 @@ def apply_config_defaults(
     for key, value in table.items():
         dest = key.replace("-", "_")
         if dest not in actions:
-            raise UsageError(
-                f"--config {args.config}: [{command}] has unknown option '{key}'." + suggest(dest, actions)
-            )
-        defaults[dest] = _config_value(actions[dest], value, f"--config {args.config}: [{command}] {key}")
+            raise UsageError(f"--config {path}: [{command}] has unknown option '{key}'." + suggest(dest, actions))
+        defaults[dest] = _config_value(actions[dest], value, f"--config {path}: [{command}] {key}")
+        actions[dest].required = False  # the file gives it
     sub.set_defaults(**defaults)
-    return parser.parse_args(argv), config
+    return config
 
 
 #: Top-level tables of a configuration file besides one per command.
