@@ -352,6 +352,11 @@ def read_trace(path: str | Path) -> Trace:
     try:
         f = h5py.File(path, "r")
     except (OSError, RuntimeError) as exc:
+        from cageless.conditions import VIDEO_SUFFIXES
+
+        if path.suffix.lower() in VIDEO_SUFFIXES:
+            raise _fail(path, "is a video, not a trace.", "Track it first (`cageless track VIDEO -o out`) and "
+                        "give the out/<name>.trace.h5 it writes.") from None
         raise _fail(path, f"is not a readable HDF5 file ({exc}).") from exc
     try:
         with f:

@@ -527,7 +527,8 @@ def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, backgro
     log.info("%s: ball circle r = %.1f px, counts per burst %s, %d of %d bursts with %d balls", path, circle[2],
              counts, len(good), len(spans), z)
     if found != z:
-        raise SelectionError(path, f"found {found} balls moving together along one circle, but the bearing has {z}.",
+        raise SelectionError(path, f"found {found} balls moving together along one circle, but {z} are expected (the "
+                             "bearing's ball count, or --n-balls).",
                              f"Check the stated speed (speed_rpm: balls far from the expected cage speed are "
                              f"rejected) and the bearing's ball count; if the video really shows {found} balls, "
                              f"state it with --n-balls {found}. The QC image shows what was found.", table=table, found=found, ring=ring)

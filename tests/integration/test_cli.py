@@ -260,3 +260,11 @@ def test_a_config_entry_satisfies_a_required_option(tmp_path, capsys):
     assert main(["simulate", f"--config={cfg}", "--explain"]) == 0
     assert main(["simulate", "--explain"]) == 2  # without the file it is still required
     assert "--speed-rpm" in capsys.readouterr().err
+
+
+def test_compare_given_a_video_says_to_track_it(tmp_path, capsys):
+    video = tmp_path / "clip.mkv"
+    video.write_bytes(b"\x1aE\xdf\xa3" + b"\x00" * 60)
+    assert main(["compare", str(video), str(video)]) == 1
+    err = capsys.readouterr().err
+    assert "clip.mkv: is a video, not a trace" in err and "cageless track" in err and "HDF5" not in err

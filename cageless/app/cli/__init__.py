@@ -34,7 +34,7 @@ SUBCOMMANDS: tuple[str, ...] = ("info", "track", "simulate", "compare", "report"
 SUMMARIES: dict[str, str] = {
     "info": "show the bearing, its kinematics and characteristic frequencies",
     "track": "track the balls in videos and write trace files",
-    "simulate": "decide (and explain) the bearing model a scene calls for",
+    "simulate": "simulate the bearing for a scene (--explain: the model and effects it calls for, and why)",
     "compare": "compare a measured and a simulated trace (one Table-2 row)",
     "report": "lab folder -> traces, simulations, slip table and report.html",
     "sweep": "a scene over a parameter grid and seeds: peak slip table and plot",

@@ -32,9 +32,11 @@ examples:
 def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     """Add the ``simulate`` subcommand."""
     p = subparsers.add_parser(
-        "simulate", parents=[parent], help="decide (and explain) the bearing model a scene calls for",
-        description="Build the scene (speed, loads, lubricant, orientation) and decide the model level and "
-        "the effects it calls for, each with its reason. --explain prints them without solving.",
+        "simulate", parents=[parent],
+        help="simulate the bearing for a scene (--explain: the model and effects it calls for, and why)",
+        description="Build the scene (speed, loads, lubricant, orientation), decide the model level and "
+        "the effects it calls for, each with its reason, and simulate it into a trace. --explain prints the "
+        "choice without solving.",
         epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--speed-rpm", type=finite_float, required=True, help="inner-ring speed (rpm)")
