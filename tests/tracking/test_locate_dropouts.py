@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from cageless.tracking.detect import static_defects
 from cageless.tracking.locate import BALL_BAND, BearingLocation
 from cageless.tracking.locate_motion import DROPOUT_GAIN, frame_gains, motion_map
 
@@ -69,3 +70,21 @@ def test_a_band_narrower_than_a_ball_is_widened_to_whole_balls():
     already = BearingLocation(centre=(50.0, 50.0), outer_radius=300.0, band_inner=160.0, band_outer=270.0,
                               contour_residual=0.3)
     assert already.holding_balls(ratio) is already
+
+
+def test_a_compact_static_glint_is_a_defect():
+    """A saturated 3 x 3 glint on a flat face, bright in every frame: all 9 of its pixels are static defects (the
+    5 x 5 median is the face's level there; a 3 x 3 median would be the glint's own); a highlight seen in one
+    frame of 8 is not."""
+    rng = np.random.default_rng(3)
+    frames = rng.normal(40.0, 2.0, (8, 30, 30))
+    frames[:, 10:13, 10:13] = 255.0
+    frames[2, 18:21, 18:21] += 150.0
+    background = np.median(frames, axis=0)
+    out = static_defects(background.astype(np.float32), 2.0, frames=frames.astype(np.float32))
+    expected = np.zeros((30, 30), bool)
+    expected[10:13, 10:13] = True
+    np.testing.assert_array_equal(out, expected)
+    old = static_defects(background.astype(np.float32), 2.0, frames=frames.astype(np.float32), size=3)
+    # What the 3 x 3 median found: the glint's 4 corners only (4 of 9 bright there), its centre and edges left in.
+    assert sorted(map(tuple, np.argwhere(old).tolist())) == [(10, 10), (10, 12), (12, 10), (12, 12)]
