@@ -12,7 +12,7 @@ margin, is the ball annulus mask.
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import cv2
@@ -26,6 +26,11 @@ from cageless.tracking.io.base import FrameSource
 __all__ = ["BearingLocation", "background_frame", "locate_bearing", "fit_circle"]
 
 log = logging.getLogger(__name__)
+
+
+#: Least width of the ball search band, in ball diameters: a whole ball, with a tenth of a diameter for lens
+#: distortion, the highlight's tail and the margin the search mask takes off each edge.
+BALL_BAND = 1.2
 
 
 @dataclass(frozen=True)
@@ -59,6 +64,22 @@ class BearingLocation:
         v, u = np.ogrid[0:shape[0], 0:shape[1]]
         r = np.hypot(u - self.centre[0], v - self.centre[1])
         return (r >= self.band_inner + margin) & (r <= self.band_outer - margin)
+
+    def holding_balls(self, ball_over_pitch_radius: float) -> BearingLocation:
+        """The band widened, about its middle, to at least :data:`BALL_BAND` ball diameters.
+
+        The dark band between the lands is where ball surface is seen, and its middle is the pitch circle;
+        but a highlight can sit anywhere on its ball, out to the ball's rim (a light from the side), and where
+        the lands hide part of each ball the band is narrower than a ball: then highlights near the rim fall
+        outside it over part of the orbit (corpus seed 7021: a band 0.33 ball wide about the pitch circle held
+        the highlights of 6 of 18 balls). ``ball_over_pitch_radius`` is D / (d_m / 2).
+        """
+        mid = 0.5 * (self.band_inner + self.band_outer)
+        half = 0.5 * BALL_BAND * ball_over_pitch_radius * mid
+        if self.band_outer - self.band_inner >= 2 * half:
+            return self
+        return replace(self, band_inner=min(self.band_inner, max(mid - half, 0.0)),
+                       band_outer=max(self.band_outer, mid + half))
 
     def crop(self, shape: tuple[int, int], pad: int = 2) -> tuple[slice, slice]:
         """Rows and columns of the band's bounding box, clipped to the image."""

@@ -36,7 +36,8 @@ from cageless.tracking.io import CineReader, FrameSource, open_video
 from cageless.tracking.kinematics import DEFAULT_TRACK_FIT, DEFAULT_WINDOW, revolution_speed, robust_track_fit
 from cageless.tracking.link import BallCountWarning, TrackSetup, track_frames
 from cageless.tracking.locate import BearingLocation, background_frame, locate_bearing
-from cageless.tracking.locate_motion import holds_the_motion, locate_by_motion, motion_map, plausible_band
+from cageless.tracking.locate_motion import (DROPOUT_GAIN, frame_gains, holds_the_motion, locate_by_motion, motion_map,
+                                             plausible_band)
 from cageless.tracking.qc import QCReport, build_qc, slip_warnings, write_qc, write_selection_qc
 from cageless.tracking.select import SPEED_BAND, Selection, SelectionError, select_balls
 
@@ -226,7 +227,10 @@ def _setup(video: FrameSource, loc: BearingLocation, background: np.ndarray, bea
     bg = np.ascontiguousarray(background[rows, cols])
     picks = np.linspace(0, len(video) - 1, min(4, len(video))).astype(int)
     sample = np.stack([frames(int(i)) for i in picks])
-    sigma = noise_sigma(sample, bg, mask)
+    # Not over a lighting dropout: a dark frame's whole difference from the background is not noise (one dark
+    # frame of the 4 made it 4x too large on the long clip of corpus seed 7021, and with it every threshold).
+    steady = frame_gains(list(sample)) >= DROPOUT_GAIN
+    sigma = noise_sigma(sample[steady] if steady.sum() >= 2 else sample, bg, mask)
     spread = np.stack([frames(int(i)) for i in np.linspace(0, len(video) - 1, min(_DEFECT_FRAMES, len(video)))
                        .astype(int)])
     defects = static_defects(bg, sigma, frames=spread)
@@ -266,6 +270,41 @@ def _setup(video: FrameSource, loc: BearingLocation, background: np.ndarray, bea
     return setup, sel
 
 
+def _select(video: FrameSource, loc: BearingLocation, background: np.ndarray, bearing: Bearing,
+            options: TrackOptions, conditions: OperatingConditions, path: Path
+            ) -> tuple[BearingLocation, _CroppedFrames, TrackSetup, Selection]:
+    """:func:`_setup` on the located band; when that shows too few balls and the band, found from the ring
+    faces' brightness, is narrower than a ball, once more on the band widened to hold whole balls
+    (:meth:`~cageless.tracking.locate.BearingLocation.holding_balls`): where the lands hide part of each ball the
+    dark band between them is narrower than a ball, and a highlight near its ball's rim (a light from the
+    side) leaves it over part of the orbit. The narrow band is tried first because it keeps the bright face
+    edges out of the search (widening every band to a ball lost 3 of 32 TUNING clips to the bright wedges
+    between balls); the error of the first try is the one raised when both fail."""
+    g = bearing.geometry
+    z = options.n_balls or g.n_balls
+    wide = loc.holding_balls(g.ball_diameter_m / (0.5 * g.pitch_diameter_m))
+    try:
+        return _select_in(video, loc, background, bearing, options, conditions, path)
+    except SelectionError as exc:
+        if wide is loc or loc.source != "brightness" or (exc.found or 0) >= z:
+            raise
+        log.info("%s: %s of %d balls in the band between the lands; searching the band of whole balls",
+                 path, exc.found, z)
+        try:
+            return _select_in(video, wide, background, bearing, options, conditions, path)
+        except SelectionError:
+            raise exc from None
+
+
+def _select_in(video: FrameSource, loc: BearingLocation, background: np.ndarray, bearing: Bearing,
+               options: TrackOptions, conditions: OperatingConditions, path: Path
+               ) -> tuple[BearingLocation, _CroppedFrames, TrackSetup, Selection]:
+    rows, cols = loc.crop(video.frame_shape)
+    frames = _CroppedFrames(video, rows, cols, options.chunk)
+    setup, sel = _setup(video, loc, background, bearing, options, frames, conditions, path)
+    return loc, frames, setup, sel
+
+
 def track_video(
     path: str | Path, conditions: OperatingConditions, bearing: Bearing, options: TrackOptions | None = None,
     out_dir: str | Path | None = None, progress: bool = True, config: dict[str, Any] | None = None,
@@ -296,11 +335,10 @@ def track_video(
                                 "too short to give a speed.", "Record longer, or lower --window.")
         background = background_frame(video)
         loc = _locate(video, background, bearing, path)
-        rows, cols = loc.crop(video.frame_shape)
-        frames = _CroppedFrames(video, rows, cols, options.chunk)
         try:
-            setup, sel = _setup(video, loc, background, bearing, options, frames, conditions, path)
+            loc, frames, setup, sel = _select(video, loc, background, bearing, options, conditions, path)
         except SelectionError as exc:
+            rows, cols = loc.crop(video.frame_shape)
             if out_dir is not None and exc.table is not None:
                 shown = exc.table.assign(u_px=exc.table.u_px + cols.start, v_px=exc.table.v_px + rows.start)
                 qc_png = write_selection_qc(Path(out_dir) / "qc", _stem(path), video[0], shown, exc.ring,
@@ -308,6 +346,7 @@ def track_video(
                 raise SelectionError(path, f"{exc.message} No trace written; QC: {qc_png}.", exc.hint,
                                      exc.table, exc.found, exc.ring) from None
             raise
+        rows, cols = frames.rows, frames.cols
         with tqdm(total=len(video), desc=path.name, unit="frame", disable=not progress, leave=False) as bar:
             table = _track_all(path, fps, video, frames, times, setup, options, bar.update)
         table["u_px"] += cols.start
