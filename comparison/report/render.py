@@ -35,7 +35,6 @@ th{background:#f3f3f3}tr.failed td{background:#fde8e8}tr.mismatch td{background:
 <div>tracking QC: {% if s.qc_pass %}<span class="pass">pass</span>{% else %}<span class="fail">fail</span>: {{ s.qc_reasons | join('; ') }}{% endif %}</div>
 {% if s.svg %}<img alt="slip rate against orbital angle, measured and simulated" src="data:image/svg+xml;base64,{{ s.svg | b64 }}">{% endif %}</div>{% endfor %}
 {% for f in r.failures %}<div class="card"><h3>{{ f.title }}</h3><span class="fail">failed</span>: {{ f.message }}</div>{% endfor %}</div>
-<p class="note">{{ r.definition }}</p>
 <h2>Conditions</h2>
 <table><thead><tr><th>Speed (r/min)</th><th>Radial load (N)</th><th>Axial load (N)</th><th>Video</th><th>Status</th></tr></thead>
 <tbody>{% for c in r.conditions %}<tr>{% for v in c %}<td>{{ v }}</td>{% endfor %}</tr>{% endfor %}</tbody></table>

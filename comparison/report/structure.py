@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Mapping, Sequence
 from datetime import datetime, timezone
 from typing import Any
@@ -53,7 +54,7 @@ def _section(d: ConditionDescription) -> dict[str, Any]:
             section["figures"].append({"caption": "Contact trajectory on the raceways (simulated, spatial model; "
                                                   "the paper's figure 13): how far the contact angle swings "
                                                   "around the orbit.", "svg": figures.contact_track_figure(d)})
-        section["facts"] += [("settling time left out of the simulation", f"{d.comparison.settle_s:g} s"),
+        section["facts"] += [("settling time left out of the simulation", f"{1e3 * d.comparison.settle_s:.0f} ms"),
                              ("slip reference", SLIP_REFERENCES.get(r.slip_reference, r.slip_reference)),
                              ("peak slip estimator", f"maximum over 0-180 deg of the 1 deg mean profile smoothed by "
                                                      f"a periodic Gaussian of sigma {PEAK_SMOOTHING_DEG:g} deg "
@@ -87,10 +88,17 @@ def _qc(d: ConditionDescription) -> dict[str, Any]:
     return {"title": d.label, "facts": facts}
 
 
+def _number(value: float) -> str:
+    """A table cell: blank for an unknown (NaN) number, e.g. a failed video's unread conditions."""
+    return f"{value:g}" if math.isfinite(value) else ""
+
+
 def build_report(descriptions: Sequence[ConditionDescription], failed_rows: Sequence[ComparisonRow] = (),
                  reproduction: Mapping[str, Any] | None = None, timings: Mapping[str, float] | None = None,
                  title: str = "cageless: model against experiment") -> dict[str, Any]:
     """The report's structure: conditions, the Table-2-style table, one section per condition, QC, reproduction."""
+    descriptions = sorted(descriptions, key=lambda d: (d.row.speed_rpm, d.row.radial_load_n, d.row.axial_load_n,
+                                                       d.row.label))  # the slip table's order
     rows = [d.row for d in descriptions] + list(failed_rows)
     frame = table_frame(rows)
     repro = [("software version", __version__)] + [(k, v if isinstance(v, str) else json.dumps(v, sort_keys=True))
@@ -107,7 +115,7 @@ def build_report(descriptions: Sequence[ConditionDescription], failed_rows: Sequ
     return {
         "title": title,
         "generated_utc": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC"),
-        "conditions": [[f"{r.speed_rpm:g}", f"{r.radial_load_n:g}", f"{r.axial_load_n:g}", r.label, r.status]
+        "conditions": [[_number(r.speed_rpm), _number(r.radial_load_n), _number(r.axial_load_n), r.label, r.status]
                        for r in table_frame(rows).itertuples()],
         "table_html": to_html(frame),
         "definition": f"{SLIP_RATE_DEFINITION} {slip_reference_note(frame)}",

@@ -82,7 +82,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
                          parameter_set=args.parameter_set or DEFAULT_SET)
     print(f"parameters: {note}" if note else f"parameters: set '{options.parameter_set}'")
     res = run_lab(args.lab, args.out, options, bearing_from_config(config), progress=not args.quiet)
-    for row in res.rows:
+    for row in sorted(res.rows, key=lambda r: (r.status == "failed", r.speed_rpm, r.radial_load_n, r.label)):
         if row.status == "failed":
             print(failed_line(row.label, row.message), file=sys.stderr)
         else:
