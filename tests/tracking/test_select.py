@@ -128,7 +128,7 @@ def test_wrong_speed_is_refused_without_a_trace(bright, capsys):
     out = d / "wrong"
     assert main(["track", str(clip["video"]), "-o", str(out), "-q", "--speed-rpm", "6000"]) == 1
     text = capsys.readouterr().err
-    assert "FAILED bright.cine" in text and "No trace written" in text
+    assert f"FAILED {clip['video']}: found" in text and "No trace written" in text  # a single video: as typed
     assert not list(out.glob("*.trace.h5"))
     table = pd.read_csv(out / "qc" / "bright.candidates.csv")
     assert (table.status == "rejected").all() and "wrong speed" in set(table.reason)

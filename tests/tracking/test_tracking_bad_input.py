@@ -60,7 +60,8 @@ def test_wrong_ball_count_is_an_error_with_qc_and_no_trace(tmp_path, capsys):
     --n-balls 13 tracks them."""
     g13 = dataclasses.replace(B.geometry, n_balls=13)
     video = _clip(tmp_path / "thirteen.cine", n=30, geometry=g13)
-    with pytest.raises(TrackingError, match=r"thirteen.cine: found 13 balls .* the bearing has 14\. No trace written"):
+    with pytest.raises(TrackingError, match=r"thirteen.cine: found 13 balls .* but 14 are expected \(the "
+                                            r"bearing's ball count, or --n-balls\)\. No trace written"):
         track_video(video, COND, B, out_dir=tmp_path / "out", progress=False)
     assert not list(tmp_path.rglob("*.trace.h5"))
     assert (tmp_path / "out" / "qc" / "thirteen.selection.png").is_file()
@@ -68,7 +69,7 @@ def test_wrong_ball_count_is_an_error_with_qc_and_no_trace(tmp_path, capsys):
     assert set(table.status) <= {"selected", "rejected"} and table.reason.notna().sum() > 0
     assert main(["track", str(video), "-o", str(tmp_path / "cli"), "-q", "--speed-rpm", "3000"]) == 1
     text = capsys.readouterr().err
-    assert "FAILED thirteen.cine" in text and "--n-balls 13" in text
+    assert f"FAILED {video}: found 13 balls" in text and "--n-balls 13" in text  # a single video: as typed
     assert not list((tmp_path / "cli").glob("*.trace.h5"))
     assert main(["track", str(video), "-o", str(tmp_path / "cli"), "-q", "--speed-rpm", "3000", "--n-balls", "13"]) == 0
     assert read_trace(tmp_path / "cli" / "thirteen.trace.h5").n_balls == 13
