@@ -66,14 +66,14 @@ def test_the_solution_depends_on_the_deborah_number_alone(mod):
 
 def test_in_the_unloaded_zone_the_term_is_saturated_small_and_falls_with_cho(mod):
     # 1800 rpm, 500 N, the paper's C_ho range (Wang et al. 2026, sec. 4): measured with the benchmark,
-    # De 24-73, x_bar 3.1 -> 2.1 um, power 1.73 -> 1.21 mW beside the Chiu rolling loss's 31.8 mW
+    # De 24-73, x_bar 3.1 -> 2.1 um, power 1.73 -> 1.21 mW beside the Chiu rolling loss's 27.7 mW (default r_s 0.210 mm)
     rows = [r for r in mod.contact_rows() if r["contact"] == "unloaded outer" and r["cho"] > 0]
     assert [r["cho"] for r in rows] == [2500.0, 5000.0, 7500.0]
     assert min(r["de"] for r in rows) > 20.0
     powers = [r["p_h_mw"] for r in rows]
     assert powers[0] > powers[1] > powers[2]
-    assert powers[0] < 0.06 * rows[0]["p_chiu_mw"]
-    assert (powers[0] - powers[2]) < 0.02 * rows[0]["p_chiu_mw"]
+    assert powers[0] < 0.07 * rows[0]["p_chiu_mw"]  # 6.3 %
+    assert (powers[0] - powers[2]) < 0.02 * rows[0]["p_chiu_mw"]  # 1.9 %
 
 
 def test_in_the_loaded_zone_the_term_exceeds_the_catalogue_friction_tenfold(mod):
@@ -87,9 +87,9 @@ def test_in_the_loaded_zone_the_term_exceeds_the_catalogue_friction_tenfold(mod)
 
 
 def test_no_damping_makes_the_unloaded_term_more_than_a_tenth_of_the_chiu_loss(mod):
-    # x_bar / b = phi(De) peaks near De ~ 1.7 (C_ho ~ 180 N s/m here): measured 3.38 mW, 10.6 % of 31.8 mW. So no
-    # C_ho range can move the unloaded-zone losses, which set the slip beyond gravity's 5.6 %, by more than ~11 %.
+    # x_bar / b = phi(De) peaks near De ~ 1.7 (C_ho ~ 180 N s/m here): measured 3.38 mW, 12.2 % of 27.7 mW. So no
+    # C_ho range can move the unloaded-zone losses, which set the slip beyond gravity's 5.6 %, by more than ~13 %.
     scan = tuple(float(c) for c in __import__("numpy").geomspace(10.0, 10000.0, 13))
     rows = [r for r in mod.contact_rows(cho_values=scan) if r["contact"] == "unloaded outer"]
     ratio = max(r["p_h_mw"] / r["p_chiu_mw"] for r in rows)
-    assert 0.08 < ratio < 0.11, ratio
+    assert 0.10 < ratio < 0.13, ratio
