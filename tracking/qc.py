@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import logging
 import math
+import textwrap
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -259,8 +260,11 @@ def write_selection_qc(qc_dir: Path, stem: str, frame: np.ndarray | None, table:
         p = (int(round(r.u_px * scale)), int(round(r.v_px * scale)))
         cv2.circle(img, p, 3 * scale if r.status == "selected" else 2 * scale, colour, 1, cv2.LINE_AA)
     counts = table.assign(key=np.where(table.status == "selected", "selected", table.reason)).key.value_counts()
-    y = 18
-    cv2.putText(img, title[:90], (6, y), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (255, 255, 255), 1, cv2.LINE_AA)
+    y = 2
+    char_px = cv2.getTextSize("x", cv2.FONT_HERSHEY_SIMPLEX, 0.45, 1)[0][0]
+    for line in textwrap.wrap(title, width=max(20, (img.shape[1] - 12) // max(char_px, 1))):  # the whole title
+        y += 16
+        cv2.putText(img, line, (6, y), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (255, 255, 255), 1, cv2.LINE_AA)
     for reason, n in counts.items():
         y += 16
         cv2.putText(img, f"{reason}: {n}", (6, y), cv2.FONT_HERSHEY_SIMPLEX, 0.45,

@@ -3,6 +3,7 @@ and the last-resort handler (issue 17)."""
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import time
@@ -38,6 +39,22 @@ def test_r01_sample_may_replace_what_it_wrote_itself(tmp_path, capsys, monkeypat
         (lab / name).write_text("rendered\n")
     assert_clean(cli(capsys, "sample", lab, "-q"), 0)
     assert len(calls) == 2
+
+
+def test_sample_does_not_replace_a_file_edited_since_it_wrote_it(tmp_path, capsys, monkeypatch):
+    """The manifest records what each file held: a conditions.csv the user edited is kept, not restored."""
+    monkeypatch.setattr("cageless.tracking.synthetic.lab.make_lab", lambda out, **kw: [])
+    lab = tmp_path / "s"
+    lab.mkdir()
+    assert_clean(cli(capsys, "sample", lab, "-q"), 0)
+    (lab / "conditions.csv").write_text("rendered\n")
+    assert_clean(cli(capsys, "sample", lab, "-q"), 0)  # the second run records what it wrote
+    (lab / "conditions.csv").write_text("edited by hand\n")
+    assert_clean(cli(capsys, "sample", lab, "-q"), 2, "conditions.csv", "edited since", "--overwrite")
+    assert (lab / "conditions.csv").read_text() == "edited by hand\n"
+    assert_clean(cli(capsys, "sample", lab, "-q", "--overwrite"), 0)
+    manifest = json.loads((lab / ".cageless-sample.json").read_text())
+    assert "clip_3000rpm.toml" not in manifest["files"] and "run_1800.toml" in manifest["files"]
 
 
 def test_r03_simulate_overwrite_flag_replaces_a_foreign_file(tmp_path, capsys):

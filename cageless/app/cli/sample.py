@@ -68,7 +68,9 @@ def _targets(specs: Any) -> list[str]:
     names = {"conditions.csv", "README.md"}
     for spec in specs:
         stem = Path(spec.name).stem
-        names |= {spec.name, f"{stem}.truth.csv", f"{stem}.truth.json", f"{stem}.toml"}
+        names |= {spec.name, f"{stem}.truth.csv", f"{stem}.truth.json"}
+        if spec.conditions_via == "sidecar":
+            names.add(f"{stem}.toml")
     return sorted(names)
 
 
@@ -79,14 +81,23 @@ def _refuse_foreign(out: Any, targets: list[str], overwrite: bool) -> None:
     from cageless.errors import UsageError
 
     try:
-        ours = set(json.loads((out / _MANIFEST).read_text()).get("files", []))
-    except (OSError, ValueError, AttributeError):
-        ours = set()
+        manifest = json.loads((out / _MANIFEST).read_text())
+        ours, digests = set(manifest.get("files", [])), dict(manifest.get("sha256", {}))
+    except (OSError, ValueError, AttributeError, TypeError):
+        ours, digests = set(), {}
     foreign = [n for n in targets if (out / n).exists() and n not in ours]
-    if foreign and not overwrite:
-        shown = ", ".join(foreign[:4]) + (f" and {len(foreign) - 4} more" if len(foreign) > 4 else "")
-        raise UsageError(f"{out}: already holds {shown}, which 'cageless sample' would replace and did not write. "
-                         "Choose an empty folder, or pass --overwrite.")
+    edited = [n for n in targets if n in digests and (out / n).is_file() and _sha256(out / n) != digests[n]]
+    for names, what in ((foreign, "did not write"), (edited, "wrote but which were edited since")):
+        if names and not overwrite:
+            shown = ", ".join(names[:4]) + (f" and {len(names) - 4} more" if len(names) > 4 else "")
+            raise UsageError(f"{out}: already holds {shown}, which 'cageless sample' would replace and {what}. "
+                             "Choose an empty folder, or pass --overwrite.")
+
+
+def _sha256(path: Any) -> str:
+    import hashlib
+
+    return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
 def _record(out: Any, targets: list[str], done: bool) -> None:
@@ -95,4 +106,5 @@ def _record(out: Any, targets: list[str], done: bool) -> None:
 
     from cageless.atomic import atomic_write_text
 
-    atomic_write_text(out / _MANIFEST, json.dumps({"files": targets, "complete": done}, indent=1))
+    digests = {n: _sha256(out / n) for n in targets if done and (out / n).is_file()}
+    atomic_write_text(out / _MANIFEST, json.dumps({"files": targets, "complete": done, "sha256": digests}, indent=1))

@@ -229,8 +229,8 @@ def _summary_line(trace: Any, sol: Any, out: str) -> str:
     else:  # a start-up transient's peak is not a slip anyone should quote
         slip = (f"no settled slip: the run is within the {1e3 * startup:.0f} ms start-up that compare and report "
                 f"leave out (simulate at least --duration {startup + 0.1:.2g})")
-    dp5_only = sol.method in ("dp5", "auto: dp5")
-    by, uncounted = ("", "") if dp5_only else (" by DP5", "; CVODE's and scipy's own rejections are not counted")
+    compiled_only = sol.method in ("dp5", "auto: dp5", "ark4", "rosw")  # the compiled methods count their own
+    by, uncounted = ("", "") if compiled_only else (" by DP5", "; CVODE's and scipy's own rejections are not counted")
     return (f"{trace.status} ({sol.method}): {sol.n_steps} steps, {sol.n_rejected} rejected{by} "
             f"({sol.n_onset_retries} at contact onsets, {sol.n_force_jump_retries} at force jumps; "
             f"{sol.n_contact_changes} contact changes; {sol.n_stiff_steps} at the stability edge){uncounted}, "
