@@ -17,7 +17,7 @@ from cageless.atomic import atomic_write_text
 from cageless.comparison.compare import SLIP_REFERENCES, ComparisonRow
 from cageless.comparison.metrics import SLIP_RATE_DEFINITION
 
-__all__ = ["table_frame", "slip_reference_note", "to_csv", "to_markdown", "to_latex", "to_html", "write_tables",
+__all__ = ["table_frame", "number_cell", "slip_reference_note", "to_csv", "to_markdown", "to_latex", "to_html", "write_tables",
            "HEADERS"]
 
 HEADERS = {
@@ -46,7 +46,7 @@ def _headers(frame: pd.DataFrame) -> list[str]:
     return (["Video"] if _labelled(frame) else []) + list(HEADERS.values())
 
 
-def _number(value: float, fmt: str) -> str:
+def number_cell(value: float, fmt: str = "g") -> str:
     """A table cell: blank for a value that is not known (NaN), e.g. a failed video's unread speed."""
     return format(value, fmt) if isinstance(value, int | float) and math.isfinite(value) else ""
 
@@ -56,11 +56,11 @@ def _cells(frame: pd.DataFrame) -> list[list[str]]:
     labelled = _labelled(frame)
     for _, r in frame.iterrows():
         cells = [str(r["label"] or "")] if labelled else []
-        cells += [_number(r[c], "g") for c in ("speed_rpm", "radial_load_n", "axial_load_n")]
+        cells += [number_cell(r[c], "g") for c in ("speed_rpm", "radial_load_n", "axial_load_n")]
         if r["status"] == "failed":
             cells += ["failed"] + [""] * 4
         else:
-            cells += [_number(r[c], ".2f") for c in list(HEADERS)[3:]]
+            cells += [number_cell(r[c], ".2f") for c in list(HEADERS)[3:]]
         out.append(cells)
     return out
 
@@ -69,7 +69,7 @@ def _notes(frame: pd.DataFrame) -> list[str]:
     notes = [SLIP_RATE_DEFINITION, slip_reference_note(frame)]
     for _, r in frame.iterrows():
         if r["status"] != "ok":
-            where = (f" ({_number(r['speed_rpm'], 'g')} r/min, {_number(r['radial_load_n'], 'g')} N)"
+            where = (f" ({number_cell(r['speed_rpm'], 'g')} r/min, {number_cell(r['radial_load_n'], 'g')} N)"
                      if math.isfinite(r["speed_rpm"]) else "")
             notes.append(f"{r['label'] or 'condition'}{where}: {r['status']}: {r['message']}")
     return notes

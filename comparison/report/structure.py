@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import math
 from collections.abc import Mapping, Sequence
 from datetime import datetime, timezone
 from typing import Any
@@ -14,7 +13,7 @@ from cageless.comparison.metrics import SLIP_RATE_DEFINITION
 from cageless.profiles import PEAK_SMOOTHING_DEG
 from cageless.comparison.report import figures
 from cageless.comparison.report.describe import ConditionDescription, tracking_verdict
-from cageless.comparison.table import slip_reference_note, table_frame, to_html
+from cageless.comparison.table import number_cell, slip_reference_note, table_frame, to_html
 
 __all__ = ["build_report"]
 
@@ -88,11 +87,6 @@ def _qc(d: ConditionDescription) -> dict[str, Any]:
     return {"title": d.label, "facts": facts}
 
 
-def _number(value: float) -> str:
-    """A table cell: blank for an unknown (NaN) number, e.g. a failed video's unread conditions."""
-    return f"{value:g}" if math.isfinite(value) else ""
-
-
 def build_report(descriptions: Sequence[ConditionDescription], failed_rows: Sequence[ComparisonRow] = (),
                  reproduction: Mapping[str, Any] | None = None, timings: Mapping[str, float] | None = None,
                  title: str = "cageless: model against experiment") -> dict[str, Any]:
@@ -115,7 +109,7 @@ def build_report(descriptions: Sequence[ConditionDescription], failed_rows: Sequ
     return {
         "title": title,
         "generated_utc": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC"),
-        "conditions": [[_number(r.speed_rpm), _number(r.radial_load_n), _number(r.axial_load_n), r.label, r.status]
+        "conditions": [[*(number_cell(v) for v in (r.speed_rpm, r.radial_load_n, r.axial_load_n)), r.label, r.status]
                        for r in table_frame(rows).itertuples()],
         "table_html": to_html(frame),
         "definition": f"{SLIP_RATE_DEFINITION} {slip_reference_note(frame)}",

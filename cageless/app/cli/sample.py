@@ -79,6 +79,7 @@ def _refuse_foreign(out: Any, targets: list[str], overwrite: bool) -> None:
     import json
 
     from cageless.errors import UsageError
+    from cageless.provenance import sha256_file
 
     try:
         manifest = json.loads((out / _MANIFEST).read_text())
@@ -86,7 +87,8 @@ def _refuse_foreign(out: Any, targets: list[str], overwrite: bool) -> None:
     except (OSError, ValueError, AttributeError, TypeError):
         ours, digests = set(), {}
     foreign = [n for n in targets if (out / n).exists() and n not in ours]
-    edited = [n for n in targets if n in digests and (out / n).is_file() and _sha256(out / n) != digests[n]]
+    edited = [n for n in targets
+              if n in digests and (out / n).is_file() and sha256_file(out / n, cache=False) != digests[n]]
     for names, what in ((foreign, "did not write"), (edited, "wrote but which were edited since")):
         if names and not overwrite:
             shown = ", ".join(names[:4]) + (f" and {len(names) - 4} more" if len(names) > 4 else "")
@@ -94,17 +96,12 @@ def _refuse_foreign(out: Any, targets: list[str], overwrite: bool) -> None:
                              "Choose an empty folder, or pass --overwrite.")
 
 
-def _sha256(path: Any) -> str:
-    import hashlib
-
-    return hashlib.sha256(path.read_bytes()).hexdigest()
-
-
 def _record(out: Any, targets: list[str], done: bool) -> None:
     """Remember which names this command writes (before rendering, so a killed run can be re-run)."""
     import json
 
     from cageless.atomic import atomic_write_text
+    from cageless.provenance import sha256_file
 
-    digests = {n: _sha256(out / n) for n in targets if done and (out / n).is_file()}
+    digests = {n: sha256_file(out / n, cache=False) for n in targets if done and (out / n).is_file()}
     atomic_write_text(out / _MANIFEST, json.dumps({"files": targets, "complete": done, "sha256": digests}, indent=1))

@@ -192,15 +192,15 @@ def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bear
 def _namer(inputs: list[str]) -> Callable[[Path], str]:
     """How a video is named on its ``ok``/``FAILED`` line, the same way on every line of a run: relative to the
     input folder it was found in (as the report names it), else as given on the command line."""
-    folders = [Path(i).resolve() for i in inputs if Path(i).is_dir()]
-    given = {Path(i).resolve(): i for i in inputs if not Path(i).is_dir()}
+    typed = {Path(i).resolve(): i for i in inputs}
+    folders = [full for full in typed if full.is_dir()]
 
     def shown(video: Path) -> str:
         full = Path(video).resolve()
         for folder in folders:
             if full != folder and full.is_relative_to(folder):
                 return full.relative_to(folder).as_posix()
-        return given.get(full, next((i for i in inputs if Path(i).resolve() == full), str(video)))
+        return typed.get(full, str(video))
 
     return shown
 
