@@ -202,17 +202,30 @@ def read_sidecar(path: str | Path) -> dict[str, float]:
     return out
 
 
-def read_conditions_csv(path: str | Path) -> dict[str, dict[str, float]]:
+def read_conditions_csv(
+    path: str | Path, row_errors: dict[str, ConditionsError] | None = None
+) -> dict[str, dict[str, float]]:
     """Read a folder's ``conditions.csv`` into ``{file name: {key: value}}``.
 
     Empty cells are left out (they take the default). Rows are matched to videos
     by file name or by stem.
 
+    Parameters
+    ----------
+    path
+        The CSV file.
+    row_errors
+        When given, a problem confined to one row (a non-numeric cell, a file
+        listed twice) does not fail the whole table: the row is left out and
+        its error is stored here under the row's file name, so that only that
+        video fails. A row with an empty ``file`` cell is then skipped with a
+        warning.
+
     Raises
     ------
     ConditionsError
-        On a missing ``file`` or ``speed_rpm`` column, an unknown column, a
-        non-numeric cell or a duplicated file.
+        On a missing ``file`` or ``speed_rpm`` column, an unknown column, or
+        (without ``row_errors``) a non-numeric cell or a duplicated file.
     """
     path = Path(path)
     sep, decimal = _csv_dialect(path)
@@ -237,23 +250,41 @@ def read_conditions_csv(path: str | Path) -> dict[str, dict[str, float]]:
             log.warning("%s: ignoring column '%s'; the columns read are file, %s", path, col, ", ".join(_SOURCE_KEYS))
             table = table.drop(columns=col)
     rows: dict[str, dict[str, float]] = {}
+    seen: set[str] = set()
     for i, row in table.iterrows():
         line = int(i) + 2  # 1-based, after the header
         name = str(row["file"]).strip()
-        if not name or name == "nan":
-            raise ConditionsError(path, f"line {line}: empty 'file' cell.")
-        if name in rows:
-            raise ConditionsError(path, f"line {line}: '{name}' is listed twice.", "Keep one row per video.")
-        values: dict[str, float] = {}
-        for key in _SOURCE_KEYS:
-            if key not in table.columns or pd.isna(row[key]):
-                continue
-            try:
-                values[key] = float(row[key])
-            except (TypeError, ValueError):
-                raise ConditionsError(path, f"line {line}: '{key}' = {row[key]!r} is not a number.") from None
-        rows[name] = values
+        try:
+            if not name or name == "nan":
+                raise ConditionsError(path, f"line {line}: empty 'file' cell.", "Name the video in the 'file' column.")
+            if name in seen:
+                rows.pop(name, None)  # neither row can be trusted
+                raise ConditionsError(path, f"line {line}: '{name}' is listed twice.", "Keep one row per video.")
+            seen.add(name)
+            rows[name] = _csv_values(path, line, row, table.columns)
+        except ConditionsError as exc:
+            if row_errors is None:
+                raise
+            if not name or name == "nan":
+                log.warning("%s", exc)
+            else:
+                row_errors[name] = exc
     return rows
+
+
+def _csv_values(path: Path, line: int, row: pd.Series, columns: pd.Index) -> dict[str, float]:
+    """The numeric condition values of one CSV row, empty cells left out."""
+    values: dict[str, float] = {}
+    for key in _SOURCE_KEYS:
+        if key not in columns or pd.isna(row[key]):
+            continue
+        try:
+            values[key] = float(row[key])
+        except (TypeError, ValueError):
+            raise ConditionsError(
+                path, f"line {line}: '{key}' = {row[key]!r} is not a number.", "Write a plain number in that cell."
+            ) from None
+    return values
 
 
 def _csv_dialect(path: Path) -> tuple[str, str]:
@@ -342,6 +373,25 @@ def _csv_row(video: Path, table: Mapping[str, Mapping[str, float]]) -> Mapping[s
     return table.get(video.name, table.get(stem))
 
 
+def _csv_row_error(video: Path, row_errors: Mapping[str, ConditionsError]) -> ConditionsError | None:
+    """The error of the CSV row that names ``video``, if that row was malformed."""
+    stem = video.name if video.is_dir() else video.stem
+    return row_errors.get(video.name, row_errors.get(stem))
+
+
+def _warn_disagreement(video: Path, sources: list[tuple[str, Mapping[str, float] | None]]) -> None:
+    """Log each key two sources give different values for, naming which one wins."""
+    given = [(label, values) for label, values in sources if values]
+    for i, (label, values) in enumerate(given):
+        for lower_label, lower in given[i + 1:]:
+            for key in sorted(set(values) & set(lower)):
+                if not math.isclose(values[key], lower[key], rel_tol=1e-9):
+                    log.warning(
+                        "%s: %s = %g from the %s overrides %g from the %s; remove one if it is wrong",
+                        video.name, key, values[key], label, lower[key], lower_label,
+                    )
+
+
 def resolve_conditions(
     video: str | Path, csv_table: Mapping[str, Mapping[str, float]] | None = None
 ) -> ResolvedConditions:
@@ -363,12 +413,17 @@ def resolve_conditions(
     video = Path(video)
     if csv_table is None:
         csv_path = video.parent / CONDITIONS_CSV
-        csv_table = read_conditions_csv(csv_path) if csv_path.is_file() else {}
+        row_errors: dict[str, ConditionsError] = {}
+        csv_table = read_conditions_csv(csv_path, row_errors) if csv_path.is_file() else {}
+        row_error = _csv_row_error(video, row_errors)
+        if row_error is not None:
+            raise row_error
     sources: list[tuple[str, Mapping[str, float] | None]] = []
     sidecar = _sidecar_for(video)
     sources.append((f"sidecar {sidecar.name}" if sidecar else "", read_sidecar(sidecar) if sidecar else None))
     sources.append((CONDITIONS_CSV, _csv_row(video, csv_table)))
     sources.append(("file name", parse_file_name(video)))
+    _warn_disagreement(video, sources)
     merged: dict[str, float] = {}
     origin: dict[str, str] = {}
     for label, values in reversed(sources):  # lowest precedence first, higher ones overwrite
@@ -495,28 +550,32 @@ def discover_lab(folder: str | Path) -> list[LabEntry]:
     """Find every video of a lab folder and resolve its conditions.
 
     A video whose conditions cannot be resolved gets an entry carrying the
-    error; the others are unaffected. A malformed ``conditions.csv`` is an error
-    for every video, since any of them may depend on it.
+    error; the others are unaffected. A bad row of ``conditions.csv`` fails only
+    the video it names; a ``conditions.csv`` that cannot be read as a table at
+    all (no ``file`` or ``speed_rpm`` column, bad syntax) is an error for every
+    video, since any of them may depend on it.
     """
     folder = Path(folder)
     videos = find_videos(folder)
     csv_path = folder / CONDITIONS_CSV
     csv_error: ConditionsError | None = None
     table: dict[str, dict[str, float]] = {}
+    row_errors: dict[str, ConditionsError] = {}
     if csv_path.is_file():
         try:
-            table = read_conditions_csv(csv_path)
+            table = read_conditions_csv(csv_path, row_errors)
         except ConditionsError as exc:
             csv_error = exc
     known = {v.name for v in videos} | {v.stem for v in videos}
-    for name in sorted(set(table) - known):
+    for name in sorted((set(table) | set(row_errors)) - known):
         log.warning("%s: row '%s' matches no video in the folder", csv_path, name)
     entries = [LabEntry(video=p, error=ConditionsError(
         p, f"is a broken symbolic link (to {os.readlink(p)}): the file it points to is missing.",
         "Fix or remove the link.")) for p in _dangling_links(folder)]
     for video in videos:
-        if csv_error is not None:
-            entries.append(LabEntry(video=video, error=csv_error))
+        error = csv_error or _csv_row_error(video, row_errors)
+        if error is not None:
+            entries.append(LabEntry(video=video, error=error))
             continue
         try:
             entries.append(LabEntry(video=video, resolved=resolve_conditions(video, table)))

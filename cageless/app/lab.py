@@ -212,15 +212,23 @@ class _Cache:
 
 # -- executors ------------------------------------------------------------------------------------------
 
+def _announce_failure(label: str, stage: str, message: str, progress: bool) -> None:
+    """Say at once that one input failed, so a long run does not hide it until the end."""
+    if progress:
+        tqdm.write(f"FAILED {label} ({stage}): {message.splitlines()[0] if message else ''}", file=sys.stderr)
+
+
 def _run_jobs(pool: Any, jobs: list[tuple[Callable[..., tuple[str, str]], tuple[Any, ...]]], desc: str,
-              progress: bool) -> list[tuple[str, str]]:
+              progress: bool, labels: list[str] | None = None) -> list[tuple[str, str]]:
     futures: list[Future[Any]] = [pool.submit(fn, *args) for fn, args in jobs]
     out = []
-    for fut in tqdm(futures, desc=desc, disable=not progress or not futures, leave=False):
+    for i, fut in enumerate(tqdm(futures, desc=desc, disable=not progress or not futures, leave=False)):
         try:
             out.append(fut.result())
         except Exception as exc:  # a crashed worker fails its job only  # noqa: BLE001
             out.append(("failed", f"{type(exc).__name__}: {exc}"))
+        if out[-1][0] != "ok" and labels is not None:
+            _announce_failure(labels[i], desc, out[-1][1], progress)
     return out
 
 
@@ -310,6 +318,8 @@ def _run_lab(folder: str | Path, out: Path, options: LabOptions | None, bearing:
     failed: list[ComparisonRow] = [_failed_row(e.video.name, None, str(e.error)) for e in entries if not e.ok]
     bearings, bad = _entry_bearings([e for e in entries if e.ok], bearing)
     failed += bad
+    for row in failed:
+        _announce_failure(row.label, "conditions", row.message, progress)
     good = [e for e in entries if e.ok and e.video in bearings]
     with job_pool(options.workers, options.scheduler) as pool:
         t0 = time.perf_counter()
@@ -399,7 +409,7 @@ def _track_all(pool: Any, entries: list[LabEntry], bearings: dict[Path, Bearing]
                                   n_balls)))
         keys.append(key)
         pending.append(e.video)
-    _collect(traces, pending, keys, _run_jobs(pool, jobs, "tracking", progress), cache)
+    _collect(traces, pending, keys, _run_jobs(pool, jobs, "tracking", progress, [p.name for p in pending]), cache)
     return traces, len(entries) - len(jobs)
 
 
@@ -436,5 +446,6 @@ def _simulate_all(pool: Any, entries: list[LabEntry], traces: dict[Path, Any], b
         notice = compile_notice()
         if notice:
             tqdm.write(notice, file=sys.stderr)
-    _collect(sims, pending, keys, _run_jobs(pool, jobs, "simulation", progress), cache)
+    _collect(sims, pending, keys, _run_jobs(pool, jobs, "simulation", progress, [_sim_name(k) for k in pending]),
+             cache)
     return sims, len(conditions) - len(jobs)

@@ -120,6 +120,33 @@ def test_precedence_is_sidecar_then_csv_then_name(tmp_path):
     assert r.origin["speed_rpm"] == "sidecar n3000_Fr500_Fa0.toml"
 
 
+def test_disagreeing_sources_are_logged(tmp_path, caplog):
+    video = _touch(tmp_path / "n3000_Fr500_Fa0.cine")
+    (tmp_path / "conditions.csv").write_text("file,speed_rpm,radial_load_n\nn3000_Fr500_Fa0.cine,1800,500\n")
+    with caplog.at_level("WARNING", logger="cageless.conditions"):
+        r = resolve_conditions(video)
+    assert r.conditions.speed_rpm == 1800.0
+    # The agreeing load is not reported; the speed is, with both values and both sources.
+    assert [m for m in caplog.messages if "overrides" in m] == [
+        "n3000_Fr500_Fa0.cine: speed_rpm = 1800 from the conditions.csv overrides 3000 from the file name; "
+        "remove one if it is wrong"
+    ]
+
+
+def test_a_bad_csv_row_fails_only_its_video(tmp_path):
+    good, bad = _touch(tmp_path / "good.cine"), _touch(tmp_path / "bad.cine")
+    (tmp_path / "conditions.csv").write_text("file,speed_rpm\ngood.cine,3000\nbad.cine,fast\n,1800\n")
+    entries = {e.video.name: e for e in discover_lab(tmp_path)}
+    assert entries["good.cine"].resolved.conditions.speed_rpm == 3000.0
+    assert "line 3: 'speed_rpm' = 'fast' is not a number" in str(entries["bad.cine"].error)
+    assert resolve_conditions(good).conditions.speed_rpm == 3000.0  # a single video ignores the other row
+    with pytest.raises(ConditionsError, match="line 3"):
+        resolve_conditions(bad)
+    row_errors: dict = {}
+    assert read_conditions_csv(tmp_path / "conditions.csv", row_errors) == {"good.cine": {"speed_rpm": 3000.0}}
+    assert list(row_errors) == ["bad.cine"]
+
+
 def test_two_sidecars_are_ambiguous(tmp_path):
     video = _touch(tmp_path / "clip.cine")
     (tmp_path / "clip.toml").write_text("speed_rpm = 1\n")

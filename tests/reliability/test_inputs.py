@@ -85,6 +85,10 @@ def test_r31_truncated_cine_has_a_cli_flag(tmp_path, capsys, cine40):
     run = cli(capsys, "track", cut, "-o", tmp_path / "o", "--workers", "1", "-q", "--allow-truncated")
     assert_clean(run, 0, "frames", "truncated; using its 34 complete frames of 40 (6 dropped)")
     assert (tmp_path / "o" / "n3000_Fr500.trace.h5").is_file()
+    run = cli(capsys, "info", cut)  # the hint names a flag that info also takes
+    assert_clean(run, 1, "is truncated", "--allow-truncated")
+    run = cli(capsys, "info", cut, "--allow-truncated")
+    assert_clean(run, 0, "frames            34")
 
 
 def test_r32_png_sequence_with_a_missing_frame_names_it(tmp_path, capsys, png30):

@@ -124,3 +124,21 @@ def test_r15_impossible_sidecar_speed_is_a_failed_row(tmp_path, capsys, mini_lab
     assert_clean(run, 1, "clip_3000rpm", "'speed_rpm' = 1e+12", "plausible range", "sidecar clip_3000rpm.toml")
     table = pd.read_csv(tmp_path / "out" / "slip_table.csv")
     assert list(table.status) == ["failed"]  # never a "complete" 100 % slip
+
+
+def test_a_failed_job_is_announced_when_it_fails(capsys):
+    """A long report says at once which input failed, not only in the summary at the end."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from cageless.app.lab import _run_jobs
+
+    def ok() -> tuple[str, str]:
+        return ("ok", "a.trace.h5")
+
+    def crash() -> tuple[str, str]:
+        raise RuntimeError("worker died\nsecond line")
+
+    with ThreadPoolExecutor(1) as pool:
+        out = _run_jobs(pool, [(ok, ()), (crash, ())], "tracking", True, ["a.cine", "b.cine"])
+    assert out == [("ok", "a.trace.h5"), ("failed", "RuntimeError: worker died\nsecond line")]
+    assert "FAILED b.cine (tracking): RuntimeError: worker died\n" in capsys.readouterr().err

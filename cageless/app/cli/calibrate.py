@@ -42,7 +42,7 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--budget", type=int, help="objective evaluations (default 12; 10 per parameter for several)")
     p.add_argument("--seeds", type=int, default=2, help="simulations (seeds 0..K-1) pooled per evaluation (default 2)")
     p.add_argument("--duration", type=finite_float,
-                   help="simulated time after the start-up (s; default: the trace's length, at least one cage "
+                   help="simulated time after the start-up, which is added to it (s; default: the trace's length, at least one cage "
                    "revolution; 0.1 with a target)")
     p.add_argument("--settle", type=finite_float,
                    help="start-up left out (s; default three cage revolutions, at least 0.04)")

@@ -41,6 +41,8 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     )
     p.add_argument("video", nargs="?", help="a video file or image folder to describe instead of the bearing")
     p.add_argument("--fps", type=finite_float, default=None, help="frame-rate override for VIDEO (frames/s)")
+    p.add_argument("--allow-truncated", action="store_true",
+                   help="describe the complete frames of a truncated .cine instead of refusing it")
     p.add_argument("--speed-rpm", type=finite_float, default=3000.0, help="inner-ring speed in rpm (default 3000)")
     p.add_argument(
         "--contact-angle-deg", type=finite_float, default=0.0,
@@ -111,11 +113,11 @@ def _format_text(d: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def describe_video(path: str, fps: float | None = None) -> dict[str, Any]:
+def describe_video(path: str, fps: float | None = None, allow_truncated: bool = False) -> dict[str, Any]:
     """Return what the reader sees in a video, JSON-ready."""
     from cageless.tracking.io import open_video
 
-    with open_video(path, fps=fps) as video:
+    with open_video(path, fps=fps, allow_truncated=allow_truncated) as video:
         meta = video.metadata.to_dict()
         meta["extra"] = {k: v for k, v in meta["extra"].items() if k != "exposure_per_frame_s"}
         try:
@@ -153,7 +155,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
 
     check_options(args, ("fps", "speed_rpm"), force=False)
     if args.video is not None:
-        meta = describe_video(args.video, args.fps)
+        meta = describe_video(args.video, args.fps, args.allow_truncated)
         print(json.dumps(meta, indent=2) if args.json else _format_video(meta))
         return 0
     bearing = bearing_from_config(config)

@@ -32,7 +32,7 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("lab", help="lab folder (videos with their conditions)")
     p.add_argument("-o", "--out", default="report", help="output folder (default ./report)")
     p.add_argument("--duration", type=finite_float,
-                   help="simulated time after the start-up (s; default: the longest video, at least --revolutions "
+                   help="simulated time after the start-up, which is added to it (s; default: the longest video, at least --revolutions "
                    "cage revolutions)")
     p.add_argument("--revolutions", type=finite_float, default=20.0,
                    help="cage revolutions simulated after the start-up, at least (default 20: every 1 deg bin "
@@ -57,8 +57,9 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Run the workflow and print where the report is."""
+    from cageless.conditions import find_videos
     from cageless.config import bearing_from_config
-    from cageless.errors import UsageError
+    from cageless.errors import CagelessError, UsageError
     from cageless.app.lab import LabOptions, run_lab
     from cageless.app.calibrate import describe_calibration
     from cageless.app.cli.common import failed_line, parameter_values
@@ -80,6 +81,9 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
                          scheduler=args.scheduler, force=args.force, parameters=values, calibration=note,
                          n_balls=args.n_balls, slip_reference=args.slip_reference,
                          parameter_set=args.parameter_set or DEFAULT_SET)
+    if not find_videos(args.lab):  # find_videos names a missing folder; say so before any output
+        raise CagelessError(f"{args.lab}: no videos found. A lab folder holds videos (cine, avi/mp4/mkv or image "
+                            "folders) with their conditions.")
     print(f"parameters: {note}" if note else f"parameters: set '{options.parameter_set}'")
     res = run_lab(args.lab, args.out, options, bearing_from_config(config), progress=not args.quiet)
     for row in sorted(res.rows, key=lambda r: (r.status == "failed", r.speed_rpm, r.radial_load_n, r.label)):

@@ -43,8 +43,8 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--radial-load-n", type=finite_float, default=0.0, help="radial load (N, default 0)")
     p.add_argument("--axial-load-n", type=finite_float, default=0.0, help="axial load (N, default 0)")
     p.add_argument("--duration", type=finite_float, default=None,
-                   help="simulated time (s; default: the start-up that compare and report leave out, three cage "
-                   "revolutions, then one more revolution: 0.2 s at 3000 rpm)")
+                   help="total simulated time, start-up included (s; default: the start-up that compare and report "
+                   "leave out, three cage revolutions, then one more revolution: 0.2 s at 3000 rpm)")
     p.add_argument("--gravity", type=finite_float, default=9.81, help="gravity (m/s^2, default 9.81; 0 for none)")
     p.add_argument("--orientation", choices=("horizontal", "vertical"), default="horizontal", help="shaft orientation")
     p.add_argument("--misalignment-rad", type=finite_float, default=0.0,

@@ -34,7 +34,7 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--vary", action="append", default=[], metavar="NAME=SPEC",
                    help="a parameter and its values: start:stop:count or v1,v2,... (repeatable)")
     p.add_argument("--seeds", type=int, default=1, help="seeds per grid point (default 1)")
-    p.add_argument("--duration", type=finite_float, default=0.1, help="simulated time after the start-up (s)")
+    p.add_argument("--duration", type=finite_float, default=0.1, help="simulated time after the start-up, which is added to it (s, default 0.1)")
     p.add_argument("--settle", type=finite_float,
                    help="start-up left out (s; default three cage revolutions at each point, at least 0.04)")
     add_parameter_set_option(p)
