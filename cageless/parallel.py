@@ -34,8 +34,29 @@ def job_pool(workers: int = 2, scheduler: str | None = None) -> Any:
         except (OSError, TimeoutError) as exc:
             raise CagelessError(f"--scheduler {scheduler}: cannot reach the Dask scheduler ({exc}). Check the "
                                 "address and that the scheduler is running, or leave out --scheduler.") from None
-    return ProcessPoolExecutor(max_workers=max(1, workers), mp_context=get_context("spawn"),
-                               initializer=die_with_parent, initargs=(os.getpid(),))
+    return _LocalPool(max_workers=max(1, workers), mp_context=get_context("spawn"),
+                      initializer=die_with_parent, initargs=(os.getpid(),))
+
+
+class _LocalPool(ProcessPoolExecutor):
+    """A process pool that, left by an exception (Ctrl-C, ``kill -TERM``, an error), stops at once.
+
+    The standard executor's ``with`` block waits for every queued job before it lets the exception
+    through; this one cancels the queued jobs and ends the running ones, which write nothing partial
+    (outputs are atomic), so an interrupted run stops in about a second.
+    """
+
+    def __exit__(self, exc_type: Any, exc_val: Any, exc_tb: Any) -> bool:
+        if exc_type is None:
+            return bool(super().__exit__(exc_type, exc_val, exc_tb))
+        processes = list((getattr(self, "_processes", None) or {}).values())
+        self.shutdown(wait=False, cancel_futures=True)
+        for proc in processes:
+            proc.terminate()
+        for proc in processes:
+            proc.join(timeout=5.0)
+        self.shutdown(wait=True)  # the pool is broken now: this only joins its threads and frees its queues
+        return False
 
 
 def die_with_parent(parent_pid: int) -> None:
@@ -47,6 +68,9 @@ def die_with_parent(parent_pid: int) -> None:
     parent.
     """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # tqdm's default lock is a multiprocessing semaphore: a worker ended by an interrupted run could not
+    # release it, and Python would warn of a leaked semaphore. A worker's bars need only a thread lock.
+    tqdm.set_lock(threading.RLock())
     if sys.platform.startswith("linux"):
         try:
             import ctypes

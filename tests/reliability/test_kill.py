@@ -66,6 +66,41 @@ def test_r41_pool_workers_die_with_their_parent(tmp_path):
     assert not any(_alive(w) for w in workers), "a worker outlived its killed parent"
 
 
+def test_kill_term_stops_the_pool_at_once(tmp_path):
+    """``kill -TERM`` (as Ctrl-C) leaves a job pool at once: queued jobs cancelled, running ones ended.
+
+    The standard executor's ``with`` block would first run all four 60-s jobs (two minutes); and a
+    terminated run must not leave leaked-semaphore warnings behind.
+    """
+    script = tmp_path / "parent.py"
+    script.write_text(textwrap.dedent("""
+        import signal, sys, time
+        from cageless.app.cli import _terminated
+        from cageless.parallel import job_pool
+        if __name__ == "__main__":
+            signal.signal(signal.SIGTERM, _terminated)
+            try:
+                with job_pool(2) as pool:
+                    futures = [pool.submit(time.sleep, 60) for _ in range(4)]
+                    while len(pool._processes) < 2:
+                        time.sleep(0.1)
+                    print(*pool._processes, flush=True)
+                    [f.result() for f in futures]
+            except KeyboardInterrupt:
+                sys.exit(130)
+    """))
+    proc = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    workers = [int(x) for x in proc.stdout.readline().split()]
+    time.sleep(1.0)  # the workers have taken their jobs
+    t0 = time.monotonic()
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert time.monotonic() - t0 < 15.0
+    assert len(workers) == 2 and not any(_alive(w) for w in workers)
+    assert "leaked" not in err and "Traceback" not in err, err
+
+
 def _kill_at(argv: list[str], delay_s: float, cwd: Path) -> list[int]:
     """Start ``cageless argv``, SIGKILL the parent only after ``delay_s``; return the pids of its children."""
     proc = subprocess.Popen([sys.executable, "-m", "cageless", *argv], cwd=cwd, stdout=subprocess.DEVNULL,

@@ -197,6 +197,14 @@ def _write_crash_log(text: str, argv: Sequence[str]) -> str | None:
     return None
 
 
+def _terminated(signum: int, frame: object) -> None:
+    """``kill -TERM`` stops a run the way Ctrl-C does: workers ended, nothing partial left."""
+    raise KeyboardInterrupt
+
+
 def entry_point() -> None:
     """Console-script entry: exit with :func:`main`'s code."""
+    import signal
+
+    signal.signal(signal.SIGTERM, _terminated)
     sys.exit(main())
