@@ -18,22 +18,29 @@ Here:
 Measured on the traces of these runs, the inner contact ends at -0.3, -0.2 and -1.3 deg from the horizontal
 (median over passes) at 1800, 3000 and 6000 rpm. So the exit is at the horizontal, as the closed form assumes.
 
-**The losses that are off.** The rolling losses (hydrodynamic rolling force at the race contacts) and drag are
-switched off (forced). The restitution is the default (0.8).
+**The losses that are off.** The rolling losses (hydrodynamic rolling force at the race contacts), drag and the
+film-regime traction are switched off (forced). The film-regime traction is a loss here: in full film it limits
+the traction to the Bair-Winer shear stress of the thin, lightly loaded unloaded-zone contact, so the ball slides
+while gravity slows it and the sliding dissipates (measured with it on: 7.45 / 0.97 % at 1800 / 6000 rpm, above
+even a sliding ball's 1 - sqrt(1 - g r / (0.5 v^2)) = 7.95 / 0.69 %). Without it the race traction is the
+slide-to-roll curve, which holds the ball rolling. The restitution is the default (0.8).
 
 **The lubricant damping stays on.** It acts only on the normal approach speed at the race contacts, so a ball
 rolling on the outer race at constant radius feels none of it. Without it, the ring and balls ring undamped
 after the start: measured peak slips were then 3.37 / 1.20 / 0.33 %, *below* the closed form, because
 vibration energy feeds the balls. So switching it off is not possible here.
 
-**What is compared.** The quantity compared is the peak of the mean slip profile in the unloaded zone
-(:func:`cageless.simulation.run.peak_unloaded_slip`), over 0.1 s after the start-up. That is 1.2 / 2.0 / 4.0 cage
-revolutions at the three speeds. With 0.05 s the 1800 rpm peak moved to 6.01 % (+0.40 pp), less than one
-revolution being covered. The remaining excess, 0.1-0.2 pp, comes from the ball-ball impacts of the full
-complement.
+**What is compared.** The closed form starts from a ball leaving the loaded zone at the pure-rolling speed. The
+model's balls leave it slightly slower: the traction that drives them there works at a small creep, and the mean
+slip profile's 0-1 deg bin (the exit) reads 0.53 / 0.23 / 0.09 % at 1800 / 3000 / 6000 rpm. So the closed form
+is compared with the **rise** of the mean slip profile from the exit bin to the top (89-91 deg),
+1 - (1 - s_top) / (1 - s_exit), the speed lost climbing. Measured: 5.54 / 1.95 / 0.480 % against 5.61 / 1.98 /
+0.492 %, within 0.07 pp. The peak of the smoothed profile
+(:func:`cageless.simulation.run.peak_unloaded_slip`) is then the exit slip plus that rise: 5.98 / 2.14 / 0.56 %.
+The windows after the start-up are 0.3 / 0.2 / 0.1 s, 3.6 / 4.0 / 4.0 cage revolutions: at 1800 rpm 0.1 s
+(1.2 revolutions) put the peak 0.3 pp higher, too few passes being averaged.
 
-**With gravity off,** and the losses off, nothing slows a ball in the unloaded zone, and its slip stays at 0
-(measured -0.001 %). With the losses on, the rolling force alone slows it: slip above 0, and falling with speed,
+**With gravity off,** and the losses off, nothing slows a ball in the unloaded zone, and its slip stays at 0. With the losses on, the rolling force alone slows it: slip above 0, and falling with speed,
 because the ball's momentum grows as v while the rolling force grows more slowly (C_0 ~ u, Fbar ~ ln of the
 film, which thickens with speed).
 """
@@ -47,12 +54,15 @@ import pytest
 from cageless.bearing import default_bearing
 from cageless.conditions import OperatingConditions
 from cageless.kinematics import startup_duration, theoretical_cage_speed
+from cageless.profiles import angle_profile
 from cageless.simulation.effects import choose_model
 from cageless.simulation.run import peak_unloaded_slip, simulate
 from cageless.simulation.scene import Scene
 
 G = 9.81
-WINDOW_S = 0.1
+#: Simulated time after the start-up: about four cage revolutions at each speed (3.6 at 1800 rpm).
+WINDOW_S = {1800.0: 0.3, 3000.0: 0.2, 6000.0: 0.1}
+LOSSES_OFF = {"rolling_losses": False, "drag": False, "film_traction": False}
 
 
 def gravity_slip(rpm: float) -> float:
@@ -63,14 +73,27 @@ def gravity_slip(rpm: float) -> float:
     return 1.0 - math.sqrt(1.0 - G * r / (0.7 * v * v))
 
 
-def _peak(rpm: float, gravity: float, window: float, losses: bool = False) -> float:
+def _run(rpm: float, gravity: float, window: float, losses: bool = False):  # noqa: ANN202
+    """(trace, start-up) of a 500 N run with the losses off (or on)."""
     geo = default_bearing().geometry
     settle = startup_duration(rpm, geo.ball_diameter_m, geo.pitch_diameter_m)
     scene = Scene(conditions=OperatingConditions(rpm, 500.0), duration_s=settle + window, gravity_m_s2=gravity)
-    choice = choose_model(scene, effects={} if losses else {"rolling_losses": False, "drag": False}, force=True)
+    choice = choose_model(scene, effects={} if losses else LOSSES_OFF, force=True)
     assert ("rolling_losses" in choice.active) == losses and "lubricant_damping" in choice.active
-    assert losses or "drag" not in choice.active
-    return peak_unloaded_slip(simulate(scene, choice, progress=False).trace, settle)
+    assert losses or not {"drag", "film_traction"} & set(choice.active)
+    return simulate(scene, choice, progress=False).trace, settle
+
+
+def _peak(rpm: float, gravity: float, window: float, losses: bool = False) -> float:
+    trace, settle = _run(rpm, gravity, window, losses)
+    return peak_unloaded_slip(trace, settle)
+
+
+def _exit_and_top(trace, settle: float) -> tuple[float, float]:  # noqa: ANN001
+    """The mean slip profile's exit bin (0-1 deg) and its top (the mean of the 89-90 and 90-91 deg bins)."""
+    keep = (trace.time >= settle)[:, None] & trace.valid
+    prof = angle_profile(trace.angle, trace.slip, 1.0, valid=keep).set_index("angle_deg")["mean"]
+    return float(prof.loc[0.5]), float(prof.loc[[89.5, 90.5]].mean())
 
 
 def test_closed_form_values():
@@ -87,8 +110,14 @@ def test_closed_form_values():
 @pytest.mark.slow
 @pytest.mark.parametrize("rpm", [1800.0, 3000.0, 6000.0])
 def test_unloaded_zone_slip_is_the_gravity_energy_value(rpm):
-    peak = _peak(rpm, G, WINDOW_S)
-    assert abs(peak - gravity_slip(rpm)) < 0.003, (peak, gravity_slip(rpm))
+    trace, settle = _run(rpm, G, WINDOW_S[rpm])
+    exit_slip, top = _exit_and_top(trace, settle)
+    rise = 1.0 - (1.0 - top) / (1.0 - exit_slip)
+    assert abs(rise - gravity_slip(rpm)) < 0.003, (rise, gravity_slip(rpm))
+    # the ball leaves the loaded zone a little behind the cage speed (traction creep), never ahead of it
+    assert 0.0 < exit_slip < 0.01
+    peak = peak_unloaded_slip(trace, settle)
+    assert abs(peak - (exit_slip + gravity_slip(rpm))) < 0.003, (peak, exit_slip, gravity_slip(rpm))
 
 
 @pytest.mark.slow
