@@ -233,22 +233,7 @@ def read_conditions_csv(
         table = pd.read_csv(path, dtype={"file": str}, skipinitialspace=True, sep=sep, decimal=decimal)
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         raise ConditionsError(path, f"cannot parse the CSV: {exc}.") from exc
-    table.columns = [str(c).strip() for c in table.columns]
-    for required in ("file", "speed_rpm"):
-        if required not in table.columns:
-            found = ", ".join(repr(c) for c in table.columns[:8])
-            raise ConditionsError(
-                path, f"missing column '{required}' (the header has {found}).",
-                f"Columns are: file, {', '.join(CONDITION_KEYS)} (only file and speed_rpm are required), "
-                "separated by commas.",
-            )
-    for col in list(table.columns):
-        if col != "file" and col not in _SOURCE_KEYS:
-            hint = suggest(col, _SOURCE_KEYS)
-            if hint:  # a misspelled key would silently lose its value
-                raise ConditionsError(path, f"unknown column '{col}'." + hint)
-            log.warning("%s: ignoring column '%s'; the columns read are file, %s", path, col, ", ".join(_SOURCE_KEYS))
-            table = table.drop(columns=col)
+    table = _checked_columns(path, table)
     rows: dict[str, dict[str, float]] = {}
     seen: set[str] = set()
     for i, row in table.iterrows():
@@ -270,6 +255,27 @@ def read_conditions_csv(
             else:
                 row_errors[name] = exc
     return rows
+
+
+def _checked_columns(path: Path, table: pd.DataFrame) -> pd.DataFrame:
+    """The table with stripped column names, its required columns checked and unknown ones dropped."""
+    table.columns = [str(c).strip() for c in table.columns]
+    for required in ("file", "speed_rpm"):
+        if required not in table.columns:
+            found = ", ".join(repr(c) for c in table.columns[:8])
+            raise ConditionsError(
+                path, f"missing column '{required}' (the header has {found}).",
+                f"Columns are: file, {', '.join(CONDITION_KEYS)} (only file and speed_rpm are required), "
+                "separated by commas.",
+            )
+    for col in list(table.columns):
+        if col != "file" and col not in _SOURCE_KEYS:
+            hint = suggest(col, _SOURCE_KEYS)
+            if hint:  # a misspelled key would silently lose its value
+                raise ConditionsError(path, f"unknown column '{col}'." + hint)
+            log.warning("%s: ignoring column '%s'; the columns read are file, %s", path, col, ", ".join(_SOURCE_KEYS))
+            table = table.drop(columns=col)
+    return table
 
 
 def _csv_values(path: Path, line: int, row: pd.Series, columns: pd.Index) -> dict[str, float]:

@@ -194,13 +194,25 @@ def _settings(method: str, kw: dict[str, Any]) -> dict[str, Any]:
 
 
 def _step_chunk(part: Problem, t: npt.NDArray[np.float64], current: str, kw: dict[str, Any],
-                session: CvodeSession | None) -> Solution:
-    """One chunk with the current method (CVODE kept warm across chunks: see simulation.solve.CvodeSession)."""
+                warm: CvodeSession | float | None) -> Solution:
+    """One chunk with the current method, warm from the chunk before when it ran the same method: CVODE keeps its
+    session (see simulation.solve.CvodeSession), the IMEX method starts at its last step length (from the
+    default first step, a tenth of a microsecond for 0.1 ms chunks, it took 1306 steps where one solve takes
+    752 over 5 ms settled at 3000 rpm, 500 N). DP5 starts afresh each chunk, as it always has."""
     settings = _settings(current, kw)
     if current == "CVODE":
         return step_cvode(part, t, settings["rtol"], settings["max_step"], max_steps=settings["max_steps"],
-                          session=session)
+                          session=warm if isinstance(warm, CvodeSession) else None)
+    if current == "ark4" and isinstance(warm, float):
+        settings["first_step"] = min(warm, settings["max_step"])
     return solve(part, t, method=current, **settings)
+
+
+def _warm_state(current: str, sol: Solution, before: CvodeSession | float | None) -> CvodeSession | float | None:
+    """What the next chunk of the same method starts from (see :func:`_step_chunk`)."""
+    if current == "CVODE":
+        return sol.extra.get("cvode", before)
+    return float(sol.extra["last_h"]) if current == "ark4" and sol.extra.get("last_h", 0.0) > 0.0 else None
 
 
 def _go_back(stiff_rates: list[float], dp5_rate: float, time_s: float) -> dict[str, Any] | None:
@@ -254,7 +266,7 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
     auto, current = method == "auto", "dp5" if method == "auto" else method
     probes: list[dict[str, Any]] = []
     dp5_rate, schedule, sol = np.inf, _Schedule(), None
-    session: CvodeSession | None = None
+    warm: CvodeSession | float | None = None
     stiff_rates: list[float] = []  # cost per simulated second of each stiff chunk since the switch
     notice = compile_notice() if progress else None
     if notice:
@@ -271,8 +283,8 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
             part = replace(pr, log=log, y0=y0, t0=t0)
             kw = {"rtol": rtol, "max_step": max_step, "force_jump": force_jump,
                   "max_steps": max(1, max_steps - totals["n_steps"] - totals["n_rejected"])}
-            sol = _step_chunk(part, t[a + 1:b + 1], current, kw, session)
-            session = sol.extra.get("cvode", session) if current == "CVODE" else None
+            sol = _step_chunk(part, t[a + 1:b + 1], current, kw, warm)
+            warm = _warm_state(current, sol, warm)
             ys.append(sol.y)
             for key in totals:
                 totals[key] += getattr(sol, key)

@@ -49,6 +49,9 @@ class EffectSpec:
     #: For an effect added by :func:`register_effect`: its slot values (name -> value) from the run's
     #: :class:`~cageless.simulation.parameters.ModelParameters` (the built-in rows are filled by the models).
     fill: Callable[[Any], Mapping[str, float]] | None = None
+    #: For an added effect: its open parameters (name with its unit, default), which ``--set NAME=VALUE``, a
+    #: configuration's ``[parameters]`` table and :meth:`ModelParameters.value` reach like the built-in ones.
+    parameters: tuple[tuple[str, float], ...] = ()
 
 
 def _always(what: str) -> Callable[[Scene], tuple[bool, str]]:
@@ -110,6 +113,11 @@ EFFECTS: tuple[EffectSpec, ...] = (
                "ball-ball contacts", _dry, flag="DRY", slots=("MU_DRY", "V_REG", "MU_STATIC", "V_STRIBECK")),
 )
 _BY_NAME = {e.name: e for e in EFFECTS}
+
+
+def added_parameters() -> dict[str, float]:
+    """The open parameters of the effects added with :func:`register_effect`, with their defaults."""
+    return {name: value for e in EFFECTS for name, value in e.parameters}
 
 
 def register_effect(spec: EffectSpec) -> None:

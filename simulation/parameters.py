@@ -68,7 +68,7 @@ from typing import Any
 
 from cageless.errors import ParameterError, suggest
 
-__all__ = ["ModelParameters", "parse_set_overrides"]
+__all__ = ["ModelParameters", "parse_set_overrides", "names"]
 
 
 @dataclass(frozen=True)
@@ -158,6 +158,9 @@ class ModelParameters:
     boundary_friction_coefficient: float = 0.1
     boundary_slip_speed_m_s: float = 5e-3
     oil_temperature_c: float = 20.0
+    #: Values given for the open parameters of effects added with
+    #: :func:`cageless.simulation.effects.register_effect` (name, value); the others take the effect's default.
+    added: tuple[tuple[str, float], ...] = ()
 
     def __post_init__(self) -> None:
         rules = {
@@ -213,17 +216,53 @@ class ModelParameters:
                                        self.traction_sliding_coefficient)
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready values."""
-        return dataclasses.asdict(self)
+        """JSON-ready values (an added effect's values by name, beside the built-in ones)."""
+        out = dataclasses.asdict(self)
+        out.update(dict(out.pop("added")))
+        return out
+
+    def value(self, name: str) -> float:
+        """The value of a built-in parameter, or of an added effect's parameter (its default if not given)."""
+        from cageless.simulation.effects import added_parameters
+
+        if name in _BUILT_IN:
+            return getattr(self, name)
+        given = dict(self.added)
+        if name in given:
+            return given[name]
+        defaults = added_parameters()
+        if name not in defaults:
+            raise ParameterError("parameters", f"{name!r} is not a model parameter" + (suggest(name, names())))
+        return defaults[name]
 
     def with_overrides(self, values: Mapping[str, float]) -> ModelParameters:
-        """A copy with ``values`` replaced; unknown names get a suggestion."""
-        names = [f.name for f in dataclasses.fields(self)]
+        """A copy with ``values`` replaced; unknown names get a suggestion. An added effect's parameter
+        (:func:`cageless.simulation.effects.register_effect`) is set by its name like a built-in one."""
+        from cageless.simulation.effects import added_parameters
+
+        known = names()
         for name in values:
-            if name not in names:
+            if name not in known:
                 raise ParameterError("--set", f"{name!r} is not a model parameter"
-                                     + (suggest(name, names) or f"; the parameters are {', '.join(names)}"))
-        return dataclasses.replace(self, **values)
+                                     + (suggest(name, known) or f"; the parameters are {', '.join(known)}"))
+        extra = {k: v for k, v in values.items() if k in added_parameters()}
+        for name, value in extra.items():
+            if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+                raise ParameterError(f"parameters.{name}", "must be a finite number", value)
+        built_in = {k: v for k, v in values.items() if k not in extra}
+        added = tuple(sorted({**dict(self.added), **{k: float(v) for k, v in extra.items()}}.items()))
+        return dataclasses.replace(self, **built_in, added=added)
+
+
+#: The built-in parameters' names (the fields of :class:`ModelParameters` but its ``added`` values).
+_BUILT_IN = tuple(f.name for f in dataclasses.fields(ModelParameters) if f.name != "added")
+
+
+def names() -> list[str]:
+    """Every model parameter's name: the built-in ones, then those of added effects."""
+    from cageless.simulation.effects import added_parameters
+
+    return [*_BUILT_IN, *added_parameters()]
 
 
 def parse_set_overrides(items: list[str]) -> dict[str, float]:

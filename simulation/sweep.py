@@ -52,7 +52,7 @@ def parse_vary(items: Sequence[str], bearing: Bearing | None = None) -> dict[str
     from cageless.simulation.parameters import ModelParameters
 
     bearing = bearing or default_bearing()
-    model = [f.name for f in dataclasses.fields(ModelParameters)]
+    model = [f.name for f in dataclasses.fields(ModelParameters) if f.name != "added"]
     dotted = [f"{s}.{k}" for s, d in bearing.to_dict().items() if isinstance(d, dict) for k in d]
     known = [*SCENE_NAMES, *model, *dotted, *ALIASES]
     out: dict[str, list[float]] = {}

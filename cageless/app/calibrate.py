@@ -77,7 +77,7 @@ class Bound:
 def _known_names(bearing: Bearing) -> list[str]:
     from cageless.simulation.parameters import ModelParameters
 
-    model = [f.name for f in dataclasses.fields(ModelParameters)]
+    model = [f.name for f in dataclasses.fields(ModelParameters) if f.name != "added"]
     dotted = [f"{s}.{k}" for s, d in bearing.to_dict().items() if isinstance(d, dict) for k in d]
     return [*model, *dotted, *_ALIASES]
 

@@ -58,10 +58,7 @@ def dp5_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_st
     length (never below ``h_onset``): for each component i with ``jump_floor[i] > 0`` (the
     accelerations), |f_i(end) - f_i(start)| > ``force_jump`` (max(|f_i(start)|, |f_i(end)|) + floor_i).
     ``stats`` receives [n_steps, n_rejected, n_rhs, last_h, n_onset_retries, n_contact_changes,
-    n_force_jump_retries, n_stiff_steps]. A stiff step is an accepted step at the edge of the method's
-    stability region: h |lambda| > 3.25, with |lambda| estimated as ||f(y1) - f(y_6)|| / ||y1 - y_6|| from
-    the last two stages (Hairer & Wanner, *Solving ODEs II*, sect. IV.2, the test of their DOPRI5 code).
-    Returns a status code:
+    n_force_jump_retries, n_stiff_steps] (a stiff step: see :func:`_stiff`). Returns a status code:
     0 ok, 1 too many steps, 2 step-size underflow, 3 non-finite state.
     """  # noqa: D401
     n = y0.shape[0]
@@ -203,7 +200,9 @@ def _dp5_error(h, y, ynew, ks, atol, rtol):  # pragma: no cover - compiled
 
 @numba.njit(cache=True, inline="always")
 def _stiff(h, ks, ynew, yt):  # pragma: no cover - compiled
-    """Whether an accepted step sits at the stability edge: h |lambda| > 3.25 (see :func:`dp5_integrate`)."""
+    """Whether an accepted step sits at the edge of the method's stability region: h |lambda| > 3.25, with
+    |lambda| estimated as ||f(y1) - f(y_6)|| / ||y1 - y_6|| from the last two stages (Hairer & Wanner, *Solving
+    ODEs II*, sect. IV.2, the test of their DOPRI5 code)."""
     num = 0.0
     den = 0.0
     for i in range(ynew.shape[0]):

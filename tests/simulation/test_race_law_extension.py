@@ -3,7 +3,8 @@
 The example law is defined here, in a test-only module run in a fresh process (the laws compile into the
 models' race contacts, so they are registered before the models import): a linear spring f = k_x delta
 added along the normal of every race contact, switched by its own row of the effects table, with its
-stiffness in its own parameter slot. Nothing else of the package is edited. The check is the closed form
+stiffness in its own parameter slot, set from its open parameter ``race_spring_k_n_m`` (``--set`` reaches it
+like a built-in parameter). Nothing else of the package is edited. The check is the closed form
 (traction off, since it scales with the normal force): the law adds (-k_x delta_o + k_x delta_i n_r) / m to
 each ball's radial acceleration (the outer contact pushes the ball inward, the inner one out along its normal,
 of radial component n_r), and nothing where a contact is open; a short run with it differs from one without.
@@ -23,7 +24,7 @@ import json, numba, numpy as np
 from cageless.simulation.effects import EffectSpec
 from cageless.simulation.models import race_laws
 
-K_X = 2.0e6  # N/m: the example law's parameter
+K_X = 2.0e6  # N/m: the example law's parameter's default
 SLOT = -1  # its slot in the parameter vector, known once the layout is generated (below); read at compile time
 
 @numba.njit(inline="always")
@@ -32,7 +33,8 @@ def linear_spring(delta, delta_dot, q, p):
 
 spec = EffectSpec("race_spring", "a linear spring k_x delta at the race contacts (test-only example law)",
                   lambda s: (True, "example law"), flag="F_SPRING", slots=("K_X",),
-                  fill=lambda par: {"K_X": K_X})
+                  fill=lambda par: {"K_X": par.value("race_spring_k_n_m")},
+                  parameters=(("race_spring_k_n_m", K_X),))
 race_laws.register_race_law(spec, linear_spring)
 from cageless.simulation.models.base import LAYOUT
 SLOT = LAYOUT.index("K_X")
@@ -59,7 +61,23 @@ ln = np.hypot(sx, sz)
 d_i = 0.5 * pr_on.parameter("DI") + 0.5 * pr_on.parameter("D") - ln
 n_r = (sx * np.cos(th) + sz * np.sin(th)) / ln  # radial component of the inner contact normal
 trace_on, trace_off = on.run(), off.run()
-print(json.dumps({"active": list(on.model.active), "k_x": pr_on.parameter("K_X"), "m": pr_on.parameter("M"),
+# its parameter is set like a built-in one: --set on the command line, then in the run's parameters
+import contextlib, io, sys, tempfile
+from cageless.app.cli import main
+from cageless.simulation.parameters import ModelParameters
+from cageless.trace import read_trace
+out = tempfile.mkdtemp() + "/set.trace.h5"
+with contextlib.redirect_stdout(io.StringIO()):
+    rc = main(["simulate", "--speed-rpm", "3000", "--radial-load-n", "500", "--duration", "5e-4", "-q",
+               "--set", "race_spring_k_n_m=4e6", "-o", out])
+    typo = main(["simulate", "--speed-rpm", "3000", "--duration", "5e-4", "-q", "--set", "race_spring_kn_m=4e6",
+                 "-o", out + ".typo"])
+stiffer = Simulation(scene, ModelParameters().with_overrides({"race_spring_k_n_m": 4e6}),
+                     Choices(effects={"race_traction": False}, force=True)).build()
+a_stiff = stiffer.rhs(0.0, y)
+set_config = read_trace(out).provenance["config"]["parameters"]
+print(json.dumps({"cli_rc": rc, "cli_typo_rc": typo, "cli_k": set_config["race_spring_k_n_m"],
+                  "k_set": stiffer.parameter("K_X"), "dr_acc_set": (a_stiff[2 * z:3 * z] - a_off[2 * z:3 * z]).tolist(),"active": list(on.model.active), "k_x": pr_on.parameter("K_X"), "m": pr_on.parameter("M"),
                   "d_o": d_o.tolist(), "d_i": d_i.tolist(), "n_r": n_r.tolist(), "dr_acc": (a_on[2 * z:3 * z] - a_off[2 * z:3 * z]).tolist(),
                   "ring_z_on": float(on.solution.y[-1, 5 * z + 1]), "ring_z_off": float(off.solution.y[-1, 5 * z + 1]),
                   "ok": bool(on.solution.success and off.solution.success)}))
@@ -103,6 +121,11 @@ def test_an_example_race_law_enters_the_forces(tmp_path):
         loaded += d_o > 0
     assert loaded >= 3 and max(abs(v) for v in r["dr_acc"]) > 1.0  # the law acts where balls are loaded
     assert r["ring_z_on"] != r["ring_z_off"]  # the stiffer contacts carry the load: the run differs
+    # --set race_spring_k_n_m=4e6 reaches the run (exit 0, on record) and the slot; the force doubles
+    assert r["cli_rc"] == 0 and r["cli_k"] == 4.0e6 and r["cli_typo_rc"] == 2
+    assert r["k_set"] == 4.0e6
+    for dr, dr_set in zip(r["dr_acc"], r["dr_acc_set"], strict=True):
+        assert abs(dr_set - 2.0 * dr) <= 1e-6 * abs(dr) + 1e-9
 
 
 @pytest.mark.slow  # a fresh compile of the spatial kernels
