@@ -127,7 +127,7 @@ def static_defects(background: np.ndarray, sigma_noise: float, k: float = 8.0,
     if frames is not None and len(frames):
         q = len(frames) // 4  # bright in three quarters of them: a dark frame or a ball passing over a glint
         low = np.partition(frames, q, axis=0)[q].astype(np.float32)
-        out &= (low - cv2.medianBlur(low, size)) > q * sigma_noise
+        out &= (low - cv2.medianBlur(low, size)) > k * sigma_noise
     return out
 
 

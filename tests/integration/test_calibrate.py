@@ -177,7 +177,7 @@ def test_several_parameters_use_a_design_then_nelder_mead(tmp_path, capsys):
 TRUE, RANGE = 0.3e-3, (0.15e-3, 0.6e-3)
 
 
-def _measured(tmp_path: Path, seed: int) -> tuple[Path, float]:
+def _measured(tmp_path: Path, seed: int, settle_s: float = 0.02) -> tuple[Path, float]:
     from cageless.bearing import default_bearing
     from cageless.conditions import OperatingConditions
     from cageless.simulation.parameters import ModelParameters
@@ -185,9 +185,10 @@ def _measured(tmp_path: Path, seed: int) -> tuple[Path, float]:
     from cageless.simulation.scene import Scene
     from cageless.simulation.simulation import Simulation
 
-    scene = Scene(OperatingConditions(6000.0, 500.0, 0.0), default_bearing(), duration_s=0.07, seed=seed)
+    scene = Scene(OperatingConditions(6000.0, 500.0, 0.0), default_bearing(), duration_s=settle_s + 0.05, seed=seed)
     trace = Simulation(scene, ModelParameters(meniscus_distance_m=TRUE)).run()
-    return as_video_trace(trace, 0.02, tmp_path / f"measured{seed}.trace.h5"), 100 * peak_unloaded_slip(trace, 0.02)
+    return (as_video_trace(trace, settle_s, tmp_path / f"measured{seed}.trace.h5"),
+            100 * peak_unloaded_slip(trace, settle_s))
 
 
 def test_calibration_recovers_a_known_meniscus_distance_from_a_trace(tmp_path, capsys):
@@ -209,12 +210,15 @@ def test_calibration_recovers_a_known_meniscus_distance_from_a_trace(tmp_path, c
 @pytest.mark.slow
 @pytest.mark.parametrize("seed", [17, 23, 31])
 def test_calibration_recovers_it_from_other_measurements_and_from_the_peak(tmp_path, seed):
-    path, peak = _measured(tmp_path, seed)
+    """Three other seeds' measurements, from the end of the start-up (40 ms at 6000 rpm: three cage revolutions).
+    With only 20 ms left out, seed 31's trace still held its start-up transient, which the fit's seeds 0 and 1 do
+    not share: it read 0.322 mm (7.3 % off)."""
+    path, peak = _measured(tmp_path, seed, settle_s=0.04)
     bound = [Bound("meniscus_distance_m", *RANGE)]
     from cageless.app.calibrate import target_from_trace
 
-    by_trace = calibrate(target_from_trace(path, 0.05), bound, budget=10, seeds=2, settle_s=0.02, progress=False)
+    by_trace = calibrate(target_from_trace(path, 0.05), bound, budget=10, seeds=2, settle_s=0.04, progress=False)
     by_peak = calibrate(target_from_peak(6000.0, 500.0, peak, duration_s=0.05), bound, budget=10, seeds=2,
-                        settle_s=0.02, progress=False)
+                        settle_s=0.04, progress=False)
     assert abs(by_trace.fitted["meniscus_distance_m"] - TRUE) < 0.05 * TRUE
     assert abs(by_peak.fitted["meniscus_distance_m"] - TRUE) < 0.1 * TRUE

@@ -44,18 +44,20 @@ ALL = [("TUNING", s) for s in TUNING] + [("HOLDOUT", s) for s in HOLDOUT]
 #: across masked as defects (a 5 x 5 median, was 3 x 3: 7020's saturated glint on the highlights' path pulled
 #: the centroid by up to 10 mrad) TUNING 28 (no clip worse by more than 0.01 mrad; 1020 0.37 -> 0.14, 1029
 #: 0.35 -> 0.14 mrad) and HOLDOUT 27: 7011, 7012, 7020 (1.12 -> 0.33 mrad), 7025 pass, 7018 1.46 -> 1.32 mrad,
-#: while 7026 goes from 0.68 to 2.05 mrad (not diagnosed).
+#: while 7026 goes from 0.68 to 2.05 mrad (not diagnosed); with the static-defect test's second condition at
+#: its stated 8 sigma (it read the frame-quartile index, 4 for 16 frames, as its threshold) the same counts,
+#: no TUNING clip worse (1022 0.553 -> 0.545, 1029 0.136 -> 0.130 mrad), and held out 7026 2.05 -> 1.63 mrad.
 #: Remove a seed when it passes.
 KNOWN_FAILURES: dict[int, str] = {
     1011: "angle_rms 0.679 mrad > 0.5; speed_rms 0.712 % of cage speed > 0.5; slip_mae 0.467 pp > 0.3",
     1012: "angle_rms 0.536 mrad > 0.5; speed_rms 0.762 % of cage speed > 0.5",
     1014: "angle_rms 0.83 mrad > 0.5",
-    1022: "angle_rms 0.553 mrad > 0.5",
+    1022: "angle_rms 0.545 mrad > 0.5",
     7004: "speed_rms 0.697 % of cage speed > 0.5",
     7008: "angle_rms 0.58 mrad > 0.5",
     7009: "angle_rms 0.614 mrad > 0.5",
     7018: "angle_rms 1.32 mrad > 0.5",
-    7026: "angle_rms 2.05 mrad > 0.5; speed_rms 0.673 % of cage speed > 0.5; slip_mae 0.376 pp > 0.3",
+    7026: "angle_rms 1.63 mrad > 0.5; speed_rms 0.545 % of cage speed > 0.5; slip_mae 0.303 pp > 0.3",
 }
 
 #: The same for the long variants (one cage revolution each), "" = passes: all 64 seeds measured with the tracker of

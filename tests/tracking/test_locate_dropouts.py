@@ -88,3 +88,18 @@ def test_a_compact_static_glint_is_a_defect():
     old = static_defects(background.astype(np.float32), 2.0, frames=frames.astype(np.float32), size=3)
     # What the 3 x 3 median found: the glint's 4 corners only (4 of 9 bright there), its centre and edges left in.
     assert sorted(map(tuple, np.argwhere(old).tolist())) == [(10, 10), (10, 12), (12, 10), (12, 12)]
+
+
+def test_a_static_defect_stands_out_by_k_sigma_in_the_frames_too():
+    """Both conditions use the same k sigma (8 by default): a spot 6 sigma above the face in the background and in
+    every frame is not a defect, one 10 sigma above is. (The frames' test once used the quartile index, 4 for
+    16 frames, as its threshold: the 6 sigma spot passed it.)"""
+    rng = np.random.default_rng(5)
+    frames = rng.normal(40.0, 0.2, (16, 30, 30))
+    frames[:, 8:10, 8:10] += 12.0  # 6 sigma of sigma_noise = 2
+    frames[:, 20:22, 20:22] += 20.0  # 10 sigma
+    background = np.median(frames, axis=0).astype(np.float32)
+    loose = np.zeros((30, 30), np.float32) + background
+    loose[8:10, 8:10] += 30.0  # the background alone would call both spots defects
+    out = static_defects(loose, 2.0, frames=frames.astype(np.float32))
+    assert not out[8:10, 8:10].any() and out[20:22, 20:22].all()
