@@ -49,7 +49,7 @@ revolution being covered. With every loss above off (seed 0, 0.1 s): 2.08 % at 3
 **Not at 1800 rpm (expected failure).** The closed form is a statement about one free ball. At 1800 rpm the climb
 slows a ball by 5.6 %, and the full complement's balls meet in the climb: with R = 0.8 the impacts dissipate
 (+0.65-0.7 pp, above), and with R = 1 they swap speeds between balls instead (a spike of 8.6 % at 30 deg in the mean
-profile, peak 7.21 %, seed 0; seeds 1 and 2: 7.06 % and 6.35 %), so no restitution makes the mean profile one free ball's. The peak there is
+profile, peak 7.21 %, seed 0), so no restitution makes the mean profile one free ball's. The peak there is
 pinned as an expected failure until a per-ball energy check replaces it.
 
 **With gravity off,** and the losses off, nothing slows a ball in the unloaded zone, and its slip stays at 0
