@@ -68,7 +68,7 @@ from typing import Any
 
 from cageless.errors import ParameterError, suggest
 
-__all__ = ["ModelParameters", "parse_set_overrides", "names"]
+__all__ = ["ModelParameters", "parse_set_overrides", "names", "BUILT_IN_NAMES"]
 
 
 @dataclass(frozen=True)
@@ -225,7 +225,7 @@ class ModelParameters:
         """The value of a built-in parameter, or of an added effect's parameter (its default if not given)."""
         from cageless.simulation.effects import added_parameters
 
-        if name in _BUILT_IN:
+        if name in BUILT_IN_NAMES:
             return getattr(self, name)
         given = dict(self.added)
         if name in given:
@@ -255,14 +255,14 @@ class ModelParameters:
 
 
 #: The built-in parameters' names (the fields of :class:`ModelParameters` but its ``added`` values).
-_BUILT_IN = tuple(f.name for f in dataclasses.fields(ModelParameters) if f.name != "added")
+BUILT_IN_NAMES = tuple(f.name for f in dataclasses.fields(ModelParameters) if f.name != "added")
 
 
 def names() -> list[str]:
     """Every model parameter's name: the built-in ones, then those of added effects."""
     from cageless.simulation.effects import added_parameters
 
-    return [*_BUILT_IN, *added_parameters()]
+    return [*BUILT_IN_NAMES, *added_parameters()]
 
 
 def parse_set_overrides(items: list[str]) -> dict[str, float]:

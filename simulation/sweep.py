@@ -10,7 +10,6 @@ an open model parameter (``cho_n_s_m``, ``film_thickness_m``, ...) or a dotted b
 
 from __future__ import annotations
 
-import dataclasses
 import itertools
 import math
 from collections.abc import Mapping, Sequence
@@ -49,10 +48,10 @@ def _values(name: str, spec: str) -> list[float]:
 
 def parse_vary(items: Sequence[str], bearing: Bearing | None = None) -> dict[str, list[float]]:
     """``NAME=start:stop:count`` or ``NAME=v1,v2`` items into {canonical name: values}; names are checked."""
-    from cageless.simulation.parameters import ModelParameters
+    from cageless.simulation.parameters import BUILT_IN_NAMES
 
     bearing = bearing or default_bearing()
-    model = [f.name for f in dataclasses.fields(ModelParameters) if f.name != "added"]
+    model = list(BUILT_IN_NAMES)
     dotted = [f"{s}.{k}" for s, d in bearing.to_dict().items() if isinstance(d, dict) for k in d]
     known = [*SCENE_NAMES, *model, *dotted, *ALIASES]
     out: dict[str, list[float]] = {}

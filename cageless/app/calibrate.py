@@ -22,7 +22,6 @@ Method
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -75,9 +74,9 @@ class Bound:
 
 
 def _known_names(bearing: Bearing) -> list[str]:
-    from cageless.simulation.parameters import ModelParameters
+    from cageless.simulation.parameters import BUILT_IN_NAMES
 
-    model = [f.name for f in dataclasses.fields(ModelParameters) if f.name != "added"]
+    model = list(BUILT_IN_NAMES)
     dotted = [f"{s}.{k}" for s, d in bearing.to_dict().items() if isinstance(d, dict) for k in d]
     return [*model, *dotted, *_ALIASES]
 

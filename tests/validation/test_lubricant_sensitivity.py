@@ -50,8 +50,18 @@ def test_viscosity_moves_the_1800_rpm_slip_by_more_than_15_percent():
 
 @pytest.mark.slow
 def test_a_hotter_oil_lowers_the_slip():
-    cold, hot = _ends("oil_temperature_c=20,60")
-    assert hot < cold, (cold, hot)
+    """20 -> 60 degC at 1800 rpm, 4 seeds x 0.2 s: 9.55 % (s.d. 0.27) -> 8.86 % (s.d. 0.51), a fall of 2.4 standard
+    errors. Not monotonic: 40 degC reads 7.48 % (s.d. 0.24). Thinning the oil lowers the rolling loss (eta u), but
+    also the film: towards 60 degC the lightly loaded unloaded-zone contacts approach mixed lubrication, where
+    the traction rises again. With 2 seeds x 0.1 s the 20/60 degC pair read 9.49 / 9.99 %, within the chaotic
+    spread of the 1800 rpm ring (about 1 pp between seeds)."""
+    vary = parse_vary(["oil_temperature_c=20,60"])
+    runs = run_sweep(vary, 4, 1800.0, 500.0, duration_s=0.2, workers=2, progress=False)
+    assert (runs.status == "ok").all(), runs
+    summ = summarise(runs, list(vary)).reset_index(drop=True)
+    mean, sd, n = summ.peak_slip_mean_pct, summ.peak_slip_std_pct, summ.runs
+    standard_error = math.hypot(sd.iloc[0] / math.sqrt(n.iloc[0]), sd.iloc[-1] / math.sqrt(n.iloc[-1]))
+    assert mean.iloc[0] - mean.iloc[-1] > 2.0 * standard_error, summ
 
 
 @pytest.mark.parametrize("race", ["inner", "outer"])
