@@ -94,18 +94,16 @@ def _problems():
     import numpy as np
 
     from cageless.conditions import OperatingConditions
-    from cageless.simulation.effects import choose_model
-    from cageless.simulation.run import build_problem
     from cageless.simulation.scene import Scene
+    from cageless.simulation.simulation import Choices, Simulation
     from cageless.simulation.solve import solve
 
     out = []
     for label, cond in (("planar", OperatingConditions(3000.0, 500.0)),
                         ("spatial, 5 strips", OperatingConditions(3000.0, 500.0, 400.0))):
         scene = Scene(conditions=cond)
-        on = build_problem(scene, choose_model(scene), ModelParameters())
-        off = build_problem(scene, choose_model(scene, effects={"film_traction": False}, force=True),
-                            ModelParameters())
+        on = Simulation(scene, ModelParameters()).build()
+        off = Simulation(scene, ModelParameters(), Choices(effects={"film_traction": False}, force=True)).build()
         sol = solve(on, np.array([0.0, 0.02]), rtol=1e-6)
         out.append((label, on, off, sol.y[-1]))
     return out
@@ -116,9 +114,8 @@ def cost(run_ms: float, repeats: int = 5, calls: int = 2000) -> None:
     import time
 
     from cageless.conditions import OperatingConditions
-    from cageless.simulation.effects import choose_model
-    from cageless.simulation.run import simulate
     from cageless.simulation.scene import Scene
+    from cageless.simulation.simulation import Choices, Simulation
 
     print("| model | RHS on (us) | RHS off (us) | ratio on/off |\n|---|---|---|---|")
     for label, on, off, y in _problems():
@@ -136,10 +133,11 @@ def cost(run_ms: float, repeats: int = 5, calls: int = 2000) -> None:
     for _ in range(2):
         for key, eff in (("on", {}), ("off", {"film_traction": False})):
             t0 = time.perf_counter()
-            res = simulate(scene, choose_model(scene, effects=eff, force=True), progress=False)
+            sim = Simulation(scene, choices=Choices(effects=eff, force=True))
+            sim.run()
             wall = time.perf_counter() - t0
             old = rows.get(key)
-            rows[key] = (res.solution.n_steps, res.solution.n_rhs, min(wall, old[2]) if old else wall)
+            rows[key] = (sim.solution.n_steps, sim.solution.n_rhs, min(wall, old[2]) if old else wall)
     print(f"\n{run_ms:g} ms planar run at 3000 rpm, 500 N (best of 2 walls, interleaved)\n")
     print("| film_traction | steps | RHS calls | wall (s) |\n|---|---|---|---|")
     for key in ("on", "off"):

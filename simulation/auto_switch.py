@@ -251,6 +251,24 @@ class _Schedule:
             self.next = -1 if for_good else (self.listed.pop(0) if self.listed else -1)
 
 
+def _begin(pr: Problem, t: npt.NDArray[np.float64], edges: npt.NDArray[np.int64], method: str, progress: bool,
+           kw: dict[str, Any]) -> tuple[str, float, float, list[dict[str, Any]]]:
+    """The compile notice (with ``progress``), then for ``"auto"`` the pilot probe over the first chunk: the
+    method to start with, DP5's cost rate (inf until measured), the wall time spent and the probes so far."""
+    notice = compile_notice() if progress else None
+    if notice:
+        tqdm.write(notice, file=sys.stderr)
+    if method != "auto":
+        return method, np.inf, 0.0, []
+    pilot = _pilot(pr, float(t[edges[1]]), kw) if len(edges) > 1 else None
+    if pilot is None:
+        return "dp5", np.inf, 0.0, []
+    rate = pilot.pop("dp5_rate")
+    if pilot["switch"]:
+        return STIFF_METHOD, rate, pilot["wall_s"], [pilot]
+    return "dp5", np.inf, pilot["wall_s"], [pilot]
+
+
 def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: str, max_step: float | None,
                  chunks: int, progress: bool, max_steps: int, force_jump: float) -> Solution:
     """Integrate ``pr`` over the samples ``t`` in about ``chunks`` pieces; ``method`` is a key of
@@ -261,22 +279,13 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
     ys = [pr.y0[None, :]]
     totals = dict.fromkeys(("n_steps", "n_rejected", "n_rhs", "n_onset_retries", "n_contact_changes",
                             "n_force_jump_retries", "n_stiff_steps"), 0)
-    wall = 0.0
     y0, log, t0 = pr.y0.copy(), pr.log.copy(), float(t[0])
-    auto, current = method == "auto", "dp5" if method == "auto" else method
-    probes: list[dict[str, Any]] = []
-    dp5_rate, schedule, sol = np.inf, _Schedule(), None
+    auto = method == "auto"
+    schedule, sol = _Schedule(), None
     warm: CvodeSession | float | None = None
     stiff_rates: list[float] = []  # cost per simulated second of each stiff chunk since the switch
-    notice = compile_notice() if progress else None
-    if notice:
-        tqdm.write(notice, file=sys.stderr)
-    pilot = _pilot(pr, float(t[edges[1]]), {"rtol": rtol, "max_step": max_step, "force_jump": force_jump,
-                                            "max_steps": max_steps}) if auto and len(edges) > 1 else None
-    if pilot is not None:
-        probes.append(pilot)
-        wall, rate = wall + pilot["wall_s"], pilot.pop("dp5_rate")
-        current, dp5_rate = (STIFF_METHOD, rate) if pilot["switch"] else (current, dp5_rate)
+    current, dp5_rate, wall, probes = _begin(pr, t, edges, method, progress, {
+        "rtol": rtol, "max_step": max_step, "force_jump": force_jump, "max_steps": max_steps})
     with tqdm(total=float(t[-1] - t[0]), desc="simulated", disable=not progress, leave=False,
               bar_format=_BAR_FORMAT) as bar:
         for i, (a, b) in enumerate(zip(edges[:-1], edges[1:], strict=True)):

@@ -38,7 +38,7 @@ import numpy.typing as npt
 from cageless.conditions import OperatingConditions
 from cageless.kinematics import theoretical_cage_speed
 from cageless.simulation.auto_switch import RTOL_FACTOR
-from cageless.simulation.effects import choose_model
+from cageless.simulation.effects import choose_model, removable_effects
 from cageless.simulation.models.planar_reference import reference_rhs
 from cageless.simulation.problem import Problem
 
@@ -48,7 +48,7 @@ from cageless.simulation.simulation import Choices, Simulation
 from cageless.simulation.solve import solve, step_cvode, step_scipy
 
 __all__ = ["accuracy_study", "format_accuracy", "plot_accuracy", "model_study", "format_models", "effects_study",
-           "format_effects", "OPTIONAL_EFFECTS"]
+           "format_effects"]
 
 #: (method, rtol, max_step in s). The step cap is an accuracy knob of its own for the implicit CVODE,
 #: whose steps are otherwise set by accuracy alone: the default 2 us keeps ~15 steps inside a ball-ball
@@ -277,13 +277,11 @@ def format_models(result: dict[str, Any]) -> str:
     return _cost_table(title, ("scene", "model"), result["rows"], lambda r: (r["scene"], r["model"]))
 
 
-OPTIONAL_EFFECTS = ("lubricant_damping", "race_traction", "ehl_film", "rolling_losses", "ball_ball_film", "gravity",
-                    "drag")
-
-
 def effects_study(rpm: float = 1800.0, radial_load_n: float = 500.0, axial_load_n: float = 0.0,
                   duration_s: float = 0.15, settle_s: float | None = None) -> dict[str, Any]:
-    """Run a scene with every optional effect, then with each one that is on removed in turn.
+    """Run a scene with every effect it calls for, then with each removable one that is on removed in turn
+    (:func:`cageless.simulation.effects.removable_effects`; removing an effect also switches off those that act
+    only on it).
 
     Each run lasts ``settle_s`` (default: the start-up of :func:`cageless.kinematics.startup_duration`)
     plus ``duration_s``, and its statistics come from the part after the start-up.
@@ -316,7 +314,7 @@ def effects_study(rpm: float = 1800.0, radial_load_n: float = 500.0, axial_load_
     rows = [{"removed": "(none: full model)", "peak_slip_pct": 100 * peak_unloaded_slip(ref, settle_s),
              "profile_change_pp": 0.0, "wall_s": ref_wall, "saving_pct": 0.0}]
     on = {e.name for e in full.effects if e.on}
-    for name in OPTIONAL_EFFECTS:
+    for name in removable_effects():
         if name not in on:
             rows.append({"removed": name, "peak_slip_pct": float("nan"), "profile_change_pp": float("nan"),
                          "wall_s": float("nan"), "saving_pct": float("nan"), "note": "off for this scene"})

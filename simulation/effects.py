@@ -27,7 +27,7 @@ from cageless.simulation.scene import Scene
 
 __all__ = [
     "EffectSpec", "EffectChoice", "ModelChoice", "EFFECTS", "LEVELS", "choose_model", "parse_effect_overrides",
-    "describe_table", "check_lubricant", "parameter_slots", "effect_flags", "register_effect",
+    "describe_table", "check_lubricant", "parameter_slots", "effect_flags", "register_effect", "removable_effects",
 ]
 
 LEVELS = ("planar", "spatial")
@@ -52,6 +52,13 @@ class EffectSpec:
     #: For an added effect: its open parameters (name with its unit, default), which ``--set NAME=VALUE``, a
     #: configuration's ``[parameters]`` table and :meth:`ModelParameters.value` reach like the built-in ones.
     parameters: tuple[tuple[str, float], ...] = ()
+    #: Effects this one changes the law of: it has nothing to act on, and is switched off with that reason,
+    #: when all of them are off (``dry_friction`` replaces the law of ``race_traction`` and
+    #: ``ball_ball_friction``).
+    acts_on: tuple[str, ...] = ()
+    #: False for the contacts without which there is no bearing model (race and ball-ball contact): the
+    #: effect ablation (``cageless bench effects``) removes every other effect in turn.
+    removable: bool = True
 
 
 def _always(what: str) -> Callable[[Scene], tuple[bool, str]]:
@@ -84,7 +91,7 @@ def _drag(s: Scene) -> tuple[bool, str]:
 
 EFFECTS: tuple[EffectSpec, ...] = (
     EffectSpec("race_contact", "Hertz point contact Q = K delta^1.5 between ball and inner/outer groove",
-               _always("balls always touch the races"), flag="F_RACE", slots=("KI", "KO")),
+               _always("balls always touch the races"), flag="F_RACE", slots=("KI", "KO"), removable=False),
     EffectSpec("lubricant_damping", "normal damping C_ho d(delta)/dt at race contacts, never tensile", _lubricated,
                needs_lubricant=True, flag="F_LUB", slots=("CHO",)),
     EffectSpec("race_traction", "traction mu(slip) at race contacts (dry: Coulomb-Stribeck)",
@@ -94,23 +101,26 @@ EFFECTS: tuple[EffectSpec, ...] = (
     EffectSpec("film_traction", "race traction by lubrication regime from Lambda = h_min / sigma: boundary "
                "friction, mixed, full film limited by the Bair-Winer limiting shear stress; the film's viscosity "
                "from Roelands at the mean Hertz pressure and the oil temperature", _lubricated,
-               needs_lubricant=True, flag="F_FTRAC",
+               needs_lubricant=True, flag="F_FTRAC", acts_on=("race_traction",),
                slots=("SIGMA", "LSS", "MU_B", "V_REG_B", "U_MIN", "LAM_B", "LAM_F", "ETA_T", "ROE_LN", "ROE_Z",
                       "LHC_I", "LHM_I", "AB_I", "LHC_O", "LHM_O", "AB_O")),
     EffectSpec("rolling_losses", "hydrodynamic rolling force on the ball centre and moment about it at both race "
                "contacts, from the film and the entrainment speed, with inlet starvation (Chiu 1974)", _lubricated,
                needs_lubricant=True, flag="F_ROLL",
                slots=("ETA0", "RC_I", "RH_I", "LT_FILM_I", "LT_FIX_I", "RC_O", "RH_O", "LT_FILM_O", "LT_FIX_O")),
-    EffectSpec("ball_ball_contact", "Hertz contact between neighbours with hysteresis damping (restitution R) "
-               "and friction from the surface sliding speed", _always("no cage: neighbours meet"), flag="F_BB",
-               slots=("KB", "CHI", "V_IN_MIN")),
+    EffectSpec("ball_ball_contact", "Hertz contact between neighbours with hysteresis damping (restitution R)",
+               _always("no cage: neighbours meet"), flag="F_BB", slots=("KB", "CHI", "V_IN_MIN"), removable=False),
+    EffectSpec("ball_ball_friction", "friction between neighbours from their surface sliding speed (the race "
+               "traction's law; dry: Coulomb-Stribeck)", _always("neighbours rub where they meet"),
+               flag="F_BBFRIC"),
     EffectSpec("ball_ball_film", "squeeze film between neighbouring balls", _lubricated, needs_lubricant=True,
                flag="F_BBFILM", slots=("ETA0", "H0")),
     EffectSpec("gravity", "m g on balls and ring", _gravity, flag="F_GRAV", slots=("G",)),
     EffectSpec("drag", "1/2 C_D(Re) rho A V^2 against the orbital motion (Schiller-Naumann C_D) and the churning "
                "moment on the spin", _drag, flag="F_DRAG", slots=("CD", "RHO_MIX", "MU_MIX")),
     EffectSpec("dry_friction", "Coulomb-Stribeck friction of bare steel instead of the traction curve, at race and "
-               "ball-ball contacts", _dry, flag="DRY", slots=("MU_DRY", "V_REG", "MU_STATIC", "V_STRIBECK")),
+               "ball-ball contacts", _dry, flag="DRY", slots=("MU_DRY", "V_REG", "MU_STATIC", "V_STRIBECK"),
+               acts_on=("race_traction", "ball_ball_friction")),
 )
 _BY_NAME = {e.name: e for e in EFFECTS}
 
@@ -228,8 +238,33 @@ def choose_model(scene: Scene, level: str | None = None, effects: Mapping[str, b
                                         f"(the scene alone: {reason})", forced=True))
         else:
             choices.append(EffectChoice(spec.name, on, reason))
+    choices = _without_idle(choices, overrides)
     check_lubricant({c.name: c.on for c in choices}, scene.lubricated)
     return ModelChoice(level=chosen_level, level_reason=level_reason, effects=tuple(choices))
+
+
+def _without_idle(choices: list[EffectChoice], overrides: Mapping[str, bool]) -> list[EffectChoice]:
+    """``choices`` with every effect whose :attr:`EffectSpec.acts_on` effects are all off switched off, with
+    that reason (so its flag never claims a law that is not evaluated).
+
+    Raises
+    ------
+    UsageError
+        When the user asked for such an effect explicitly.
+    """
+    on = {c.name: c.on for c in choices}
+    out = []
+    for c in choices:
+        targets = _BY_NAME[c.name].acts_on
+        if c.on and targets and not any(on.get(t, False) for t in targets):
+            idle = " and ".join(targets) + (" is" if len(targets) == 1 else " are") + " off"
+            if overrides.get(c.name):
+                raise UsageError(f"--effect {c.name}=on changes the law of {' or '.join(targets)}, and {idle}: "
+                                 f"switch one on or drop --effect {c.name}=on.")
+            c = EffectChoice(c.name, False, f"nothing to act on: {idle}", forced=c.forced)
+            on[c.name] = False
+        out.append(c)
+    return out
 
 
 def check_lubricant(on: Mapping[str, bool], lubricated: bool) -> None:
@@ -247,9 +282,10 @@ def check_lubricant(on: Mapping[str, bool], lubricated: bool) -> None:
         if spec.needs_lubricant and on.get(spec.name, False):
             raise UsageError(f"--effect {spec.name}=on needs a lubricant, and the bearing is dry: "
                              f"drop it (--effect {spec.name}=off) or add a lubricant.")
-    if on.get("race_traction", False) and not on.get("dry_friction", False):
-        raise UsageError("race traction on a dry bearing needs the dry_friction effect (--effect dry_friction=on): "
-                         "the traction curve is a lubricated law.")
+    for name in _BY_NAME["dry_friction"].acts_on:
+        if on.get(name, False) and not on.get("dry_friction", False):
+            raise UsageError(f"{name} on a dry bearing needs the dry_friction effect (--effect dry_friction=on): "
+                             "the traction curve is a lubricated law.")
 
 
 def parameter_slots(body: tuple[str, ...]) -> tuple[str, ...]:
@@ -282,6 +318,11 @@ def parse_effect_overrides(items: list[str]) -> dict[str, bool]:
             raise UsageError(f"--effect {item}: write NAME=on or NAME=off.")
         out[name.strip()] = value.lower() == "on"
     return out
+
+
+def removable_effects() -> tuple[str, ...]:
+    """The effects an ablation removes in turn: every row of the table but the contacts that make the model."""
+    return tuple(e.name for e in EFFECTS if e.removable)
 
 
 def describe_table() -> list[dict[str, str]]:

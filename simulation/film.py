@@ -8,7 +8,9 @@ Part III - Fully flooded results", J. Lubr. Technol. 99 (1977) 264-276:
 
 with U = eta_0 u / (E' R_x), G = alpha E', W = Q / (E' R_x^2), u the mean
 entraining velocity, R_x the effective radius in the rolling direction, k the
-ellipticity and E' = 2 / ((1 - nu_1^2)/E_1 + (1 - nu_2^2)/E_2).
+ellipticity and E' = 2 / ((1 - nu_1^2)/E_1 + (1 - nu_2^2)/E_2). The formulas are written once, compiled, in
+:mod:`cageless.simulation.physics.film_traction` (``hd_central_film``, ``hd_minimum_film``); this module checks
+the inputs and names the groups.
 """
 
 from __future__ import annotations
@@ -57,9 +59,12 @@ def hamrock_dowson(load_n: float, entraining_speed_m_s: float, rx_m: float, elli
                         ("reduced_modulus_pa", reduced_modulus_pa)):
         if not (math.isfinite(value) and value > 0):
             raise ParameterError(name, "must be a finite number > 0", value)
-    u = viscosity_pa_s * entraining_speed_m_s / (reduced_modulus_pa * rx_m)
-    g = pressure_viscosity_1_pa * reduced_modulus_pa
-    w = load_n / (reduced_modulus_pa * rx_m**2)
-    h_min = 3.63 * u**0.68 * g**0.49 * w**-0.073 * (1 - math.exp(-0.68 * ellipticity))
-    h_c = 2.69 * u**0.67 * g**0.53 * w**-0.067 * (1 - 0.61 * math.exp(-0.73 * ellipticity))
-    return FilmThickness(central_m=h_c * rx_m, minimum_m=h_min * rx_m, speed_u=u, material_g=g, load_w=w)
+    # the formulas themselves are the compiled ones the right-hand sides use (one source)
+    from cageless.simulation.physics.film_traction import hd_central_film, hd_minimum_film
+
+    args = (viscosity_pa_s, pressure_viscosity_1_pa, reduced_modulus_pa, entraining_speed_m_s, load_n, rx_m,
+            ellipticity)
+    return FilmThickness(central_m=hd_central_film(*args), minimum_m=hd_minimum_film(*args),
+                         speed_u=viscosity_pa_s * entraining_speed_m_s / (reduced_modulus_pa * rx_m),
+                         material_g=pressure_viscosity_1_pa * reduced_modulus_pa,
+                         load_w=load_n / (reduced_modulus_pa * rx_m**2))

@@ -199,17 +199,9 @@ class JacobianStructure:
             return None
         z = problem.n_balls
         n = len(problem.y0)
-        if problem.model_id == PLANAR:
-            fields = [list(range(f * z, (f + 1) * z)) for f in range(5)]
-            ring_rows = planar.planar_ring_rows(z)
-            other = list(range(5 * z, 5 * z + 4))
-        else:
-            b = 5 * z + 6
-            fields = [list(range(f * z, (f + 1) * z)) for f in range(5)]
-            fields += [list(range(b + f * z, b + (f + 1) * z)) for f in range(4)]
-            ring_rows = spatial.spatial_ring_rows(z)
-            other = list(range(5 * z, 5 * z + 4)) + list(range(b + 4 * z, n))
-        counters = [5 * z + 4, 5 * z + 5]
+        # the models own their state layouts
+        fields, ring_rows, other, counters = (planar.planar_state_blocks(z) if problem.model_id == PLANAR
+                                              else spatial.spatial_state_blocks(z, n))
         ball_cols = np.array(fields, dtype=np.int64)
         if sorted(ball_cols.ravel().tolist() + other + counters) != list(range(n)):
             raise ValueError(f"the state layout of model {problem.model_id} does not match its Jacobian structure")

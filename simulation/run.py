@@ -69,8 +69,10 @@ def check_supported(scene: Scene, choice: ModelChoice | None = None) -> None:
                          "let the scene choose the spatial level (drop --level planar).")
 
 
-def initial_state(scene: Scene) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], tuple[float, float]]:
-    """Balls packed around the loaded zone (gap at the top), ring and balls in quasi-static equilibrium.
+def initial_state(scene: Scene, gravity: bool = True
+                  ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], tuple[float, float]]:
+    """Balls packed around the loaded zone (gap at the top), ring and balls in quasi-static equilibrium
+    (the ring's weight counted when ``gravity``, the gravity effect, is on).
 
     The ring sinks by the displacement e that carries the radial load and the ring's weight
     (Newton-Raphson, :func:`~cageless.simulation.quasistatic.radial_load_distribution`); each loaded ball sits
@@ -80,7 +82,8 @@ def initial_state(scene: Scene) -> tuple[npt.NDArray[np.float64], npt.NDArray[np
     g = b.geometry
     theta = P.packed_start(b, seed=scene.seed, spread=scene.initial_gap_fraction)
     radius = np.full(g.n_balls, 0.5 * g.pitch_diameter_m)
-    weight = b.masses.ring_translational_mass_kg * scene.gravity_m_s2 if scene.orientation == "horizontal" else 0.0
+    across = gravity and scene.orientation == "horizontal"
+    weight = b.masses.ring_translational_mass_kg * scene.gravity_m_s2 if across else 0.0
     load = scene.conditions.radial_load_n + weight
     if load <= 0:
         return theta, radius, (0.0, 0.0)
@@ -95,8 +98,8 @@ def initial_state(scene: Scene) -> tuple[npt.NDArray[np.float64], npt.NDArray[np
 
 def build_problem(scene: Scene, choice: ModelChoice, parameters: ModelParameters) -> Problem:
     """The planar or spatial problem of ``choice`` for ``scene``, from the quasi-static start."""
-    theta, radius, ring = initial_state(scene)
     effects = {e.name: e.on for e in choice.effects}
+    theta, radius, ring = initial_state(scene, gravity=effects.get("gravity", False))
     gravity = scene.gravity_m_s2 if effects.get("gravity") else 0.0
     vertical = scene.orientation == "vertical"
     kw = {"gravity_m_s2": 0.0 if vertical else gravity,

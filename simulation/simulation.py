@@ -152,8 +152,8 @@ class Simulation:
         A solver failure does not raise: :attr:`solution` ``.success`` is False and the trace's ``status``
         says ``"incomplete: <why>"``; samples after the failure are NaN.
         """
-        from cageless.simulation.auto_switch import solve_chunks
         from cageless.simulation.run import to_trace
+        from cageless.simulation.solve import solve
 
         c = self.choices
         prov = Provenance.start(config={"scene": self.scene.to_dict(), "model": json.loads(self.model.to_json()),
@@ -163,8 +163,8 @@ class Simulation:
         pr = self.build()
         t = self.sample_times()
         start = time.perf_counter()
-        sol = solve_chunks(pr, t, c.rtol, c.method, c.max_step, min(50, len(t) - 1), progress, c.max_steps,
-                           c.force_jump)
+        sol = solve(pr, t, c.method, c.rtol, np.inf if c.max_step is None else c.max_step, max_steps=c.max_steps,
+                    force_jump=c.force_jump, chunks=min(50, len(t) - 1), progress=progress)
         wall = time.perf_counter() - start
         provenance = prov.finish().to_dict()
         provenance["solver_stats"] = {"n_steps": sol.n_steps, "n_rejected": sol.n_rejected, "n_rhs": sol.n_rhs,

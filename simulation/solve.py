@@ -526,7 +526,7 @@ METHODS: dict[str, Method] = {
 
 def solve(problem: Problem, t_eval: npt.ArrayLike, method: str = "dp5", rtol: float = 1e-6,
           max_step: float = np.inf, first_step: float | None = None, max_steps: int = 50_000_000,
-          force_jump: float = FORCE_JUMP) -> Solution:
+          force_jump: float = FORCE_JUMP, chunks: int | None = None, progress: bool = False) -> Solution:
     """Integrate ``problem`` and sample it at ``t_eval``.
 
     Parameters
@@ -551,6 +551,13 @@ def solve(problem: Problem, t_eval: npt.ArrayLike, method: str = "dp5", rtol: fl
         floor), and retry it at half the length, so a force that rises steeply inside a contact is
         resolved even when the error estimate passes (the role of the contact-force-change trigger of
         Gupta's GSTIFF integrator, paper §2.6). 0 turns it off.
+    chunks
+        Cut the run at sample times into about this many pieces
+        (:func:`cageless.simulation.auto_switch.solve_chunks`): ``"auto"`` re-decides its method between them
+        and ``progress`` shows a bar of the simulated time; an infinite ``max_step`` then gives each method its
+        default cap. None: one piece (``"auto"`` always runs in up to 50).
+    progress
+        With ``chunks``: show the progress bar (and the compile notice of a first run).
 
     Raises
     ------
@@ -571,4 +578,10 @@ def solve(problem: Problem, t_eval: npt.ArrayLike, method: str = "dp5", rtol: fl
         raise ParameterError("t_eval", f"must be increasing times >= t0 = {problem.t0}")
     if problem.atol.shape != problem.y0.shape or np.any(problem.atol <= 0):
         raise ParameterError("atol", "must be positive, one per state")
+    if chunks is not None:
+        from cageless.simulation.auto_switch import solve_chunks
+
+        cap = float(max_step) if np.isfinite(max_step) else None
+        return solve_chunks(problem, t, rtol, method, cap, max(1, int(chunks)), progress, int(max_steps),
+                            float(force_jump))
     return METHODS[method](problem, t, rtol, float(max_step), first_step, int(max_steps), float(force_jump))

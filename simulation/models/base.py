@@ -30,6 +30,7 @@ P_F_TRAC, P_TA, P_TB, P_TC, P_TD, P_U_FLOOR = LAYOUT.slots("F_TRAC", "TA", "TB",
 P_RC_I, P_RH_I, P_LT_FILM_I, P_LT_FIX_I = LAYOUT.slots("RC_I", "RH_I", "LT_FILM_I", "LT_FIX_I")
 P_RC_O, P_RH_O, P_LT_FILM_O, P_LT_FIX_O = LAYOUT.slots("RC_O", "RH_O", "LT_FILM_O", "LT_FIX_O")
 P_F_BB, P_KB, P_CHI, P_V_IN_MIN = LAYOUT.slots("F_BB", "KB", "CHI", "V_IN_MIN")
+P_F_BBFRIC = LAYOUT.index("F_BBFRIC")
 P_F_BBFILM, P_ETA0, P_H0 = LAYOUT.slots("F_BBFILM", "ETA0", "H0")
 P_F_GRAV, P_G = LAYOUT.slots("F_GRAV", "G")
 P_F_DRAG, P_CD, P_RHO_MIX, P_MU_MIX = LAYOUT.slots("F_DRAG", "CD", "RHO_MIX", "MU_MIX")
@@ -41,11 +42,16 @@ N_PARAMS = len(LAYOUT)
 #: the elastic (Hertz) part of the outer and inner race normal forces (N), the race traction the tangential
 #: law gives (N, on the ball along the rolling direction), the race contacts' entrainment speeds u_r (m/s),
 #: the elastic normal force and the friction magnitude between balls j and j+1 (N), then the race films (m),
-#: filled from the same pass by :func:`cageless.simulation.models.observables.kernel_observables`.
+#: filled from the same pass by :func:`cageless.simulation.models.observables.kernel_observables`, and the
+#: sliding speed of the ball's surface against the outer and inner race at the contact centre, along the
+#: direction the traction is given in (m/s: the speed the traction law was evaluated at, so the traction
+#: opposes it).
 OBSERVABLES = ("outer_normal", "inner_normal", "outer_traction", "inner_traction", "outer_entrainment",
-               "inner_entrainment", "ball_ball_normal", "ball_ball_traction", "outer_film", "inner_film")
+               "inner_entrainment", "ball_ball_normal", "ball_ball_traction", "outer_film", "inner_film",
+               "outer_sliding", "inner_sliding")
 (OBS_OUTER_NORMAL, OBS_INNER_NORMAL, OBS_OUTER_TRACTION, OBS_INNER_TRACTION, OBS_OUTER_ENTRAIN, OBS_INNER_ENTRAIN,
- OBS_BB_NORMAL, OBS_BB_TRACTION, OBS_OUTER_FILM, OBS_INNER_FILM) = range(len(OBSERVABLES))
+ OBS_BB_NORMAL, OBS_BB_TRACTION, OBS_OUTER_FILM, OBS_INNER_FILM, OBS_OUTER_SLIDE, OBS_INNER_SLIDE) = range(
+    len(OBSERVABLES))
 N_OBS = len(OBSERVABLES)
 
 

@@ -61,7 +61,8 @@ def spatial_energy(problem: Problem, y: npt.NDArray[np.float64]) -> npt.NDArray[
           + 0.5 * m_ring * (cvx**2 + cvy**2 + cvz**2) + 0.5 * p[P_IR] * (y[:, -2] ** 2 + y[:, -1] ** 2))
     pe = m * g * np.sum(r * np.sin(th), axis=1) + (m_ring * g + p[B.P_FR]) * y[:, 5 * z + 1] - p[P_FA] * y[:, b + 4 * z]
     pe -= p[P_MY] * y[:, -4]  # the moment load's work on the tilt beta_y
-    pe += p[P_GAX] * (m * np.sum(ax, axis=1) + m_ring * y[:, b + 4 * z])  # gravity along the shaft
+    if p[B.P_F_GRAV] > 0.5:  # gravity along the shaft
+        pe += p[P_GAX] * (m * np.sum(ax, axis=1) + m_ring * y[:, b + 4 * z])
     if p[B.P_F_RACE] > 0.5:
         for race, (overlap, _, _) in race_geometry(problem, y).items():
             pe += 0.4 * (p[B.P_KI] if race == "inner" else p[B.P_KO]) * np.sum(overlap**2.5, axis=1)

@@ -11,9 +11,14 @@ sample loop, so a run compiles the observation code of its own model only. They 
 * ``inner_traction``, ``outer_traction``: the race traction on the ball along the rolling direction, the
   tangential law at the contact's own sliding and entrainment speeds on that elastic normal force (the
   right-hand side applies it to the whole normal force, lubricant damping included);
+* ``inner_sliding``, ``outer_sliding``: the sliding speed of the ball's surface against the race at the
+  contact centre, along the direction of the traction (the speed the traction law was evaluated at);
+  ``inner_entrainment``, ``outer_entrainment``: the contact's mean rolling speed u_r;
 * ``ball_ball_traction``: the magnitude of the friction between balls j and j+1, likewise;
 * ``*_film``: the Hamrock-Dowson central film on the elastic load at the kernel's entrainment speed (NaN
-  where a contact is open, or where race traction is off: the race kernels then compute no entrainment).
+  where a contact is open, or where race traction is off: the race kernels then compute no entrainment),
+  from the same compiled formula the film-regime traction uses
+  (:func:`cageless.simulation.physics.film_traction.hd_central_film`).
 
 The spatial model's contact angles and points are geometry of the samples
 (:func:`cageless.simulation.models.spatial_geometry.race_geometry`). The trace's ``balls``, ``contacts``
@@ -47,8 +52,9 @@ def observables(pr: Problem, t: npt.NDArray[np.float64], y: npt.NDArray[np.float
     trac = p[B.P_F_TRAC] > 0.5
     # the films at the oil's viscosity at its temperature, as the race forces use it (the ETA0 slot)
     fields = kernel_observables(pr, t, y, film_coefficients(scene, float(p[B.P_ETA0])) if film_on and trac else None)
-    names = ["inner_normal", "outer_normal", "ball_ball_normal"] + (["inner_traction", "outer_traction"] if trac
-                                                                     else [])
+    names = ["inner_normal", "outer_normal", "ball_ball_normal"]
+    names += ["inner_traction", "outer_traction", "inner_sliding", "outer_sliding", "inner_entrainment",
+              "outer_entrainment"] if trac else []
     names += ["inner_film", "outer_film"] if film_on else []
     contacts = {name: fields[:, B.OBSERVABLES.index(name)] for name in names}
     r, om = y[:, :z], y[:, 4 * z:5 * z]
@@ -66,7 +72,7 @@ def observables(pr: Problem, t: npt.NDArray[np.float64], y: npt.NDArray[np.float
         for race, (_, angle, point) in race_geometry(pr, y).items():
             contacts[f"{race}_angle"] = angle
             contacts[f"{race}_point"] = point
-    if trac:
+    if p[B.P_F_BBFRIC] > 0.5:
         contacts["ball_ball_traction"] = fields[:, B.OBS_BB_TRACTION]
     return {
         "balls": {"radius": r, "axial": axial, "spin": spin},
@@ -126,7 +132,7 @@ def _films(row, c_outer, c_inner):  # pragma: no cover - compiled
 
 def film_coefficients(scene: Scene, viscosity_pa_s: float | None = None) -> tuple[float, float]:
     """c_h of the outer and inner race contact in the Hamrock-Dowson central film h = c_h u^0.67 Q^-0.067
-    (:func:`cageless.simulation.traction.film_coefficient`; SI units), at ``viscosity_pa_s`` (default: the
+    (:func:`cageless.simulation.traction.film_coefficient`, on the compiled formula; SI units), at ``viscosity_pa_s`` (default: the
     lubricant's reference viscosity; a run passes its oil's viscosity at the oil temperature)."""
     b = scene.bearing
     g, lub = b.geometry, b.lubricant

@@ -51,11 +51,13 @@ from cageless.simulation import effects as effects_table
 from cageless.simulation.effects import check_lubricant, effect_flags
 from cageless.simulation.parameters import ModelParameters
 from cageless.simulation.problem import Problem
-from cageless.simulation.models.base import (LAYOUT, OBS_BB_NORMAL, OBS_BB_TRACTION, OBS_INNER_ENTRAIN, OBS_INNER_NORMAL,
-                                             OBS_INNER_TRACTION, OBS_OUTER_ENTRAIN, OBS_OUTER_NORMAL, OBS_OUTER_TRACTION,
-                                             P_CD, P_CHI, P_CHO, P_D, P_DI, P_DO, P_DRY, P_ETA0, P_FR,
-                                    P_F_BB, P_F_BBFILM, P_F_DRAG, P_F_GRAV, P_F_LUB, P_F_RACE, P_F_ROLL, P_F_TRAC, P_G, P_H0,
-                                    P_I, P_KB, P_KI, P_KO, P_M, P_MR, P_RAMP, P_RHO_MIX, P_V_IN_MIN, P_WI, P_Z, signature_add)
+from cageless.simulation.models.base import (LAYOUT, OBS_BB_NORMAL, OBS_BB_TRACTION, OBS_INNER_ENTRAIN,
+                                             OBS_INNER_NORMAL, OBS_INNER_SLIDE, OBS_INNER_TRACTION,
+                                             OBS_OUTER_ENTRAIN, OBS_OUTER_NORMAL, OBS_OUTER_SLIDE,
+                                             OBS_OUTER_TRACTION, P_CHI, P_CHO, P_D, P_DI, P_DO, P_DRY, P_ETA0,
+                                             P_FR, P_F_BB, P_F_BBFILM, P_F_BBFRIC, P_F_DRAG, P_F_GRAV, P_F_LUB,
+                                             P_F_RACE, P_F_ROLL, P_F_TRAC, P_G, P_H0, P_I, P_KB, P_KI, P_KO, P_M,
+                                             P_MR, P_RAMP, P_RHO_MIX, P_V_IN_MIN, P_WI, P_Z, signature_add)
 from cageless.simulation.models.energy import planar_energy
 from cageless.simulation.models.planar_layout import PlanarLayout
 from cageless.simulation.models.contact_log import (EVENT_FIELDS, ONSET_RESOLUTION, RUBBING_FACTOR, contact_events,
@@ -114,6 +116,7 @@ def _outer_race(y, p, j, z, c, s, obs):  # pragma: no cover - compiled
             if obs is not None:  # the law on the elastic normal force
                 obs[OBS_OUTER_TRACTION] = -race_tangential(u, u_r, obs[OBS_OUTER_NORMAL], False, p)
                 obs[OBS_OUTER_ENTRAIN] = u_r
+                obs[OBS_OUTER_SLIDE] = u
             p_diss -= f_t * u
             torque += half * f_t
         if p[P_F_ROLL] > 0.5:  # rolling losses (models/rolling.py): pressure on the centre, shear at the surface
@@ -167,6 +170,7 @@ def _inner_race(y, p, j, z, w_i, c, s, fy, fz, torque, p_diss, obs):  # pragma: 
             if obs is not None:  # the law on the elastic normal force
                 obs[OBS_INNER_TRACTION] = -race_tangential(u, u_r, obs[OBS_INNER_NORMAL], True, p)
                 obs[OBS_INNER_ENTRAIN] = u_r
+                obs[OBS_INNER_SLIDE] = u
             p_diss -= f_t * u
             p_in += w_i * r_i * f_t
             torque -= half * f_t
@@ -219,7 +223,7 @@ def _pair_forces(y, p, log, j, k, z, cj, sj, ck, sk, obs):  # pragma: no cover -
     if obs is not None:
         obs[OBS_BB_NORMAL] = elastic
     f_t = torque = 0.0
-    if p[P_F_TRAC] > 0.5:
+    if p[P_F_BBFRIC] > 0.5:
         tx, tz = -nz, nx
         om_j, om_k = y[4 * z + j], y[4 * z + k]
         u = (vjx - vkx) * tx + (vjz - vkz) * tz + 0.5 * d * (om_j + om_k)  # surface of j against k, along t
@@ -339,6 +343,14 @@ def planar_ring_rows(n_balls: int) -> list[int]:
     return [5 * n_balls + 2, 5 * n_balls + 3, 5 * n_balls + 4, 5 * n_balls + 5]
 
 
+def planar_state_blocks(n_balls: int) -> tuple[list[list[int]], list[int], list[int], list[int]]:
+    """The state layout as the Jacobian's structure needs it: each per-ball field's indices (r, theta, r',
+    theta', spin), the rows :func:`planar_ring_share` fills, the ring's own states and the two energy counters."""
+    z = n_balls
+    return ([list(range(f * z, (f + 1) * z)) for f in range(5)], planar_ring_rows(z),
+            list(range(5 * z, 5 * z + 4)), [5 * z + 4, 5 * z + 5])
+
+
 @numba.njit(cache=True, inline="always")
 def planar_observe(t, y, p, log, out):  # pragma: no cover - compiled
     """The observables of state ``y`` at time t from the right-hand side's own force functions: per ball j,
@@ -429,7 +441,7 @@ def _params(bearing: Bearing, radial_load_n: float, gravity_m_s2: float, inner_s
     LAYOUT.fill(p, {"CHO": par.cho_n_s_m, "H0": par.film_thickness_m, "TA": ta, "TB": tb, "TC": tc, "TD": td,
                     "V_REG": par.slip_regularisation_m_s, "U_FLOOR": par.min_entrainment_m_s,
                     "CD": par.drag_coefficient or 0.0, "V_IN_MIN": par.min_approach_speed_m_s})
-    if p[P_DRY] and p[P_F_TRAC]:
+    if p[P_DRY] and (p[P_F_TRAC] or p[P_F_BBFRIC]):
         if par.dry_friction_coefficient is None:
             raise ParameterError("dry_friction_coefficient", "a dry scene needs the Coulomb friction of the bare "
                                  "steel contacts, which has no cited default: give it with "
@@ -437,8 +449,6 @@ def _params(bearing: Bearing, radial_load_n: float, gravity_m_s2: float, inner_s
         LAYOUT.fill(p, {"MU_DRY": par.dry_friction_coefficient,
                         "MU_STATIC": par.dry_static_coefficient or par.dry_friction_coefficient,
                         "V_STRIBECK": par.stribeck_speed_m_s})
-    else:
-        p[P_DRY] = 0.0  # no friction law is evaluated: nothing to switch
     if p[P_F_ROLL]:
         LAYOUT.fill(p, rolling_slots(bearing, par))
     if lubricated:  # the oil at its temperature; the regime traction's constants (models/regime.py)

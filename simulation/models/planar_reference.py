@@ -178,7 +178,7 @@ def _pairs(y: np.ndarray, p: np.ndarray, log: np.ndarray, fy: np.ndarray, fz: np
                                       0), 0.0)
     power = np.sum((f - el) * ddot * touching)
     ft = np.zeros(z)
-    if p[B.P_F_TRAC] > 0.5:
+    if p[B.P_F_BBFRIC] > 0.5:
         u = (vx - vx[k]) * -nz + (vz - vz[k]) * nx + 0.5 * d * (om + om[k])
         ft = np.where(touching, -tangential_force(u, 0.25 * d * np.abs(om - om[k]), f, p), 0.0)
         power -= np.sum(ft * u)

@@ -87,14 +87,15 @@ def _race(y, p, j, z, inner, w_i, rot, c, s, wt, obs):  # pragma: no cover - com
     t2x = t2y = t2z = 0.0
     p_in = 0.0
     if p[B.P_F_TRAC] > 0.5 and q > 0.0:
-        (gsx, gsy, gsz), (t2x, t2y, t2z), (mx, my, mz), p_in, p_diss, _ = _race_traction(
+        (gsx, gsy, gsz), (t2x, t2y, t2z), (mx, my, mz), p_in, p_diss, _, _ = _race_traction(
             p, inner, q, w_i, rot, wt, (ox, oy, oz), n, t, xr, rv, a_c, r_c, rq, half, p_diss)
         fx, fy, fz = fx + gsx, fy + gsy, fz + gsz
     if obs is not None and p[B.P_F_TRAC] > 0.5:  # the law on the elastic normal force, along t as the planar one's
-        g_el, _, _, _, _, u_r = _race_traction(p, inner, obs[B.OBS_OUTER_NORMAL + side], w_i, rot, wt, (ox, oy, oz), n,
+        g_el, _, _, _, _, u_r, u_s = _race_traction(p, inner, obs[B.OBS_OUTER_NORMAL + side], w_i, rot, wt, (ox, oy, oz), n,
                                                t, xr, rv, a_c, r_c, rq, half, 0.0)
         obs[B.OBS_OUTER_TRACTION + side] = g_el[0] * t[0] + g_el[1] * t[1] + g_el[2] * t[2]
         obs[B.OBS_OUTER_ENTRAIN + side] = u_r
+        obs[B.OBS_OUTER_SLIDE + side] = u_s
     rmx = rmy = rmz = 0.0
     if inner:  # reaction on the ring: -F at the contact point, and -t2
         rmx, rmy, rmz = _cross(xrx, xry, xrz, -fx, -fy, -fz)
@@ -170,7 +171,8 @@ def _race_normal(p, q, delta, rv, n):  # pragma: no cover - compiled
 def _race_traction(p, inner, q, w_i, rot, wt, o, n, t, xr, rv, a_c, r_c, rq, half, p_diss):  # pragma: no cover
     """Race traction integrated over the strips of the contact ellipse: the force on the ball (3), the moment
     of its spread along the major axis (3), the whole moment on the ball (3), the drive's input power, and the
-    dissipated power with the traction's share added; and the entrainment speed u_r."""
+    dissipated power with the traction's share added; the entrainment speed u_r, and the sliding speed of the
+    ball's surface against the race at the contact centre along t (for the observables)."""
     ox, oy, oz = o
     nx, ny, nz = n
     tx, ty, tz = t
@@ -210,7 +212,8 @@ def _race_traction(p, inner, q, w_i, rot, wt, o, n, t, xr, rv, a_c, r_c, rq, hal
         # drive power: the ring's spin times the moment of the ball's traction on it
         c1x, c1y, c1z = _cross(xrx, xry, xrz, gsx, gsy, gsz)
         p_in = (c1x + t2x) * wx + (c1y + t2y) * wy + (c1z + t2z) * wz
-    return (gsx, gsy, gsz), (t2x, t2y, t2z), (t1x + t2x, t1y + t2y, t1z + t2z), p_in, p_diss, u_r
+    u_s = u0x * tx + u0y * ty + u0z * tz
+    return (gsx, gsy, gsz), (t2x, t2y, t2z), (t1x + t2x, t1y + t2y, t1z + t2z), p_in, p_diss, u_r, u_s
 
 
 @numba.njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -273,7 +276,7 @@ def _pair(y, p, log, j, k, z, cj, sj, ck, sk, obs):  # pragma: no cover - compil
         obs[B.OBS_BB_NORMAL] = elastic
     fx, fy, fz = (f + f_film) * nx, (f + f_film) * ny, (f + f_film) * nz
     mx = my = mz = 0.0
-    if p[B.P_F_TRAC] > 0.5:
+    if p[B.P_F_BBFRIC] > 0.5:
         ojx, ojy, ojz = y[4 * z + j], y[b + 2 * z + j], y[b + 3 * z + j]
         okx, oky, okz = y[4 * z + k], y[b + 2 * z + k], y[b + 3 * z + k]
         sx, sy, sz = _cross(ojx + okx, ojy + oky, ojz + okz, half * nx, half * ny, half * nz)
@@ -316,6 +319,7 @@ def spatial_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
     b = 5 * z + 6
     m_ring = p[B.P_MR]
     grav = p[B.P_G] if p[B.P_F_GRAV] > 0.5 else 0.0
+    g_ax = p[P_GAX] if p[B.P_F_GRAV] > 0.5 else 0.0  # along the shaft (vertical shaft)
     ramp = p[B.P_RAMP]
     w_i = p[B.P_WI] * (min(t / ramp, 1.0) if ramp > 0.0 else 1.0)
     rot = _tilt(y, p)
@@ -324,8 +328,8 @@ def spatial_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
     wt = (-s_bz * y[tb + 2], c_bz * y[tb + 2], y[tb + 3])  # angular velocity of the tilting: bz' z + by' Rz y
     rmx = rmy = rmz = 0.0
     trig = log.shape[0] - 2 * z  # scratch: cos and sin of every ball's angle, once per call
-    _start(y, p, log, dydt, z, trig, grav)
-    rfx, rfy, rfz = p[P_FA] - m_ring * p[P_GAX], 0.0, -p[B.P_FR] - m_ring * grav
+    _start(y, p, log, dydt, z, trig, grav, g_ax)
+    rfx, rfy, rfz = p[P_FA] - m_ring * g_ax, 0.0, -p[B.P_FR] - m_ring * grav
     power_in = power = 0.0
     if p[B.P_F_RACE] > 0.5:
         for j in range(z):
@@ -364,9 +368,10 @@ def spatial_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, fastmath=FASTMATH, inline="always")
-def _start(y, p, log, dydt, z, trig, grav):  # pragma: no cover - compiled
+def _start(y, p, log, dydt, z, trig, grav, g_ax):  # pragma: no cover - compiled
     """Zero ``dydt``, fill the trig scratch, and start the force accumulators (x in the axial slot, y and z in
-    the planar acceleration slots; moments in the spin slots) with the balls' weight."""
+    the planar acceleration slots; moments in the spin slots) with the balls' weight (``grav`` across the
+    shaft, ``g_ax`` along it: both 0 when the gravity effect is off)."""
     b = 5 * z + 6
     m = p[B.P_M]
     for i in range(dydt.shape[0]):
@@ -376,7 +381,7 @@ def _start(y, p, log, dydt, z, trig, grav):  # pragma: no cover - compiled
         log[trig + z + j] = math.sin(y[z + j])
     for j in range(z):
         dydt[3 * z + j] = -m * grav
-        dydt[b + z + j] = -m * p[P_GAX]  # gravity along the shaft (vertical shaft)
+        dydt[b + z + j] = -m * g_ax
 
 
 @numba.njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -469,6 +474,17 @@ def spatial_ring_rows(n_balls: int) -> list[int]:
     b = 5 * n_balls + 6
     return [5 * n_balls + 2, 5 * n_balls + 3, b + 4 * n_balls + 1, b + 4 * n_balls + 4, b + 4 * n_balls + 5,
             5 * n_balls + 4, 5 * n_balls + 5]
+
+
+def spatial_state_blocks(n_balls: int, n_states: int) -> tuple[list[list[int]], list[int], list[int], list[int]]:
+    """The state layout as the Jacobian's structure needs it: each per-ball field's indices (the planar five,
+    then axial position and rate and the two transverse spins), the rows :func:`spatial_ring_share` fills, the
+    ring's own states and the two energy counters."""
+    z, b = n_balls, 5 * n_balls + 6
+    fields = [list(range(f * z, (f + 1) * z)) for f in range(5)]
+    fields += [list(range(b + f * z, b + (f + 1) * z)) for f in range(4)]
+    return (fields, spatial_ring_rows(z), list(range(5 * z, 5 * z + 4)) + list(range(b + 4 * z, n_states)),
+            [5 * z + 4, 5 * z + 5])
 
 
 def spatial_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayLike, ring0: tuple[float, float],

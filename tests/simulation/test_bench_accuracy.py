@@ -48,11 +48,14 @@ def test_model_fidelity_study_table():
 
 
 def test_effects_ablation_table():
-    from cageless.simulation.bench import OPTIONAL_EFFECTS, effects_study, format_effects
+    from cageless.simulation.bench import effects_study, format_effects
+    from cageless.simulation.effects import removable_effects
 
     result = effects_study(rpm=6000.0, duration_s=0.02, settle_s=0.01)
     rows = {r["removed"]: r for r in result["rows"]}
-    assert set(rows) == {"(none: full model)", *OPTIONAL_EFFECTS}
+    # every effect of the table but the two contacts that make the model (race, ball-ball)
+    assert set(rows) == {"(none: full model)", *removable_effects()}
+    assert {"film_traction", "ball_ball_friction", "dry_friction"} <= set(rows)
     assert rows["drag"].get("note") is None  # on by default in a lubricated scene (issue 16)
     assert rows["race_traction"]["peak_slip_pct"] > 50  # nothing drives the balls without traction
     # the film sets the rolling force (issue 16): removing either moves the profile

@@ -24,7 +24,7 @@ def test_radial_lubricated_scene():
     c = choose_model(scene())
     assert c.level == "planar"
     assert c.active == ("race_contact", "lubricant_damping", "race_traction", "ehl_film", "film_traction",
-                        "rolling_losses", "ball_ball_contact", "ball_ball_film", "gravity", "drag")
+                        "rolling_losses", "ball_ball_contact", "ball_ball_friction", "ball_ball_film", "gravity", "drag")
     # drag is on by default in a lubricated scene, in the 5 % oil-air mixture: 0.05 x 826 + 0.95 x 1.204 = 42.44
     assert {e.name: e.reason for e in c.effects}["drag"].startswith("lubricated: oil-air mixture of 42.4 kg/m^3")
     off = choose_model(scene(oil_air_density_kg_m3=0.0))
@@ -35,7 +35,8 @@ def test_scene_rules():
     dry = scene(bearing=dataclasses.replace(default_bearing(), lubricant=None), gravity_m_s2=0.0,
                 oil_air_density_kg_m3=4.0)
     c = choose_model(dry)
-    assert set(c.active) == {"race_contact", "race_traction", "ball_ball_contact", "drag", "dry_friction"}
+    assert set(c.active) == {"race_contact", "race_traction", "ball_ball_contact", "ball_ball_friction", "drag",
+                            "dry_friction"}
     axial = choose_model(scene(conditions=OperatingConditions(3000.0, 500.0, 300.0)))
     assert axial.level == "spatial" and "axial load 300 N" in axial.level_reason
     assert choose_model(scene(misalignment_rad=1e-3)).level == "spatial"
@@ -92,7 +93,7 @@ def test_the_parameter_layout_comes_from_the_table():
 
 
 def test_every_effect_has_a_rule_and_physics():
-    assert len({e.name for e in EFFECTS}) == len(EFFECTS) == 11
+    assert len({e.name for e in EFFECTS}) == len(EFFECTS) == 12
     for e in EFFECTS:
         on, reason = e.rule(scene())
         assert isinstance(on, bool) and reason and e.physics
@@ -102,8 +103,27 @@ def test_simulate_explain_cli(capsys):
     assert main(["simulate", "--speed-rpm", "3000", "--radial-load-n", "500", "--axial-load-n", "400",
                  "--explain", "--json"]) == 0
     d = json.loads(capsys.readouterr().out)
-    assert d["level"] == "spatial" and len(d["effects"]) == 11
+    assert d["level"] == "spatial" and len(d["effects"]) == 12
     assert main(["simulate", "--speed-rpm", "3000", "--effect", "drag=maybe", "--explain"]) == 2
     assert "write NAME=on or NAME=off" in capsys.readouterr().err
     assert main(["simulate", "--speed-rpm", "3000", "--set", "cho_n_s=1"]) == 2
     assert "Did you mean 'cho_n_s_m'" in capsys.readouterr().err
+
+
+def test_an_effect_with_nothing_to_act_on_is_off_with_its_reason():
+    """``acts_on``: film_traction changes race_traction's law, dry_friction that of both friction effects; with
+    their targets off they are off, saying why, so no flag claims a law that is not evaluated."""
+    c = choose_model(scene(), effects={"race_traction": False}, force=True)
+    by = {e.name: e for e in c.effects}
+    assert not by["film_traction"].on and by["film_traction"].reason == "nothing to act on: race_traction is off"
+    assert by["ball_ball_friction"].on  # its own unit now: not switched by the race traction
+    dry = Scene(conditions=OperatingConditions(3000.0, 500.0), bearing=dataclasses.replace(default_bearing(),
+                                                                                        lubricant=None))
+    c = choose_model(dry, effects={"race_traction": False, "ball_ball_friction": False}, force=True)
+    by = {e.name: e for e in c.effects}
+    assert not by["dry_friction"].on
+    assert by["dry_friction"].reason == "nothing to act on: race_traction and ball_ball_friction are off"
+    with pytest.raises(UsageError, match="--effect film_traction=on changes the law of race_traction"):
+        choose_model(scene(), effects={"race_traction": False, "film_traction": True}, force=True)
+    with pytest.raises(UsageError, match="ball_ball_friction on a dry bearing needs the dry_friction effect"):
+        choose_model(dry, effects={"race_traction": False, "dry_friction": False}, force=True)

@@ -17,7 +17,7 @@ from cageless.conditions import OperatingConditions
 from cageless.simulation.models import base as B
 from cageless.simulation.models.observables import film_coefficients, kernel_observables
 from cageless.simulation.models.planar_reference import tangential_force
-from cageless.simulation.models.regime import P_F_FTRAC, race_tangential_array
+from cageless.simulation.models.regime import race_tangential_array
 from cageless.simulation.parameters import ModelParameters
 from cageless.simulation.scene import Scene
 from cageless.simulation.simulation import Choices, Simulation
@@ -36,31 +36,32 @@ def _moving_state(pr, seed=0):
 
 
 def _closed_forms(pr, t, y, ramp_s):
-    """(outer normal, inner normal, outer traction, inner traction, outer u_r, inner u_r) from the state."""
+    """(outer normal, inner normal, outer traction, inner traction, outer u_r, inner u_r, outer sliding speed,
+    inner sliding speed) from the state."""
     p = pr.params
     z = pr.n_balls
-    d, half = p[B.P_D], 0.5 * p[B.P_D]
+    d, half = pr.parameter("D"), 0.5 * pr.parameter("D")
     r, th, rd, thd, om = (y[i * z:(i + 1) * z] for i in range(5))
     cy, cz, cvy, cvz = y[5 * z:5 * z + 4]
-    w_i = p[B.P_WI] * min(t / ramp_s, 1.0)
-    outer = p[B.P_KO] * np.clip(r + half - 0.5 * p[B.P_DO], 0, None) ** 1.5
+    w_i = pr.parameter("WI") * min(t / ramp_s, 1.0)
+    outer = pr.parameter("KO") * np.clip(r + half - 0.5 * pr.parameter("DO"), 0, None) ** 1.5
     sx, sz = r * np.cos(th) - cy, r * np.sin(th) - cz
     ln = np.hypot(sx, sz)
-    inner = p[B.P_KI] * np.clip(0.5 * p[B.P_DI] + half - ln, 0, None) ** 1.5
+    inner = pr.parameter("KI") * np.clip(0.5 * pr.parameter("DI") + half - ln, 0, None) ** 1.5
     u_o = r * thd + half * om
-    ur_o = 0.5 * np.abs(u_o - p[B.P_DO] * thd)
+    ur_o = 0.5 * np.abs(u_o - pr.parameter("DO") * thd)
     vx, vz = rd * np.cos(th) - r * thd * np.sin(th) - cvy, rd * np.sin(th) + r * thd * np.cos(th) - cvz
     vt = (-vx * sz + vz * sx) / ln
-    r_i = 0.5 * p[B.P_DI]
+    r_i = 0.5 * pr.parameter("DI")
     u_i = vt - half * om - w_i * r_i
     ur_i = 0.5 * np.abs(vt * (1 - 2 * r_i / ln) - half * om + w_i * r_i)
     assert d > 0
-    if p[P_F_FTRAC] > 0.5:  # traction by film regime: the law is checked by hand in test_film_traction_models
+    if pr.parameter("F_FTRAC") > 0.5:  # traction by film regime: the law is checked by hand in test_film_traction_models
         f_o, f_i = -race_tangential_array(u_o, ur_o, outer, False, p), -race_tangential_array(u_i, ur_i, inner, True, p)
     else:
         f_o, f_i = -tangential_force(u_o, ur_o, outer, p), -tangential_force(u_i, ur_i, inner, p)
-    return (outer, inner, f_o, f_i,
-            np.where(outer > 0, ur_o, 0.0), np.where(inner > 0, ur_i, 0.0))
+    return (outer, inner, f_o, f_i, np.where(outer > 0, ur_o, 0.0), np.where(inner > 0, ur_i, 0.0),
+            np.where(outer > 0, u_o, 0.0), np.where(inner > 0, u_i, 0.0))
 
 
 def test_planar_observables_are_the_closed_forms_at_the_sample():
@@ -74,11 +75,11 @@ def test_planar_observables_are_the_closed_forms_at_the_sample():
     out = kernel_observables(pr, ts, ys, film)
     assert out.shape == (3, B.N_OBS, pr.n_balls)
     for i, (t, y) in enumerate(zip(ts, ys, strict=True)):
-        outer, inner, f_o, f_i, ur_o, ur_i = _closed_forms(pr, t, y, ramp)
+        outer, inner, f_o, f_i, ur_o, ur_i, us_o, us_i = _closed_forms(pr, t, y, ramp)
         assert np.sum(inner > 10.0) >= 5 and np.sum(outer > 10.0) >= 5  # the loaded zone is in contact
         for field, expected in ((B.OBS_OUTER_NORMAL, outer), (B.OBS_INNER_NORMAL, inner), (B.OBS_OUTER_TRACTION, f_o),
                                 (B.OBS_INNER_TRACTION, f_i), (B.OBS_OUTER_ENTRAIN, ur_o),
-                                (B.OBS_INNER_ENTRAIN, ur_i)):
+                                (B.OBS_INNER_ENTRAIN, ur_i), (B.OBS_OUTER_SLIDE, us_o), (B.OBS_INNER_SLIDE, us_i)):
             np.testing.assert_allclose(out[i, field], expected, rtol=1e-7, atol=1e-9 * np.max(np.abs(expected)),
                                        err_msg=B.OBSERVABLES[field])
         for field, q, u, c_h in ((B.OBS_OUTER_FILM, outer, ur_o, film[0]), (B.OBS_INNER_FILM, inner, ur_i, film[1])):
@@ -86,6 +87,9 @@ def test_planar_observables_are_the_closed_forms_at_the_sample():
             np.testing.assert_allclose(out[i, field][loaded], c_h * np.maximum(u[loaded], 1e-6) ** 0.67
                                        * q[loaded] ** -0.067, rtol=1e-7)
             assert np.all(np.isnan(out[i, field][~loaded]))
+    # the traction opposes the sliding it was evaluated at
+    loaded = out[:, B.OBS_INNER_NORMAL] > 10.0
+    assert np.all(out[:, B.OBS_INNER_TRACTION][loaded] * out[:, B.OBS_INNER_SLIDE][loaded] <= 0.0)
     # the ramp enters the inner contact's entrainment: at 1/4 of the ring speed it is not the full-speed value
     full = _closed_forms(pr, ramp, ys[0], ramp)[5]
     assert np.max(np.abs(out[0, B.OBS_INNER_ENTRAIN] - full)) > 0.5
@@ -96,7 +100,9 @@ def test_non_finite_samples_give_nan_rows():
     pr = Simulation(scene).build()
     ys = np.array([_moving_state(pr), np.full(pr.y0.shape, np.nan)])
     out = kernel_observables(pr, np.array([0.0, 1e-4]), ys)
-    assert np.all(np.isfinite(out[0, :B.OBS_OUTER_FILM])) and np.all(np.isnan(out[0, B.OBS_OUTER_FILM:]))
+    films = [B.OBS_OUTER_FILM, B.OBS_INNER_FILM]
+    others = [k for k in range(B.N_OBS) if k not in films]
+    assert np.all(np.isfinite(out[0, others])) and np.all(np.isnan(out[0, films]))
     assert np.all(np.isnan(out[1]))
 
 
@@ -112,8 +118,9 @@ def test_spatial_observables_reduce_to_the_planar_ones():
     a = kernel_observables(planar, np.array([1e-3]), y_p[None])[0]
     b = kernel_observables(spatial, np.array([1e-3]), y_s[None])[0]
     # a race contact at zero overlap is closed in one model and open in the other by round-off (its force ~0)
-    touching = {B.OBS_OUTER_ENTRAIN: a[B.OBS_OUTER_NORMAL] > 1e-3, B.OBS_INNER_ENTRAIN: a[B.OBS_INNER_NORMAL] > 1e-3}
-    for field in range(B.OBS_OUTER_FILM):
+    touching = {B.OBS_OUTER_ENTRAIN: a[B.OBS_OUTER_NORMAL] > 1e-3, B.OBS_INNER_ENTRAIN: a[B.OBS_INNER_NORMAL] > 1e-3,
+                B.OBS_OUTER_SLIDE: a[B.OBS_OUTER_NORMAL] > 1e-3, B.OBS_INNER_SLIDE: a[B.OBS_INNER_NORMAL] > 1e-3}
+    for field in [k for k in range(B.N_OBS) if k not in (B.OBS_OUTER_FILM, B.OBS_INNER_FILM)]:
         keep = touching.get(field, np.ones(z, dtype=bool))
         np.testing.assert_allclose(b[field][keep], a[field][keep], rtol=1e-6,
                                    atol=1e-9 * max(np.max(np.abs(a[field])), 1e-12), err_msg=B.OBSERVABLES[field])
@@ -130,7 +137,7 @@ def test_films_in_the_trace_use_the_oil_viscosity_at_its_temperature():
     for temp in (20.0, 60.0):
         pr = Simulation(scene, ModelParameters(oil_temperature_c=temp)).build()
         ys = np.array([_moving_state(pr, 0)])
-        runs[temp] = (pr.params[B.P_ETA0], observables(pr, np.array([6e-3]), ys, scene, True)["contacts"])
+        runs[temp] = (pr.parameter("ETA0"), observables(pr, np.array([6e-3]), ys, scene, True)["contacts"])
     (eta20, c20), (eta60, c60) = runs[20.0], runs[60.0]
     assert eta60 < 0.5 * eta20  # the paper's temperature coefficient thins the oil by more than half over 40 K
     for name in ("outer_film", "inner_film"):

@@ -17,7 +17,6 @@ from scipy.integrate import quad
 
 from cageless.bearing import default_bearing
 from cageless.simulation.forces import SQUEEZE_CUTOFF, SQUEEZE_TAPER, hertz_damped, squeeze_film
-from cageless.simulation.models import base as B
 from cageless.simulation.models.planar import planar_problem
 from cageless.simulation.models.planar_reference import reference_rhs
 
@@ -102,16 +101,16 @@ def test_one_law_in_the_compiled_model_and_the_numpy_reference(gap_h0):
     f = pr.rhs(0.0, y, pr.log.copy())
     ref = reference_rhs(0.0, y, pr.params, pr.log.copy())
     np.testing.assert_allclose(f, ref, rtol=1e-10, atol=1e-9)
-    p = pr.params
-    m, r = p[B.P_M], y[1]
+    m, r, h0, eta0, d = pr.parameter("M"), y[1], pr.parameter("H0"), pr.parameter("ETA0"), pr.parameter("D")
     # ball 1's acceleration minus the centripetal and Coriolis terms: the pair force over the mass
     fr = m * (f[2 * z + 1] - r * y[3 * z + 1] ** 2)
     ft = m * (f[3 * z + 1] * r + 2 * y[2 * z + 1] * y[3 * z + 1])
-    expected = LAW(gap_h0 * p[B.P_H0], 0.02, p[B.P_ETA0], 0.25 * p[B.P_D], p[B.P_H0])
+    expected = LAW(gap_h0 * h0, 0.02, eta0, 0.25 * d, h0)
     if gap_h0 < 0:  # the Hertz force, at the current approach speed until one is recorded (models/planar.py)
-        delta = -gap_h0 * p[B.P_H0]
-        expected += hertz_damped.py_func(delta, 0.02, max(0.02, p[B.P_V_IN_MIN]), p[B.P_KB], p[B.P_CHI])
-        assert LAW(gap_h0 * p[B.P_H0], 0.02, p[B.P_ETA0], 0.25 * p[B.P_D], p[B.P_H0]) > 0
+        delta = -gap_h0 * h0
+        expected += hertz_damped.py_func(delta, 0.02, max(0.02, pr.parameter("V_IN_MIN")), pr.parameter("KB"),
+                                         pr.parameter("CHI"))
+        assert LAW(gap_h0 * h0, 0.02, eta0, 0.25 * d, h0) > 0
     assert np.hypot(fr, ft) == pytest.approx(expected, rel=1e-6, abs=1e-12)
 
 

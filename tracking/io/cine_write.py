@@ -174,20 +174,28 @@ def write_cine(
         raise ParameterError("frames", f"{width} x {height} pixels cannot be packed in {f.bits}-bit groups")
     img = f.image_size(width, height)
     desc = description or f"written by cageless {__version__}"
+    head = _headers(f, (width, height), fps, bpp, stamps, exposure_s, serial, desc)
+    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
+        fh.write(head)
+        _write_images(fh, first, it, n, f, bpp, img)
+    return Path(path)
+
+
+def _headers(f: CineFormat, size: tuple[int, int], fps: float, bpp: int, stamps: npt.NDArray[np.float64],
+             exposure_s: float, serial: int, desc: str) -> bytes:
+    """Everything before the first image: the file header, BITMAPINFOHEADER, SETUP, the tagged blocks and
+    the image offsets."""
+    width, height = size
+    n, img = len(stamps), f.image_size(width, height)
     setup = _setup_block(width, height, fps, bpp, exposure_s, serial, desc)
     tagged = _tagged_blocks(stamps, exposure_s)
     off_offsets = HEADER.size + BITMAPINFO.size + len(setup) + len(tagged)
     first_image = off_offsets + 8 * n
-    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
-        fh.write(HEADER.pack(MAGIC, HEADER.size, 0, 1, 0, n, 0, n, HEADER.size, HEADER.size + BITMAPINFO.size,
-                             off_offsets, _time64(DEFAULT_TRIGGER_S)))
-        fh.write(BITMAPINFO.pack(BITMAPINFO.size, width, height, 1, f.bi_bit_count, f.bi_compression, img,
-                                 0, 0, 0, 1 << bpp))
-        fh.write(setup)
-        fh.write(tagged)
-        fh.write((first_image + np.arange(n, dtype="<i8") * (8 + img)).astype("<i8").tobytes())
-        _write_images(fh, first, it, n, f, bpp, img)
-    return Path(path)
+    return b"".join([
+        HEADER.pack(MAGIC, HEADER.size, 0, 1, 0, n, 0, n, HEADER.size, HEADER.size + BITMAPINFO.size, off_offsets,
+                    _time64(DEFAULT_TRIGGER_S)),
+        BITMAPINFO.pack(BITMAPINFO.size, width, height, 1, f.bi_bit_count, f.bi_compression, img, 0, 0, 0, 1 << bpp),
+        setup, tagged, (first_image + np.arange(n, dtype="<i8") * (8 + img)).astype("<i8").tobytes()])
 
 
 def _tagged_blocks(stamps: npt.NDArray[np.float64], exposure_s: float) -> bytes:

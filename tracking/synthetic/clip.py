@@ -131,7 +131,18 @@ def render_clip(
     stem = path.name if fmt in ("tif", "png") else path.stem
     truth_csv = path.with_name(f"{stem}.truth.csv")
     atomic_write_text(truth_csv, truth.to_csv(index=False, float_format="%.9g"))
-    meta = {
+    meta = _metadata(renderer, video, fmt, (index, times, n_frames), sub, speed, motion, law)
+    truth_json = path.with_name(f"{stem}.truth.json")
+    atomic_write_text(truth_json, json.dumps(meta, indent=1, default=float))
+    return ClipResult(video=video, truth_csv=truth_csv, truth_json=truth_json, n_frames=len(times), truth=truth)
+
+
+def _metadata(renderer: Any, video: Path, fmt: str, frames: tuple[np.ndarray, np.ndarray, int], sub: int,
+              speed: float, motion: BallMotion, law: Any) -> dict[str, Any]:
+    """The clip's ``.truth.json``: how it was made. ``frames`` is (frame indices taken, their times, frames
+    requested)."""
+    index, times, n_frames = frames
+    return {
         "software_version": __version__, "video": video.name, "format": fmt, "seed": renderer.seed,
         "n_frames_taken": int(len(times)), "n_frames_requested": int(n_frames),
         "dropped_frames": sorted(set(range(n_frames)) - set(index.tolist())),
@@ -143,9 +154,6 @@ def render_clip(
         "conventions": "pixel centres at integer (u, v); angle_rad is the unwrapped orbital angle in the "
                        "bearing frame at mid-exposure; time_s is the frame time stamp",
     }
-    truth_json = path.with_name(f"{stem}.truth.json")
-    atomic_write_text(truth_json, json.dumps(meta, indent=1, default=float))
-    return ClipResult(video=video, truth_csv=truth_csv, truth_json=truth_json, n_frames=len(times), truth=truth)
 
 
 def _number_balls(motion: BallMotion) -> BallMotion:

@@ -91,7 +91,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     import dataclasses
 
     from cageless.conditions import OperatingConditions
-    from cageless.simulation.effects import choose_model, parse_effect_overrides
+    from cageless.simulation.effects import parse_effect_overrides
     from cageless.simulation.scene import Scene
 
     bearing = bearing_from_config(config)
@@ -107,12 +107,16 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
                   misalignment_rad=args.misalignment_rad, moment_load_nm=args.moment_load_nm,
                   oil_air_density_kg_m3=args.oil_air_density,
                   duration_s=args.duration, speed_ramp_s=args.speed_ramp, seed=args.seed)
-    choice = choose_model(scene, args.level, parse_effect_overrides(args.effect), args.force)
+    from cageless.simulation.simulation import Choices, Simulation
+
+    choices = Choices(level=args.level, effects=parse_effect_overrides(args.effect), force=args.force,
+                      method=args.solver, rtol=args.rtol, max_step=args.max_step, sample_rate_hz=args.sample_rate)
     if args.explain:
         _parameters(args, config)  # the same checks of --parameter-set, --config and --set as a run
+        choice = Simulation(scene, choices=choices).model  # the choice alone: nothing is built or compiled
         print(choice.to_json() if args.json else f"{choice.explain()}\n{_parameter_line(args, config)}")
         return 0
-    return _run(args, scene, choice, config)
+    return _run(args, scene, choices, config)
 
 
 _CHECKED = ("speed_rpm", "radial_load_n", "axial_load_n", "duration", "gravity", "misalignment_rad", "moment_load_nm",
@@ -173,19 +177,16 @@ def _parameters(args: argparse.Namespace, config: dict[str, Any]) -> Any:
     return ModelParameters().with_overrides(values)
 
 
-def _run(args: argparse.Namespace, scene: Any, choice: Any, config: dict[str, Any]) -> int:
+def _run(args: argparse.Namespace, scene: Any, choices: Any, config: dict[str, Any]) -> int:
     from cageless.errors import UsageError
-    from cageless.simulation.run import check_supported
+    from cageless.simulation.simulation import Simulation
 
-    check_supported(scene, choice)
     par = _parameters(args, config)  # validated before anything compiles
+    sim = Simulation(scene, par, choices)  # the model choice, checked against the scene
+    choice = sim.model
     if args.ensemble < 1:
         raise UsageError(f"--ensemble must be >= 1, got {args.ensemble}")
     out = args.out or f"sim_{args.speed_rpm:g}rpm_Fr{args.radial_load_n:g}.trace.h5"
-    from cageless.simulation.simulation import Choices, Simulation
-
-    sim = Simulation(scene, par, Choices(method=args.solver, rtol=args.rtol, max_step=args.max_step,
-                                         sample_rate_hz=args.sample_rate), model=choice)
     from cageless.app.calibrate import describe_calibration
 
     from cageless.simulation.parameter_sets import DEFAULT_SET
