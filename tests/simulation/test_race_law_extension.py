@@ -8,6 +8,8 @@ like a built-in parameter). Nothing else of the package is edited. The check is 
 (traction off, since it scales with the normal force): the law adds (-k_x delta_o + k_x delta_i n_r) / m to
 each ball's radial acceleration (the outer contact pushes the ball inward, the inner one out along its normal,
 of radial component n_r), and nothing where a contact is open; a short run with it differs from one without.
+Installed as a package (an entry point in the ``cageless.race_laws`` group), the same module is found by the
+plain command line.
 """
 
 from __future__ import annotations
@@ -19,25 +21,28 @@ import sys
 
 import pytest
 
-_SCRIPT = r"""
-import json, numba, numpy as np
+#: The example law: one module, the physics and its parameter (written to a file, imported by the scripts).
+_LAW_MODULE = r"""
+import numba
 from cageless.simulation.effects import EffectSpec
 from cageless.simulation.models import race_laws
 
 K_X = 2.0e6  # N/m: the example law's parameter's default
-SLOT = -1  # its slot in the parameter vector, known once the layout is generated (below); read at compile time
 
 @numba.njit(inline="always")
-def linear_spring(delta, delta_dot, q, p):
-    return p[SLOT] * delta
+def linear_spring(delta, delta_dot, q, p, s):  # s: the index of the row's first slot, K_X
+    return p[s] * delta
 
-spec = EffectSpec("race_spring", "a linear spring k_x delta at the race contacts (test-only example law)",
-                  lambda s: (True, "example law"), flag="F_SPRING", slots=("K_X",),
-                  fill=lambda par: {"K_X": par.value("race_spring_k_n_m")},
-                  parameters=(("race_spring_k_n_m", K_X),))
-race_laws.register_race_law(spec, linear_spring)
-from cageless.simulation.models.base import LAYOUT
-SLOT = LAYOUT.index("K_X")
+race_laws.register_race_law(
+    EffectSpec("race_spring", "a linear spring k_x delta at the race contacts (test-only example law)",
+               lambda scene: (True, "example law"), flag="F_SPRING", slots=("K_X",),
+               fill=lambda par: {"K_X": par.value("race_spring_k_n_m")}, parameters=(("race_spring_k_n_m", K_X),)),
+    linear_spring)
+"""
+
+_SCRIPT = r"""
+import json, numpy as np
+import cageless_race_spring  # registers the law (before the models import)
 
 from cageless.conditions import OperatingConditions
 from cageless.simulation.scene import Scene
@@ -102,8 +107,15 @@ print(json.dumps({"level": on.model.level, "active": list(on.model.active), "k_x
 """
 
 
+def _law_on_path(tmp_path) -> dict[str, str]:
+    """The example law module in a folder of its own, and an environment whose Python path holds it."""
+    (tmp_path / "cageless_race_spring.py").write_text(_LAW_MODULE)
+    path = os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+    return {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba-cache"), "PYTHONPATH": path}
+
+
 def _run(script: str, tmp_path) -> dict:
-    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba-cache")}
+    env = _law_on_path(tmp_path)
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, timeout=900)
     assert out.returncode == 0, out.stderr[-2000:]
     return json.loads(out.stdout.strip().splitlines()[-1])
@@ -136,3 +148,24 @@ def test_the_example_law_runs_at_the_spatial_level(tmp_path):
     assert r["level"] == "spatial" and "race_spring" in r["active"] and r["k_x"] == 2.0e6 and r["ok"]
     assert r["rhs_change"] > 1.0  # m/s^2 (or rad/s^2): k_x delta / m at a loaded contact is of order 1e3
     assert r["final_change"] > 0.0
+
+
+def test_an_installed_law_is_found_by_the_command_line(tmp_path):
+    """The same module installed as a package (its entry point in the ``cageless.race_laws`` group, as a
+    ``pyproject.toml`` would declare it): the plain ``cageless`` command sees the law's row and its parameter,
+    with no other file edited and nothing imported by hand."""
+    from cageless.simulation.models.race_laws import ENTRY_POINT_GROUP
+
+    env = _law_on_path(tmp_path)
+    info = tmp_path / "cageless_race_spring-0.1.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: cageless-race-spring\nVersion: 0.1\n")
+    (info / "entry_points.txt").write_text(f"[{ENTRY_POINT_GROUP}]\nrace_spring = cageless_race_spring\n")
+    cli = [sys.executable, "-m", "cageless", "simulate", "--speed-rpm", "3000", "--radial-load-n", "500", "--explain"]
+    out = subprocess.run([*cli, "--set", "race_spring_k_n_m=4e6"], capture_output=True, text=True, env=env,
+                         timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert "on  race_spring" in out.stdout and "example law" in out.stdout
+    typo = subprocess.run([*cli, "--set", "race_spring_kn_m=4e6"], capture_output=True, text=True, env=env,
+                          timeout=300)
+    assert typo.returncode == 2 and "race_spring_k_n_m" in typo.stderr  # the suggestion names the law's parameter
