@@ -17,7 +17,7 @@ from collections import OrderedDict
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 import numpy as np
 import pandas as pd
@@ -305,6 +305,20 @@ def _select_in(video: FrameSource, loc: BearingLocation, background: np.ndarray,
     return loc, frames, setup, sel
 
 
+def _refuse_with_qc(exc: SelectionError, path: Path, video: FrameSource, loc: BearingLocation,
+                    out_dir: str | Path | None) -> NoReturn:
+    """Re-raise a failed ball selection; with ``out_dir``, first write its QC image of every candidate and the
+    reason it was rejected, and name that image in the message."""
+    rows, cols = loc.crop(video.frame_shape)
+    if out_dir is not None and exc.table is not None:
+        shown = exc.table.assign(u_px=exc.table.u_px + cols.start, v_px=exc.table.v_px + rows.start)
+        qc_png = write_selection_qc(Path(out_dir) / "qc", _stem(path), video[0], shown, exc.ring,
+                                    (cols.start, rows.start), exc.message)
+        raise SelectionError(path, f"{exc.message} No trace written; QC: {qc_png}.", exc.hint,
+                             exc.table, exc.found, exc.ring) from None
+    raise exc
+
+
 def track_video(
     path: str | Path, conditions: OperatingConditions, bearing: Bearing, options: TrackOptions | None = None,
     out_dir: str | Path | None = None, progress: bool = True, config: dict[str, Any] | None = None,
@@ -338,14 +352,7 @@ def track_video(
         try:
             loc, frames, setup, sel = _select(video, loc, background, bearing, options, conditions, path)
         except SelectionError as exc:
-            rows, cols = loc.crop(video.frame_shape)
-            if out_dir is not None and exc.table is not None:
-                shown = exc.table.assign(u_px=exc.table.u_px + cols.start, v_px=exc.table.v_px + rows.start)
-                qc_png = write_selection_qc(Path(out_dir) / "qc", _stem(path), video[0], shown, exc.ring,
-                                            (cols.start, rows.start), exc.message)
-                raise SelectionError(path, f"{exc.message} No trace written; QC: {qc_png}.", exc.hint,
-                                     exc.table, exc.found, exc.ring) from None
-            raise
+            _refuse_with_qc(exc, path, video, loc, out_dir)
         rows, cols = frames.rows, frames.cols
         with tqdm(total=len(video), desc=path.name, unit="frame", disable=not progress, leave=False) as bar:
             table = _track_all(path, fps, video, frames, times, setup, options, bar.update)

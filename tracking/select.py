@@ -526,17 +526,31 @@ def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, backgro
     good = [a for a in anchors if a is not None]
     log.info("%s: ball circle r = %.1f px, counts per burst %s, %d of %d bursts with %d balls", path, circle[2],
              counts, len(good), len(spans), z)
+    _check_count(path, z, found, len(good), len(spans), table, ring)
+    return Selection(ring=ring, anchors=good, table=table, counts=counts)
+
+
+def _check_count(path: object, z: int, found: int, n_good: int, n_spans: int, table: pd.DataFrame,
+                 ring: BallRing) -> None:
+    """Refuse a clip whose count is not ``z``, or whose ``z`` balls show in fewer than half its ``n_spans``
+    sampled stretches (``n_good``).
+
+    Raises
+    ------
+    SelectionError
+        With the candidate ``table`` and the ``ring`` for the QC image.
+    """
     if found != z:
         raise SelectionError(path, f"found {found} balls moving together along one circle, but {z} are expected (the "
                              "bearing's ball count, or --n-balls).",
                              f"Check the stated speed (speed_rpm: balls far from the expected cage speed are "
                              f"rejected) and the bearing's ball count; if the video really shows {found} balls, "
-                             f"state it with --n-balls {found}. The QC image shows what was found.", table=table, found=found, ring=ring)
-    if len(good) < 0.5 * len(spans):
-        raise SelectionError(path, f"{z} consistent balls were found in only {len(good)} of {len(spans)} sampled "
+                             f"state it with --n-balls {found}. The QC image shows what was found.", table=table,
+                             found=found, ring=ring)
+    if n_good < 0.5 * n_spans:
+        raise SelectionError(path, f"{z} consistent balls were found in only {n_good} of {n_spans} sampled "
                              "stretches of the clip.", "Check the lighting and focus; the QC image shows what "
                              "was found.", table=table, found=found, ring=ring)
-    return Selection(ring=ring, anchors=good, table=table, counts=counts)
 
 
 def anchor_at(frames: Callable[[int], np.ndarray], times: np.ndarray, background: np.ndarray, mask: np.ndarray,
