@@ -488,7 +488,7 @@ def _finish(path: Path, video: FrameSource, table: pd.DataFrame, loc: BearingLoc
     g = bearing.geometry
     orbit = fit_orbit(table)
     roll = math.radians(conditions.camera_roll_deg or 0.0)
-    angle, valid, direction, order = orbital_angles(table, orbit, roll)
+    angle, valid, direction, order = orbital_angles(table, orbit, roll, steady=options.window)
     times = video.times
     try:
         angle, valid = robust_track_fit(times, angle, valid, options.track_fit)
