@@ -57,16 +57,17 @@ ALL = [("TUNING", s) for s in TUNING] + [("HOLDOUT", s) for s in HOLDOUT]
 #: data's maximum) TUNING 30: 1012 passes (angle 0.541 -> 0.279 mrad, speed 0.776 -> 0.374 %, slip 0.313 ->
 #: 0.158 pp), no clip fails anew; angle RMS over the set 3 % lower (geometric mean), better by over 10 % on 1003
 #: (0.371 -> 0.304), 1018, 1019 (0.215 -> 0.175), worse by over 10 % on 1000 (0.316 -> 0.356), 1015 (0.255 ->
-#: 0.292), 1020 (0.156 -> 0.174), 1023 (0.168 -> 0.206 mrad).
+#: 0.292), 1020 (0.156 -> 0.174), 1023 (0.168 -> 0.206 mrad). HOLDOUT with both, run once as a final check:
+#: 28 (7008 passes, 0.58 -> 0.445 mrad; no clip fails anew; 7018 1.32 -> 1.28 mrad, 7009 0.614 -> 0.625 mrad,
+#: 7026 1.63 -> 2.18 mrad and speed 0.545 -> 1.71 %, not diagnosed).
 #: Remove a seed when it passes.
 KNOWN_FAILURES: dict[int, str] = {
-    1011: "angle_rms 0.679 mrad > 0.5; speed_rms 0.712 % of cage speed > 0.5; slip_mae 0.467 pp > 0.3",
-    1022: "angle_rms 0.545 mrad > 0.5",
-    7004: "speed_rms 0.697 % of cage speed > 0.5",
-    7008: "angle_rms 0.58 mrad > 0.5",
-    7009: "angle_rms 0.614 mrad > 0.5",
-    7018: "angle_rms 1.32 mrad > 0.5",
-    7026: "angle_rms 1.63 mrad > 0.5; speed_rms 0.545 % of cage speed > 0.5; slip_mae 0.303 pp > 0.3",
+    1011: "angle_rms 0.656 mrad > 0.5; speed_rms 0.703 % of cage speed > 0.5; slip_mae 0.476 pp > 0.3",
+    1022: "angle_rms 0.553 mrad > 0.5",
+    7004: "speed_rms 0.698 % of cage speed > 0.5",
+    7009: "angle_rms 0.625 mrad > 0.5",
+    7018: "angle_rms 1.28 mrad > 0.5",
+    7026: "angle_rms 2.18 mrad > 0.5; speed_rms 1.71 % of cage speed > 0.5; slip_mae 0.381 pp > 0.3",
 }
 
 #: The same for the long variants (one cage revolution each), "" = passes: all 64 seeds measured with the tracker of
