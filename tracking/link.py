@@ -28,7 +28,7 @@ import pandas as pd
 
 from cageless.errors import TrackingError
 from cageless.tracking.candidates import find_candidates
-from cageless.tracking.detect import Detections, DetectorParams, centroid_windows, detect_full
+from cageless.tracking.detect import NO_STATIC, Detections, DetectorParams, centroid_windows, detect_full
 from cageless.tracking.link_kernel import MAX_MASS_RATIO, REDETECT_AFTER, WIDEN_AFTER, run_block
 from cageless.tracking.locate import fit_circle
 from cageless.tracking.select import Anchor, BallRing, anchor_at
@@ -69,6 +69,7 @@ class TrackSetup:
     params: DetectorParams
     ring: BallRing | None = None  # the chosen ball circle (tracking.select); None: the count-based start
     anchors: tuple[Anchor, ...] = ()  # chosen highlights in sampled frames (absolute frame numbers)
+    static: tuple[np.ndarray, float] | None = None  # (pattern, clip) subtracted from the frames (detect.static_pattern)
 
 
 @dataclass
@@ -125,7 +126,7 @@ def _ring_detections(frame: np.ndarray, s: TrackSetup,
 def _measure(frame: np.ndarray, s: TrackSetup, u0: np.ndarray, v0: np.ndarray) -> Detections:
     half = s.params.window_sigma * max(s.highlight_sigma, 1.0)
     u, v, m = centroid_windows(frame, s.background, s.mask, u0, v0, half, s.params.weight_sigma * s.sigma_noise,
-                               s.params.iterations)
+                               s.params.iterations, static=s.static)
     ok = m > 0
     return Detections(u[ok], v[ok], m[ok], np.full(int(ok.sum()), s.highlight_sigma))
 
@@ -147,7 +148,7 @@ def _anchor_start(frames: Callable[[int], np.ndarray], times: npt.NDArray[np.flo
     frame = frames(anchor.frame)
     half = s.params.window_sigma * max(s.highlight_sigma, 1.0)
     u, v, m = centroid_windows(frame, s.background, s.mask, anchor.u, anchor.v, half,
-                               s.params.weight_sigma * s.sigma_noise, s.params.iterations)
+                               s.params.weight_sigma * s.sigma_noise, s.params.iterations, static=s.static)
     bad = ~(m > 0) | (np.hypot(u - anchor.u, v - anchor.v) > half)
     u, v = np.where(bad, anchor.u, u), np.where(bad, anchor.v, v)
     m = np.where(bad, np.nanmedian(np.where(bad, np.nan, m)) if (~bad).any() else 1.0, m)
@@ -258,6 +259,8 @@ def _run_compiled(frames: Callable[[int], np.ndarray], times: npt.NDArray[np.flo
     times = np.ascontiguousarray(times, dtype=np.float64)
     half = s.params.window_sigma * s.highlight_sigma
     thr = s.params.weight_sigma * s.sigma_noise
+    static = NO_STATIC if s.static is None else (np.ascontiguousarray(s.static[0], dtype=np.float32),
+                                                 float(s.static[1]))
     for a, block in _blocks(frames, n, start, direction):
         k0 = (max(start + 1, a) if direction == 1 else min(start - 1, a + len(block) - 1)) - a
         k1 = len(block) if direction == 1 else -1
@@ -269,7 +272,7 @@ def _run_compiled(frames: Callable[[int], np.ndarray], times: npt.NDArray[np.flo
             t_state = np.array([st.t])
             k = run_block(block, k0, k1, direction, a, times, s.background, s.mask, float(centre[0]), float(centre[1]),
                           float(half), float(thr), int(s.params.iterations), float(s.params.lost_fraction),
-                          s.ring is not None, *arrays, t_state, *out)
+                          s.ring is not None, *arrays, t_state, *out, static)
             st.t = float(t_state[0])
             if k != k1:  # a frame the compiled step leaves to Python
                 _step(block[k], float(times[a + k]), st, s, centre, out, a + k)
@@ -297,9 +300,10 @@ def _step(frame: np.ndarray, t: float, st: _State, s: TrackSetup, centre: tuple[
         grow = np.where((st.omega == 0.0) | (widen & (s.ring is None)), 2.0, 1.0)
         thr = s.params.weight_sigma * s.sigma_noise
         if np.any(grow > 1.0):
-            fu, fv, _ = centroid_windows(frame, s.background, s.mask, pu, pv, half * grow, thr, 1)
+            fu, fv, _ = centroid_windows(frame, s.background, s.mask, pu, pv, half * grow, thr, 1, static=s.static)
             pu, pv = np.where(np.isfinite(fu), fu, pu), np.where(np.isfinite(fv), fv, pv)
-        mu, mv, mm = centroid_windows(frame, s.background, s.mask, pu, pv, half, thr, s.params.iterations)
+        mu, mv, mm = centroid_windows(frame, s.background, s.mask, pu, pv, half, thr, s.params.iterations,
+                                      static=s.static)
         ok = (mm >= s.params.lost_fraction * st.ref_mass) & (np.hypot(mu - pu, mv - pv) <= half)
         if s.ring is not None:
             ok &= mm <= _MAX_MASS_RATIO * st.ref_mass

@@ -35,7 +35,7 @@ def _predict(theta, radius, omega, dt, cx, cy):  # pragma: no cover - compiled
 
 @numba.njit(cache=True, nogil=True)
 def _measure(frame, bg, mask, pu, pv, omega, misses, ref_mass, half, thr, iters, lost_fraction,
-             has_ring):  # pragma: no cover - compiled
+             has_ring, static):  # pragma: no cover - compiled
     """Centroids at the predictions (re-centred first in a doubled window where the speed is not yet known,
     or, without a ball circle, after a few misses); return ``(mu, mv, mm, ok, needs_python)``."""
     z = pu.size
@@ -46,13 +46,13 @@ def _measure(frame, bg, mask, pu, pv, omega, misses, ref_mass, half, thr, iters,
         hh[j] = half * (2.0 if wide else 1.0)
         grow = grow or wide
     if grow:
-        fu, fv, _ = _centroids(frame, bg, mask, pu, pv, hh, thr, 1)
+        fu, fv, _ = _centroids(frame, bg, mask, pu, pv, hh, thr, 1, static)
         for j in range(z):
             if np.isfinite(fu[j]):
                 pu[j] = fu[j]
             if np.isfinite(fv[j]):
                 pv[j] = fv[j]
-    mu, mv, mm = _centroids(frame, bg, mask, pu, pv, np.full(z, half), thr, iters)
+    mu, mv, mm = _centroids(frame, bg, mask, pu, pv, np.full(z, half), thr, iters, static)
     ok = np.empty(z, dtype=np.bool_)
     needs_python = False
     for j in range(z):
@@ -91,9 +91,10 @@ def _update(i, t, dt, pred, mu, mv, mm, ok, cx, cy, theta, radius, omega, misses
 
 @numba.njit(cache=True, nogil=True)
 def run_block(stack, k0, k1, step, frame0, times, bg, mask, cx, cy, half, thr, iters, lost_fraction, has_ring,
-              theta, radius, omega, misses, ref_mass, t_state, out_u, out_v, out_m):  # pragma: no cover - compiled
+              theta, radius, omega, misses, ref_mass, t_state, out_u, out_v, out_m, static):  # pragma: no cover
     """Track ``stack[k]`` for ``k = k0, k0 + step, ...`` up to (not including) ``k1``; frame ``k`` is row
-    ``frame0 + k`` of ``times`` and the outputs.
+    ``frame0 + k`` of ``times`` and the outputs; ``static``, ``(pattern, clip)``, is subtracted from every pixel
+    read below ``clip`` (:data:`~cageless.tracking.detect.NO_STATIC`: none).
 
     The state arrays (``theta``, ``radius``, ``omega``, ``misses``, ``ref_mass`` and the one-element
     ``t_state``) are updated in place. Returns ``k1`` when done, or the first ``k`` that needs the Python
@@ -105,7 +106,7 @@ def run_block(stack, k0, k1, step, frame0, times, bg, mask, cx, cy, half, thr, i
         dt = t - t_state[0]
         pred, pu, pv = _predict(theta, radius, omega, dt, cx, cy)
         mu, mv, mm, ok, needs_python = _measure(stack[k], bg, mask, pu, pv, omega, misses, ref_mass, half, thr,
-                                                iters, lost_fraction, has_ring)
+                                                iters, lost_fraction, has_ring, static)
         if needs_python:
             return k
         _update(i, t, dt, pred, mu, mv, mm, ok, cx, cy, theta, radius, omega, misses, ref_mass, out_u, out_v, out_m)

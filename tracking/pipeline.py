@@ -30,7 +30,8 @@ from cageless.kinematics import slip_rate, theoretical_cage_speed
 from cageless.outputs import is_foreign_file
 from cageless.provenance import VIDEO_HASH, Provenance
 from cageless.trace import Trace, VideoInfo, write_trace
-from cageless.tracking.detect import DetectorParams, detect_full, noise_sigma, spot_sigma, static_defects
+from cageless.tracking.detect import (DetectorParams, detect_full, noise_sigma, spot_sigma, static_defects,
+                                      static_pattern)
 from cageless.tracking.geometry import fit_orbit, orbital_angles
 from cageless.tracking.io import CineReader, FrameSource, open_video
 from cageless.tracking.kinematics import DEFAULT_TRACK_FIT, DEFAULT_WINDOW, revolution_speed, robust_track_fit
@@ -234,6 +235,7 @@ def _setup(video: FrameSource, loc: BearingLocation, background: np.ndarray, bea
     spread = np.stack([frames(int(i)) for i in np.linspace(0, len(video) - 1, min(_DEFECT_FRAMES, len(video)))
                        .astype(int)])
     defects = static_defects(bg, sigma, frames=spread)
+    static = static_pattern(bg, spread, mask, defects)
     mask = mask & ~defects
     g = bearing.geometry
     z = options.n_balls or g.n_balls
@@ -266,7 +268,8 @@ def _setup(video: FrameSource, loc: BearingLocation, background: np.ndarray, bea
     hs = float(np.nanmedian(spots)) if np.isfinite(spots).any() else sel.ring.sigma_px
     setup = TrackSetup(background=bg, mask=mask, sigma_noise=sigma, highlight_sigma=hs,
                        max_area_px=math.pi * (0.25 * ball_px) ** 2, n_balls=z, params=options.detector,
-                       ring=sel.ring, anchors=tuple(sel.anchors))
+                       ring=sel.ring, anchors=tuple(sel.anchors),
+                       static=(static, float(spread.max())) if static.any() else None)
     return setup, sel
 
 
@@ -495,7 +498,7 @@ def _finish(path: Path, video: FrameSource, table: pd.DataFrame, loc: BearingLoc
     g = bearing.geometry
     orbit = fit_orbit(table)
     roll = math.radians(conditions.camera_roll_deg or 0.0)
-    angle, valid, direction, order = orbital_angles(table, orbit, roll)
+    angle, valid, direction, order = orbital_angles(table, orbit, roll, steady=options.window)
     times = video.times
     try:
         angle, valid = robust_track_fit(times, angle, valid, options.track_fit)
