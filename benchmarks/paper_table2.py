@@ -42,15 +42,25 @@ def _condition(job: tuple[int, int, int, float, dict[str, Any]]) -> dict[str, An
     """One condition and seed: the simulated trace's pooled samples after the start-up."""
     from cageless.simulation.sweep import simulate_point, sweep_base
 
-    rpm, load, seed, duration, params = job
-    trace, sol, settle, error = simulate_point({"seed": seed}, sweep_base(rpm, load, duration_s=duration,
-                                                                          parameters=params, command="paper_table2"))
+    rpm, load, seed, duration, params, clearance_m = job
+    trace, sol, settle, error = simulate_point({"seed": seed}, sweep_base(
+        rpm, load, duration_s=duration, parameters=params, bearing=_bearing(clearance_m), command="paper_table2"))
     if trace is None or not sol.success:
         return {"rpm": rpm, "load": load, "seed": seed, "ok": False, "error": error or trace.status}
     keep = (trace.time >= settle)[:, None] & trace.valid
     after = np.broadcast_to((trace.time - settle)[:, None], keep.shape)
     return {"rpm": rpm, "load": load, "seed": seed, "ok": True, "angle": trace.angle[keep], "slip": trace.slip[keep],
             "after_s": after[keep], "wall_s": trace.simulation.wall_s}
+
+
+def _bearing(clearance_m: float) -> Any:
+    """The paper's bearing (Table 1: no radial clearance) with ``clearance_m`` of diametral clearance."""
+    import dataclasses
+
+    from cageless.bearing import default_bearing
+
+    b = default_bearing()
+    return dataclasses.replace(b, geometry=b.geometry.with_diametral_clearance(clearance_m))
 
 
 def run(speeds: list[int], loads: list[int], seeds: int, duration: float, workers: int,
@@ -60,11 +70,12 @@ def run(speeds: list[int], loads: list[int], seeds: int, duration: float, worker
 
 
 def simulate_all(speeds: list[int], loads: list[int], seeds: int, duration: float, workers: int,
-                 params: dict[str, Any] | None = None, first_seed: int = 0) -> list[dict[str, Any]]:
+                 params: dict[str, Any] | None = None, first_seed: int = 0,
+                 clearance_m: float = 0.0) -> list[dict[str, Any]]:
     """Every condition x seed, on ``workers`` processes: the pooled samples after the start-up of each run."""
     from cageless.parallel import gather, job_pool
 
-    jobs = [(rpm, load, s, duration, dict(params or {})) for rpm in speeds for load in loads
+    jobs = [(rpm, load, s, duration, dict(params or {}), clearance_m) for rpm in speeds for load in loads
             for s in range(first_seed, seeds)]
     with job_pool(workers, None) as pool:
         return gather([pool.submit(_condition, j) for j in jobs], "Table 2 runs", False)
@@ -96,14 +107,14 @@ def tabulate(done: list[dict[str, Any]], speeds: list[int], loads: list[int], se
     return rows
 
 
-def recalibrate(budget: int, seeds: int, workers: int, low_m: float, high_m: float) -> Any:
+def recalibrate(budget: int, seeds: int, workers: int, low_m: float, high_m: float, clearance_m: float = 0.0) -> Any:
     """Fit the inlet meniscus distance once at :data:`CALIBRATED_AT` to its measured peak (``cageless calibrate``)."""
     from cageless.app.calibrate import Bound, calibrate, target_from_peak
 
     rpm, load = CALIBRATED_AT
     target = target_from_peak(rpm, load, TABLE2[CALIBRATED_AT][1], duration_s=0.1)
     return calibrate(target, [Bound("meniscus_distance_m", low_m, high_m)], budget=budget, seeds=seeds,
-                     workers=workers, progress=False)
+                     workers=workers, progress=False, bearing=_bearing(clearance_m))
 
 
 def format_table(rows: list[dict[str, Any]], seeds: int, duration: float, fitted: str = "") -> str:
@@ -153,6 +164,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--first-seed", type=int, default=0, help="simulate seeds FIRST_SEED..SEEDS-1 only")
     ap.add_argument("--save", type=Path, default=None, help="pickle the runs' samples here")
     ap.add_argument("--merge", type=Path, nargs="*", default=[], help="add the runs pickled by earlier --save")
+    ap.add_argument("--clearance-um", type=float, default=0.0,
+                    help="diametral clearance of the bearing (um; Table 1 gives none, the paper's experiment had a "
+                         "'large' one: ISO 5753 class C4 for a 24-30 mm bore is 23-41 um)")
     ap.add_argument("--cal-budget", type=int, default=8)
     ap.add_argument("--cal-seeds", type=int, default=2)
     ap.add_argument("--cal-range-mm", type=float, nargs=2, default=[0.1, 1.0],
@@ -174,7 +188,7 @@ def main(argv: list[str] | None = None) -> int:
         fitted = f", r_s = {args.meniscus_mm:.4f} mm"
     elif not args.no_calibrate:
         cal = recalibrate(args.cal_budget, args.cal_seeds, args.workers, 1e-3 * args.cal_range_mm[0],
-                          1e-3 * args.cal_range_mm[1])
+                          1e-3 * args.cal_range_mm[1], 1e-6 * args.clearance_um)
         r_s = cal.fitted["meniscus_distance_m"]
         params, fitted = {**params, "meniscus_distance_m": r_s}, f", r_s = {1e3 * r_s:.4f} mm"
         sys.stdout.write(f"calibration at {CALIBRATED_AT[0]} rpm / {CALIBRATED_AT[1]} N: meniscus_distance_m = "
@@ -183,7 +197,10 @@ def main(argv: list[str] | None = None) -> int:
         for e in sorted(cal.evaluations, key=lambda e: e["meniscus_distance_m"]):
             sys.stdout.write(f"  r_s {1e3 * e['meniscus_distance_m']:.4f} mm: peak {e['peak_slip_pct']:.2f} %, "
                              f"seed spread {e['seed_spread_pp']:.2f} pp\n")
-    done = simulate_all(args.speeds, args.loads, args.seeds, args.duration, args.workers, params, args.first_seed)
+    if args.clearance_um:
+        fitted += f", diametral clearance {args.clearance_um:g} um"
+    done = simulate_all(args.speeds, args.loads, args.seeds, args.duration, args.workers, params, args.first_seed,
+                        1e-6 * args.clearance_um)
     if args.save:
         with args.save.open("wb") as fh:
             pickle.dump({"params": params, "duration": args.duration, "runs": done}, fh)

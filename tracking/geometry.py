@@ -105,19 +105,7 @@ def frame_shifts(t: np.ndarray, u: np.ndarray, v: np.ndarray, orbit: Orbit,
     nu, nv = np.where(ok, du / np.where(ok, rho, 1.0), 0.0), np.where(ok, dv / np.where(ok, rho, 1.0), 0.0)
     res = np.where(ok, rho - orbit.radius, 0.0)
     scale = 1.4826 * float(np.median(np.abs(res[ok]))) if ok.any() else 0.0
-    solved = np.zeros(n, bool)
-    limit = 4.0 * max(scale, 1e-6)
-    for i in np.flatnonzero(ok.sum(axis=1) >= MIN_FRAME_BALLS):
-        use = ok[i].copy()
-        while True:  # drop the worst highlight while it is off by more than the limit
-            a = np.column_stack([nu[i, use], nv[i, use], np.ones(int(use.sum()))])
-            sol, *_ = np.linalg.lstsq(a, res[i, use], rcond=None)
-            off = np.where(use, np.abs(res[i] - (nu[i] * sol[0] + nv[i] * sol[1] + sol[2])), 0.0)
-            worst = int(np.argmax(off))
-            if off[worst] <= limit or use.sum() <= MIN_FRAME_BALLS:
-                break
-            use[worst] = False
-        out[i], solved[i] = sol[:2], True
+    out, solved = _frame_solutions(nu, nv, res, ok, 4.0 * max(scale, 1e-6))
     if not solved.any():
         return np.zeros((n, 2))
     for k in range(2):
@@ -125,6 +113,30 @@ def frame_shifts(t: np.ndarray, u: np.ndarray, v: np.ndarray, orbit: Orbit,
     if frames > 1 and n >= frames:
         out, _ = robust_track_fit(t, out, np.repeat(solved[:, None], 2, axis=1), frames)
     return out
+
+
+def _frame_solutions(nu: np.ndarray, nv: np.ndarray, res: np.ndarray, ok: np.ndarray,
+                     limit: float) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_]]:
+    """Each frame's least-squares (du, dv, dR) of ``res = du nu + dv nv + dR`` over its highlights in ``ok``, all
+    frames at once; a frame's worst highlight is dropped and the frame solved again while it is off by more
+    than ``limit`` and more than :data:`MIN_FRAME_BALLS` remain. Returns (du, dv) per frame (T, 2) and which
+    frames had enough highlights."""
+    n = len(res)
+    use = ok & (ok.sum(axis=1) >= MIN_FRAME_BALLS)[:, None]
+    solved = use.any(axis=1)
+    design = np.stack([nu, nv, np.ones_like(nu)], axis=-1)  # (T, Z, 3)
+    sol = np.zeros((n, 3))
+    active = np.flatnonzero(solved)
+    while active.size:
+        a = design[active] * use[active][..., None]
+        normal = np.einsum("tzi,tzj->tij", a, design[active])
+        sol[active] = np.einsum("tij,tj->ti", np.linalg.pinv(normal), np.einsum("tzi,tz->ti", a, res[active]))
+        off = np.where(use[active], np.abs(res[active] - np.einsum("tzi,ti->tz", design[active], sol[active])), 0.0)
+        worst = np.argmax(off, axis=1)
+        drop = (off[np.arange(active.size), worst] > limit) & (use[active].sum(axis=1) > MIN_FRAME_BALLS)
+        use[active[drop], worst[drop]] = False
+        active = active[drop]
+    return sol[:, :2], solved
 
 
 def orbital_angles(table: pd.DataFrame, orbit: Orbit, roll_rad: float = 0.0, steady: int = DEFAULT_WINDOW
