@@ -20,7 +20,9 @@ import logging
 import math
 import warnings
 from collections.abc import Callable, Iterator
+import dataclasses
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import numpy.typing as npt
@@ -28,7 +30,7 @@ import pandas as pd
 
 from cageless.errors import TrackingError
 from cageless.tracking.candidates import find_candidates
-from cageless.tracking.detect import NO_STATIC, Detections, DetectorParams, centroid_windows, detect_full
+from cageless.tracking.detect import Detections, DetectorParams, centroid_windows, compiled_static, detect_full
 from cageless.tracking.link_kernel import MAX_MASS_RATIO, REDETECT_AFTER, WIDEN_AFTER, run_block
 from cageless.tracking.locate import fit_circle
 from cageless.tracking.select import Anchor, BallRing, anchor_at
@@ -70,6 +72,11 @@ class TrackSetup:
     ring: BallRing | None = None  # the chosen ball circle (tracking.select); None: the count-based start
     anchors: tuple[Anchor, ...] = ()  # chosen highlights in sampled frames (absolute frame numbers)
     static: tuple[np.ndarray, float] | None = None  # (pattern, clip) subtracted from the frames (detect.static_pattern)
+
+    @cached_property
+    def static_compiled(self) -> tuple[np.ndarray, float, np.ndarray]:
+        """``static`` in the compiled centroid's form, with its summed-area table (built once per clip)."""
+        return compiled_static(self.static)
 
 
 @dataclass
@@ -126,7 +133,7 @@ def _ring_detections(frame: np.ndarray, s: TrackSetup,
 def _measure(frame: np.ndarray, s: TrackSetup, u0: np.ndarray, v0: np.ndarray) -> Detections:
     half = s.params.window_sigma * max(s.highlight_sigma, 1.0)
     u, v, m = centroid_windows(frame, s.background, s.mask, u0, v0, half, s.params.weight_sigma * s.sigma_noise,
-                               s.params.iterations, static=s.static)
+                               s.params.iterations, static=s.static_compiled)
     ok = m > 0
     return Detections(u[ok], v[ok], m[ok], np.full(int(ok.sum()), s.highlight_sigma))
 
@@ -148,7 +155,7 @@ def _anchor_start(frames: Callable[[int], np.ndarray], times: npt.NDArray[np.flo
     frame = frames(anchor.frame)
     half = s.params.window_sigma * max(s.highlight_sigma, 1.0)
     u, v, m = centroid_windows(frame, s.background, s.mask, anchor.u, anchor.v, half,
-                               s.params.weight_sigma * s.sigma_noise, s.params.iterations, static=s.static)
+                               s.params.weight_sigma * s.sigma_noise, s.params.iterations, static=s.static_compiled)
     bad = ~(m > 0) | (np.hypot(u - anchor.u, v - anchor.v) > half)
     u, v = np.where(bad, anchor.u, u), np.where(bad, anchor.v, v)
     m = np.where(bad, np.nanmedian(np.where(bad, np.nan, m)) if (~bad).any() else 1.0, m)
@@ -207,7 +214,7 @@ def track_frames(frames: Callable[[int], np.ndarray], times: npt.NDArray[np.floa
         start, det, z = find_start(frames, n, s, path, strict)
         cx, cy, _, _ = fit_circle(det.u, det.v)
         centre = (cx, cy)
-    s = TrackSetup(**{**s.__dict__, "n_balls": z})
+    s = dataclasses.replace(s, n_balls=z)
     th0 = _angles(det.u, det.v, centre)
     order = np.argsort(th0)
     u = np.full((n, z), np.nan)
@@ -259,8 +266,7 @@ def _run_compiled(frames: Callable[[int], np.ndarray], times: npt.NDArray[np.flo
     times = np.ascontiguousarray(times, dtype=np.float64)
     half = s.params.window_sigma * s.highlight_sigma
     thr = s.params.weight_sigma * s.sigma_noise
-    static = NO_STATIC if s.static is None else (np.ascontiguousarray(s.static[0], dtype=np.float32),
-                                                 float(s.static[1]))
+    static = s.static_compiled
     for a, block in _blocks(frames, n, start, direction):
         k0 = (max(start + 1, a) if direction == 1 else min(start - 1, a + len(block) - 1)) - a
         k1 = len(block) if direction == 1 else -1
@@ -300,10 +306,11 @@ def _step(frame: np.ndarray, t: float, st: _State, s: TrackSetup, centre: tuple[
         grow = np.where((st.omega == 0.0) | (widen & (s.ring is None)), 2.0, 1.0)
         thr = s.params.weight_sigma * s.sigma_noise
         if np.any(grow > 1.0):
-            fu, fv, _ = centroid_windows(frame, s.background, s.mask, pu, pv, half * grow, thr, 1, static=s.static)
+            fu, fv, _ = centroid_windows(frame, s.background, s.mask, pu, pv, half * grow, thr, 1,
+                                         static=s.static_compiled)
             pu, pv = np.where(np.isfinite(fu), fu, pu), np.where(np.isfinite(fv), fv, pv)
         mu, mv, mm = centroid_windows(frame, s.background, s.mask, pu, pv, half, thr, s.params.iterations,
-                                      static=s.static)
+                                      static=s.static_compiled)
         ok = (mm >= s.params.lost_fraction * st.ref_mass) & (np.hypot(mu - pu, mv - pv) <= half)
         if s.ring is not None:
             ok &= mm <= _MAX_MASS_RATIO * st.ref_mass

@@ -45,3 +45,24 @@ def test_the_centroid_of_a_highlight_under_the_speck_is_unbiased():
                              static=(pattern, float(frame.max()) + 1.0))
     assert raw[0][0] - 36.0 > 0.05
     assert abs(fixed[0][0] - 36.0) < 0.01
+
+
+def test_a_window_without_pattern_pixels_skips_the_pattern_exactly():
+    """The per-window test (summed-area table) must not change any result: a window that holds none of the
+    pattern gives bit for bit the centroid without a pattern, and one whose ring of background pixels
+    (radius + 2) reaches a single pattern pixel still reads it."""
+    shape = (60, 80)
+    rng = np.random.default_rng(3)
+    background = np.full(shape, 100.0, np.float32)
+    frame = (100.0 + rng.normal(0, 2.0, shape) + _spot(shape, 36.0, 30.0, 2.5, 400.0)).astype(np.float32)
+    mask = np.ones(shape, bool)
+    far = np.zeros(shape, np.float32)
+    far[5, 75] = 50.0  # far from the window
+    clip = float(frame.max()) + 1.0
+    plain = centroid_windows(frame, background, mask, [36.0], [30.0], 9.0, 4.0, 20)
+    skipped = centroid_windows(frame, background, mask, [36.0], [30.0], 9.0, 4.0, 20, static=(far, clip))
+    assert np.array_equal(np.array(plain), np.array(skipped))
+    near = np.zeros(shape, np.float32)
+    near[30, 36 + 10] = 50.0  # in the local-background ring (9 < 10 <= 11 px), outside the window itself
+    read = centroid_windows(frame, background, mask, [36.0], [30.0], 9.0, 4.0, 20, static=(near, clip))
+    assert not np.array_equal(np.array(plain), np.array(read))
