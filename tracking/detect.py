@@ -322,17 +322,17 @@ def _local_background(frame, mask, u, v, r, ring, static):  # pragma: no cover -
         for x in range(x0, x1 + 1):
             if (i0 <= x <= i1 and (x - u) * (x - u) + dy2 <= r * r) or not mask[y, x]:
                 continue
-            ring[cnt] = frame[y, x] - _static_at(frame, static, use, y, x)
+            ring[cnt] = frame[y, x] - _static_at(frame, static, y, x) if use else frame[y, x]
             cnt += 1
     return np.median(ring[:cnt]) if cnt >= 8 else np.nan
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def _static_at(frame, static, use, y, x):  # pragma: no cover - compiled
-    """The static pattern to subtract at pixel (y, x): ``static`` is ``(pattern, clip, table)``; nothing unless
-    ``use`` (the window holds some of the pattern: :func:`_window_has_static`), or where the pixel reads ``clip``
+def _static_at(frame, static, y, x):  # pragma: no cover - compiled
+    """The static pattern to subtract at pixel (y, x) of a window that holds some of it
+    (:func:`_window_has_static`): ``static`` is ``(pattern, clip, table)``; nothing where the pixel reads ``clip``
     or more (a saturated pixel lost the pattern's excess)."""
-    if not use or frame[y, x] >= static[1]:
+    if frame[y, x] >= static[1]:
         return 0.0
     return static[0][y, x]
 
@@ -395,7 +395,9 @@ def _pass(frame, background, mask, u, v, r, local, threshold, mirror, static):  
                 holes = True
                 continue
             base = local if np.isfinite(local) else background[y, x]
-            wgt = np.float64(frame[y, x]) - base - threshold - _static_at(frame, static, use, y, x)
+            wgt = np.float64(frame[y, x]) - base - threshold
+            if use:
+                wgt -= _static_at(frame, static, y, x)
             if wgt > 0.0:
                 taper = 1.0 - ((x - u) * (x - u) + dy2) / (r * r)  # biweight: 0 at the edge
                 wgt *= taper * taper
