@@ -11,127 +11,47 @@ registered at run time (:func:`cageless.simulation.models.race_laws.key`). A cac
 longer matches; numba recompiles and overwrites it. Nothing is deleted behind the user's back:
 :func:`clear_cache` removes the package's cache files when asked.
 
-:func:`install` registers the locator that adds the key (:class:`PackageSourcesLocator`) in front of
-numba's own; ``simulation/__init__.py`` calls it before any kernel is decorated. The caches stay where
+:func:`install` registers the package with :mod:`cageless.numba_cache`, whose locator adds the key in front
+of numba's own; ``simulation/__init__.py`` calls it before any kernel is decorated. The caches stay where
 numba puts them (``NUMBA_CACHE_DIR``, else ``__pycache__`` beside the sources, else numba's user-wide
 cache directory).
 """
 
 from __future__ import annotations
 
-import hashlib
-from functools import lru_cache
+from collections.abc import Hashable
 from pathlib import Path
-from types import SimpleNamespace
-from typing import Any
 
-from numba.core import caching
+from cageless import numba_cache
+from cageless.numba_cache import _digest, is_compiled  # noqa: F401 - _digest: for the tests of the key
 
 __all__ = ["PackageSourcesLocator", "clear_cache", "compile_notice", "install", "is_compiled", "source_digest"]
 
 _ROOT = Path(__file__).resolve().parent
-#: numba's cache implementation (renamed from ``_CacheImpl`` in numba 0.61).
-_IMPL = getattr(caching, "CacheImpl", None) or getattr(caching, "_CacheImpl")
-
-
-@lru_cache(maxsize=None)
-def _digest(root: Path) -> str:
-    h = hashlib.sha256()
-    for path in sorted(root.rglob("*.py")):
-        h.update(path.relative_to(root).as_posix().encode())
-        h.update(path.read_bytes())
-    return h.hexdigest()
+#: The locator that adds the key (shared with the tracking package: :mod:`cageless.numba_cache`).
+PackageSourcesLocator = numba_cache.SourcesLocator
 
 
 def source_digest() -> str:
     """SHA-256 over the relative path and bytes of every ``.py`` file of the package (read once per process)."""
-    return _digest(_ROOT)
+    return numba_cache.source_digest(_ROOT)
 
 
-def _inside(py_file: str) -> bool:
-    try:
-        return Path(py_file).resolve().is_relative_to(_ROOT)
-    except OSError:
-        return False
+def _laws_key() -> Hashable:
+    from cageless.simulation.models import race_laws  # laws registered at run time compile into the race contacts
 
-
-class PackageSourcesLocator(caching._CacheLocator):
-    """numba's own locator for a function of this package, with the package's source digest in its stamp."""
-
-    def __init__(self, base: Any) -> None:
-        self._base = base
-
-    def ensure_cache_path(self) -> None:
-        self._base.ensure_cache_path()
-
-    def get_cache_path(self) -> str:
-        return self._base.get_cache_path()
-
-    def get_source_stamp(self) -> Any:
-        from cageless.simulation.models import race_laws  # laws registered at run time compile into the race contacts
-
-        return (self._base.get_source_stamp(), source_digest(), race_laws.key())
-
-    def get_disambiguator(self) -> str:
-        return self._base.get_disambiguator()
-
-    @classmethod
-    def base_locators(cls, py_func: Any, py_file: str) -> list[Any]:
-        """numba's own locators that accept ``py_file``, in its order of preference."""
-        out = []
-        for other in _IMPL._locator_classes:
-            if other is not cls:
-                loc = other.from_function(py_func, py_file)
-                if loc is not None:
-                    out.append(loc)
-        return out
-
-    @classmethod
-    def from_function(cls, py_func: Any, py_file: str) -> PackageSourcesLocator | None:
-        """The locator of a function of this package (None elsewhere: numba's own locators take it)."""
-        if not _inside(py_file):
-            return None
-        for other in _IMPL._locator_classes:
-            if other is not cls:
-                base = other.from_function(py_func, py_file)
-                if base is not None:
-                    return cls(base)
-        return None
+    return race_laws.key()
 
 
 def install() -> None:
-    """Put :class:`PackageSourcesLocator` first among numba's cache locators (idempotent)."""
-    if PackageSourcesLocator not in _IMPL._locator_classes:
-        _IMPL._locator_classes.insert(0, PackageSourcesLocator)
+    """Key this package's kernels on its sources and its registered race laws (idempotent)."""
+    numba_cache.register(_ROOT, _laws_key)
 
 
 def clear_cache() -> int:
     """Delete the numba cache files (``*.nbi``, ``*.nbc``) of this package's kernels wherever numba keeps them
     now; returns how many were deleted. The next run recompiles (about a minute)."""
-    removed = 0
-    for source in sorted(_ROOT.rglob("*.py")):
-        stub = SimpleNamespace(__code__=SimpleNamespace(co_firstlineno=0))
-        dirs = {Path(loc.get_cache_path()) for loc in PackageSourcesLocator.base_locators(stub, str(source))}
-        for d in dirs:
-            for pattern in (f"{source.stem}.*.nbi", f"{source.stem}.*.nbc"):
-                for stale in d.glob(pattern):
-                    stale.unlink(missing_ok=True)
-                    removed += 1
-    return removed
-
-
-def is_compiled(dispatcher: Any) -> bool | None:
-    """Whether ``dispatcher`` (a numba ``njit`` function with ``cache=True``) is compiled in this process or has an
-    up-to-date entry in its on-disk cache; ``None`` when numba's cache cannot be read.
-
-    numba's index file of a function records the source stamp it was written under; an index written under
-    another stamp (other sources, another version) loads as empty, and the function will compile on its first
-    call.
-    """
-    try:
-        return bool(dispatcher.signatures) or bool(dispatcher._cache._cache_file._load_index())
-    except Exception:  # noqa: BLE001 - a private numba interface: when it moves, say nothing rather than fail
-        return None
+    return numba_cache.clear(_ROOT)
 
 
 def compile_notice() -> str | None:

@@ -3,4 +3,14 @@
 The pipeline lands with the video-input and tracking issues; this package
 imports only the shared core :mod:`cageless` and never ``simulation`` or
 ``comparison``.
+
+Its compiled kernels are cached by numba under the digest of the package's sources
+(:mod:`cageless.numba_cache`): the tracking loop (``link_kernel.py``) compiles in the centroid of
+``detect.py``, and numba's own key, the caller's file stamp, would keep running an edited callee's old code.
 """
+
+from pathlib import Path as _Path
+
+from cageless import numba_cache as _numba_cache
+
+_numba_cache.register(_Path(__file__).resolve().parent)

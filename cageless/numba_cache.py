@@ -1,0 +1,134 @@
+"""Keys for numba's on-disk caches: the digest of all the sources of a package.
+
+numba keys a cached function on its own source file's timestamp. A kernel that calls, and inlines,
+functions of other modules of its package (the tracking loop in ``tracking/link_kernel.py`` calls the
+centroid of ``tracking/detect.py``; the simulator's integrators call the models and forces) keeps a
+stale cache when only a callee's module is edited: it would run the old code. So every kernel of a
+registered package is cached under an explicit key: its own file's stamp together with the SHA-256 of
+every ``.py`` file of the package (:func:`source_digest`, computed once per process) and, optionally, a
+key of the package's run-time extensions. A cache written under another digest no longer matches;
+numba recompiles and overwrites it. :func:`clear` removes a package's cache files when asked.
+
+:func:`register` must run before the package's first kernel is decorated: each package calls it from its
+``__init__``. The caches stay where numba puts them (``NUMBA_CACHE_DIR``, else ``__pycache__`` beside the
+sources, else numba's user-wide cache directory).
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Callable, Hashable
+from functools import lru_cache
+from pathlib import Path
+from types import SimpleNamespace
+from typing import Any
+
+from numba.core import caching
+
+__all__ = ["SourcesLocator", "clear", "is_compiled", "register", "source_digest"]
+
+#: numba's cache implementation (renamed from ``_CacheImpl`` in numba 0.61).
+_IMPL = getattr(caching, "CacheImpl", None) or getattr(caching, "_CacheImpl")
+#: The registered package folders, each with the key of its run-time extensions (or None).
+_ROOTS: dict[Path, Callable[[], Hashable] | None] = {}
+
+
+@lru_cache(maxsize=None)
+def _digest(root: Path) -> str:
+    h = hashlib.sha256()
+    for path in sorted(root.rglob("*.py")):
+        h.update(path.relative_to(root).as_posix().encode())
+        h.update(path.read_bytes())
+    return h.hexdigest()
+
+
+def source_digest(root: Path) -> str:
+    """SHA-256 over the relative path and bytes of every ``.py`` file under ``root`` (read once per process)."""
+    return _digest(Path(root).resolve())
+
+
+def _root_of(py_file: str) -> Path | None:
+    try:
+        path = Path(py_file).resolve()
+    except OSError:
+        return None
+    return next((root for root in _ROOTS if path.is_relative_to(root)), None)
+
+
+class SourcesLocator(caching._CacheLocator):
+    """numba's own locator for a function of a registered package, with the package's source digest in its
+    stamp."""
+
+    def __init__(self, base: Any, root: Path) -> None:
+        self._base = base
+        self._root = root
+
+    def ensure_cache_path(self) -> None:
+        self._base.ensure_cache_path()
+
+    def get_cache_path(self) -> str:
+        return self._base.get_cache_path()
+
+    def get_source_stamp(self) -> Any:
+        extra = _ROOTS.get(self._root)
+        return (self._base.get_source_stamp(), source_digest(self._root), extra() if extra else None)
+
+    def get_disambiguator(self) -> str:
+        return self._base.get_disambiguator()
+
+    @classmethod
+    def base_locators(cls, py_func: Any, py_file: str) -> list[Any]:
+        """numba's own locators that accept ``py_file``, in its order of preference."""
+        out = []
+        for other in _IMPL._locator_classes:
+            if not (isinstance(other, type) and issubclass(other, SourcesLocator)):
+                loc = other.from_function(py_func, py_file)
+                if loc is not None:
+                    out.append(loc)
+        return out
+
+    @classmethod
+    def from_function(cls, py_func: Any, py_file: str) -> SourcesLocator | None:
+        """The locator of a function of a registered package (None elsewhere: numba's own locators take it)."""
+        root = _root_of(py_file)
+        if root is None:
+            return None
+        base = cls.base_locators(py_func, py_file)
+        return cls(base[0], root) if base else None
+
+
+def register(root: str | Path, extra: Callable[[], Hashable] | None = None) -> None:
+    """Cache the kernels of the package in ``root`` under its source digest (and ``extra()``, a key of what
+    compiles into them at run time); idempotent. Call before the package's first kernel is decorated."""
+    _ROOTS[Path(root).resolve()] = extra
+    if SourcesLocator not in _IMPL._locator_classes:
+        _IMPL._locator_classes.insert(0, SourcesLocator)
+
+
+def clear(root: str | Path) -> int:
+    """Delete the numba cache files (``*.nbi``, ``*.nbc``) of the kernels under ``root`` wherever numba keeps them
+    now; returns how many were deleted. The next run recompiles."""
+    removed = 0
+    for source in sorted(Path(root).resolve().rglob("*.py")):
+        stub = SimpleNamespace(__code__=SimpleNamespace(co_firstlineno=0))
+        dirs = {Path(loc.get_cache_path()) for loc in SourcesLocator.base_locators(stub, str(source))}
+        for d in dirs:
+            for pattern in (f"{source.stem}.*.nbi", f"{source.stem}.*.nbc"):
+                for stale in d.glob(pattern):
+                    stale.unlink(missing_ok=True)
+                    removed += 1
+    return removed
+
+
+def is_compiled(dispatcher: Any) -> bool | None:
+    """Whether ``dispatcher`` (a numba ``njit`` function with ``cache=True``) is compiled in this process or has an
+    up-to-date entry in its on-disk cache; ``None`` when numba's cache cannot be read.
+
+    numba's index file of a function records the source stamp it was written under; an index written under
+    another stamp (other sources, another version) loads as empty, and the function will compile on its first
+    call.
+    """
+    try:
+        return bool(dispatcher.signatures) or bool(dispatcher._cache._cache_file._load_index())
+    except Exception:  # noqa: BLE001 - a private numba interface: when it moves, say nothing rather than fail
+        return None
