@@ -197,6 +197,8 @@ _NOISE_KERNEL = np.array([[1, -2, 1], [-2, 4, -2], [1, -2, 1]], np.float32) / 6.
 #: Gaussian's (2 (phi(0) - phi(z)) / p with z its (1 + p) / 2 quantile: 0.32466 for p = 0.5).
 _NOISE_SHARE = 0.5
 _NOISE_GAIN = 0.324663
+#: Standard deviation of the rounding of a value to whole DN (1 / sqrt(12)): the least noise an estimate may report.
+_ROUNDING = 12 ** -0.5
 
 
 def pixel_noise(frames: np.ndarray, mask: np.ndarray) -> float:
@@ -208,19 +210,21 @@ def pixel_noise(frames: np.ndarray, mask: np.ndarray) -> float:
     response, so the estimate is the mean of its smaller half (in the pixels whose 3 x 3 neighbourhood lies in
     ``mask``) over what that mean is for Gaussian noise: a trimmed mean rather than a median, because on 8-bit
     data with noise under 1 DN the response takes few values and its median can be 0. The median over frames
-    is returned (a lighting dropout makes one frame's noise low). Against the renderer's own noise on the TUNING
-    clips (benchmarks/noise_estimate.py) it reads 0.9-1.9 times the noise of the ball coating; the frame minus
-    the median background (:func:`noise_sigma`) read 3-30 times it.
+    is returned (a lighting dropout makes one frame's noise low), and never less than :data:`_ROUNDING` DN: integer
+    pixel values carry at least their rounding error, and JPEG, which zeroes the high frequencies of smooth
+    blocks, can leave the residual 0 at most pixels (TUNING seeds 1004 and 1018, JPEG q30 and q83: 0.000 DN,
+    against 2.7 and 0.5 DN of noise before compression). Against the renderer's own noise on the TUNING clips
+    see benchmarks/noise_estimate.py and docs/tracking.md.
     """
     inner = cv2.erode(mask.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
     if not inner.any():
-        return 1e-3
+        return _ROUNDING
     out = []
     for f in frames if frames.ndim == 3 else frames[None]:
         r = np.abs(cv2.filter2D(f.astype(np.float32), -1, _NOISE_KERNEL)[inner])
         q = np.partition(r, r.size // 2)[: max(r.size // 2, 1)]
         out.append(float(np.mean(q)) / _NOISE_GAIN)
-    return float(max(np.median(out), 1e-3))
+    return float(max(np.median(out), _ROUNDING))
 
 
 def detect_full(frame: np.ndarray, background: np.ndarray, mask: np.ndarray, sigma_noise: float,
