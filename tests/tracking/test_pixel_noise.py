@@ -46,8 +46,8 @@ def test_the_old_estimate_measured_the_scene():
 
 
 def test_a_single_frame_and_an_empty_mask():
-    """One 2-d frame is accepted; a mask without a 3 x 3 interior gives the floor, the rounding error 1 / sqrt(12) DN, rather than
-    failing."""
+    """One 2-d frame is accepted; a mask without a 3 x 3 interior gives the floor, the rounding error
+    1 / sqrt(12) DN, rather than failing."""
     rng = np.random.default_rng(5)
     frame = rng.normal(50.0, 3.0, (40, 40)).astype(np.float32)
     assert pixel_noise(frame, np.ones((40, 40), bool)) == pytest.approx(3.0, rel=0.12)
