@@ -30,8 +30,8 @@ from cageless.kinematics import slip_rate, theoretical_cage_speed
 from cageless.outputs import is_foreign_file
 from cageless.provenance import VIDEO_HASH, Provenance
 from cageless.trace import Trace, VideoInfo, write_trace
-from cageless.tracking.detect import (DetectorParams, detect_full, noise_sigma, pixel_noise, spot_sigma,
-                                      static_defects, static_pattern)
+from cageless.tracking.detect import (DetectorParams, detect_full, noise_sigma, spot_sigma, static_defects,
+                                      static_pattern)
 from cageless.tracking.geometry import fit_orbit, orbital_angles
 from cageless.tracking.io import CineReader, FrameSource, open_video
 from cageless.tracking.kinematics import DEFAULT_TRACK_FIT, DEFAULT_WINDOW, revolution_speed, robust_track_fit
@@ -231,13 +231,10 @@ def _setup(video: FrameSource, loc: BearingLocation, background: np.ndarray, bea
     # Not over a lighting dropout: a dark frame's whole difference from the background is not noise (one dark
     # frame of the 4 made it 4x too large on the long clip of corpus seed 7021, and with it every threshold).
     steady = frame_gains(list(sample)) >= DROPOUT_GAIN
-    steady_sample = sample[steady] if steady.sum() >= 2 else sample
-    # The thresholds scale with the pixel noise (detect.pixel_noise); the defects, static structure against its
-    # local median, with the frames' spread about the median background (detect.noise_sigma).
-    sigma = pixel_noise(steady_sample, mask)
+    sigma = noise_sigma(sample[steady] if steady.sum() >= 2 else sample, bg, mask)
     spread = np.stack([frames(int(i)) for i in np.linspace(0, len(video) - 1, min(_DEFECT_FRAMES, len(video)))
                        .astype(int)])
-    defects = static_defects(bg, noise_sigma(steady_sample, bg, mask), frames=spread)
+    defects = static_defects(bg, sigma, frames=spread)
     static = static_pattern(bg, spread, mask, defects)
     mask = mask & ~defects
     g = bearing.geometry
