@@ -36,8 +36,8 @@ from cageless.errors import ParameterError
 from cageless.tracking.locate_motion import DROPOUT_GAIN, frame_gains
 
 __all__ = [
-    "DetectorParams", "DETECTORS", "Detections", "detect_full", "centroid_windows", "noise_sigma", "spot_sigma",
-    "static_defects", "static_pattern", "NO_STATIC", "compiled_static",
+    "DetectorParams", "DETECTORS", "Detections", "detect_full", "centroid_windows", "noise_sigma", "pixel_noise",
+    "spot_sigma", "static_defects", "static_pattern", "NO_STATIC", "compiled_static",
 ]
 
 #: The detector choices: binary-mask centroid, weighted centroid after full detection every frame,
@@ -178,10 +178,55 @@ def _static_noise(excess: np.ndarray, region: np.ndarray) -> float:
 
 
 def noise_sigma(frames: np.ndarray, background: np.ndarray, mask: np.ndarray) -> float:
-    """Robust noise standard deviation (MAD x 1.4826) of frame - background inside ``mask``."""
+    """Robust spread (MAD x 1.4826) of frame - background inside ``mask``.
+
+    The noise level of the detector's thresholds (tracking/pipeline.py), though not the pixel noise: in the ball
+    band, where balls and gaps take turns over the median background, it measures the scene's contrast as much
+    as the noise (1.7-43 times the renderer's sensor noise on the TUNING clips; :func:`pixel_noise` measures the
+    noise itself). Thresholds from :func:`pixel_noise` were tried (docs/tracking.md) and not adopted: at the same
+    multiples they let more of the ball coating, the rim and JPEG ringing into the centroid.
+    """
     d = (frames.astype(np.float32) - background)[..., mask]
     mad = np.median(np.abs(d - np.median(d)))
     return float(max(1.4826 * mad, 1e-3))
+
+
+#: Immerkær's 3 x 3 noise kernel over its norm 6: zero response to any locally planar intensity, and on white
+#: noise of standard deviation s a response of standard deviation s.
+_NOISE_KERNEL = np.array([[1, -2, 1], [-2, 4, -2], [1, -2, 1]], np.float32) / 6.0
+#: Share of the smallest absolute responses averaged, and the mean absolute value of that share of a unit
+#: Gaussian's (2 (phi(0) - phi(z)) / p with z its (1 + p) / 2 quantile: 0.32466 for p = 0.5).
+_NOISE_SHARE = 0.5
+_NOISE_GAIN = 0.324663
+#: Standard deviation of the rounding of a value to whole DN (1 / sqrt(12)): the least noise an estimate may report.
+_ROUNDING = 12 ** -0.5
+
+
+def pixel_noise(frames: np.ndarray, mask: np.ndarray) -> float:
+    """Standard deviation of the pixel noise (DN) in ``mask``, from the frames' high-pass residual.
+
+    Each frame is filtered with :data:`_NOISE_KERNEL` (Immerkær 1996, "Fast noise variance estimation"), which
+    cancels the shading of the balls and of the faces up to first order; what is left at most pixels is noise,
+    and at a few (ball edges, highlights, texture) structure. Those few lie in the upper tail of the absolute
+    response, so the estimate is the mean of its smaller half (in the pixels whose 3 x 3 neighbourhood lies in
+    ``mask``) over what that mean is for Gaussian noise: a trimmed mean rather than a median, because on 8-bit
+    data with noise under 1 DN the response takes few values and its median can be 0. The median over frames
+    is returned (a lighting dropout makes one frame's noise low), and never less than ``_ROUNDING`` DN: integer
+    pixel values carry at least their rounding error, and JPEG, which zeroes the high frequencies of smooth
+    blocks, can leave the residual 0 at most pixels (TUNING seeds 1004 and 1018, JPEG q30 and q83: 0.000 DN,
+    against 2.8 and 0.47 DN of sensor noise before compression). Against the renderer's own noise on the TUNING clips
+    see benchmarks/noise_estimate.py and docs/tracking.md.
+    """
+    inner = cv2.erode(mask.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
+    if not inner.any():
+        return _ROUNDING
+    out = []
+    for f in frames if frames.ndim == 3 else frames[None]:
+        r = np.abs(cv2.filter2D(f.astype(np.float32), -1, _NOISE_KERNEL)[inner])
+        k = max(int(r.size * _NOISE_SHARE), 1)
+        q = np.partition(r, k - 1)[:k]
+        out.append(float(np.mean(q)) / _NOISE_GAIN)
+    return float(max(np.median(out), _ROUNDING))
 
 
 def detect_full(frame: np.ndarray, background: np.ndarray, mask: np.ndarray, sigma_noise: float,

@@ -59,7 +59,10 @@ ALL = [("TUNING", s) for s in TUNING] + [("HOLDOUT", s) for s in HOLDOUT]
 #: (0.371 -> 0.304), 1018, 1019 (0.215 -> 0.175), worse by over 10 % on 1000 (0.316 -> 0.356), 1015 (0.255 ->
 #: 0.292), 1020 (0.156 -> 0.174), 1023 (0.168 -> 0.206 mrad). HOLDOUT with both, run once as a final check:
 #: 28 (7008 passes, 0.58 -> 0.445 mrad; no clip fails anew; 7018 1.32 -> 1.28 mrad, 7009 0.614 -> 0.625 mrad,
-#: 7026 1.63 -> 2.18 mrad and speed 0.545 -> 1.71 %, not diagnosed).
+#: 7026 1.63 -> 2.18 mrad and speed 0.545 -> 1.71 %, not diagnosed). Tried and not adopted: the detector's
+#: thresholds from the pixel noise (detect.pixel_noise; branch track-acc, commits 50d94af and dc7245f, reverted):
+#: TUNING 30, no clip failing anew (1011 0.643 mrad, speed 0.735 %; 1022 0.597 mrad), but HOLDOUT, run once, 27:
+#: 7022 failed (0.506 mrad, speed 0.545 %), 7004 speed 0.69 %, 7009 0.621, 7018 1.27, 7026 2.19 mrad.
 #: Remove a seed when it passes.
 KNOWN_FAILURES: dict[int, str] = {
     1011: "angle_rms 0.656 mrad > 0.5; speed_rms 0.703 % of cage speed > 0.5; slip_mae 0.476 pp > 0.3",
