@@ -1,12 +1,13 @@
 """The race contacts' whole normal force (Hertz spring and lubricant damping) as the implicit part of an IMEX
 split, per ball, for the planar model.
 
-Why: with only the damping implicit (:mod:`cageless.simulation.models.implicit_damping`) the explicit part
-keeps the Hertz oscillations of the loaded balls, |lambda| = 2.1e5 1/s at 3000 rpm, 500 N (settled), and
-``ark4``'s steps sit at the stability edge those set (the error estimate is dominated by a loaded ball's
-radial speed in every accepted step; benchmarks/ark_speed.py). With the normal force and the radial
-kinematics implicit the fastest explicit modes are a loaded ball's spin against the traction slope and
-the ring's, |lambda| <= 2.1e4 1/s, ten times slower.
+Why: with only the damping implicit (the split this replaced, in closed form per ball) the explicit part
+keeps the Hertz oscillations of the loaded balls, |lambda| = 2.1e5 1/s at 3000 rpm, 500 N (settled), which
+bound its stable step near 16 us. With the normal force and the radial kinematics implicit the fastest
+explicit modes are a loaded ball's spin against the traction slope and the ring's, |lambda| <= 2.1e4 1/s,
+ten times slower (benchmarks/ark_speed.py prints both). The step is then set by the error estimate, which
+must be filtered through the implicit part's stiffness (:func:`planar_filter_error`) not to carry the
+stiff normal modes the L-stable table damps, and by the contact changes.
 
 The split, per ball j (polar coordinates r, theta as the planar model's state):
 
