@@ -9,8 +9,9 @@ are chaotic after that; the energy balance's drift over the input work) and the 
 timing (CPU seconds of the process per simulated second; the machine is shared) are those of
 ``benchmarks/solver_speed.py``, which this runs with the ``ark4`` rows. Ratios are to the first candidate
 (``auto``) in the same run. Before the table it prints, for the settled planar case, the fastest modes of the
-Jacobian of the whole right-hand side and of its explicit part (the whole minus the implicit race damping
-of :mod:`cageless.simulation.models.implicit_damping`), which set DP5's and ark4's stability limits.
+Jacobian of the whole right-hand side and of its explicit part (the whole minus the implicit race normal
+forces and radial kinematics of :mod:`cageless.simulation.models.implicit_normal`), which set DP5's and
+ark4's stability limits.
 """
 
 from __future__ import annotations

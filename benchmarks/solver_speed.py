@@ -64,8 +64,8 @@ CANDIDATES = {
     "rosw7": ("rosw, rtol 1e-7 (cap 10 us)", "rosw", 1e-7, None),
     "rosw3e-7": ("rosw, rtol 3e-7 (cap 10 us)", "rosw", 3e-7, None),
     "rosw8": ("rosw, rtol 1e-8 (cap 10 us)", "rosw", 1e-8, None),
-    "ark4": ("ark4 (IMEX), rtol 1e-6 (cap 20 us)", "ark4", 1e-6, None),
-    "ark4-7": ("ark4 (IMEX), rtol 1e-7 (cap 20 us)", "ark4", 1e-7, None),
+    "ark4": ("ark4 (IMEX), rtol 1e-6 (cap 50 us)", "ark4", 1e-6, None),
+    "ark4-7": ("ark4 (IMEX), rtol 1e-7 (cap 50 us)", "ark4", 1e-7, None),
 }
 DEFAULT_CANDIDATES = "auto,dp5,rosw6,rosw7,rosw3e-7,rosw8"
 

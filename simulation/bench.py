@@ -8,7 +8,7 @@ error is measured against a tight-tolerance reference run in the same process:
 * the compiled Rosenbrock-W method (``rosw``, :mod:`cageless.simulation.integrators.rosw`) across tolerances, at its
   10 us cap;
 * the compiled IMEX method (``ark4``, :mod:`cageless.simulation.integrators.ark`) across tolerances, at its
-  20 us cap;
+  50 us cap;
 * SUNDIALS CVODE (BDF) across tolerances and step caps (2, 5, 20 us), and at its default settings
   with each Jacobian of :data:`cageless.simulation.solve.JACOBIANS` and without its onset control;
 * scipy's LSODA, BDF and DOP853 on the same compiled right-hand side;
@@ -60,7 +60,7 @@ CANDIDATES: tuple[tuple[str, float, float], ...] = (
     ("CVODE", 1e-6, 2e-5),
     ("LSODA", 1e-6, 2e-6), ("BDF", 1e-6, 2e-6), ("DOP853", 1e-6, 2e-6),
     ("rosw", 1e-6, 1e-5), ("rosw", 1e-7, 1e-5), ("rosw", 1e-8, 1e-5),
-    ("ark4", 1e-5, 2e-5), ("ark4", 1e-6, 2e-5), ("ark4", 1e-7, 2e-5),
+    ("ark4", 1e-5, 5e-5), ("ark4", 1e-6, 5e-5), ("ark4", 1e-7, 5e-5),
 )
 #: CVODE as ``simulate`` runs it (rtol 3e-8, 5 us) with one setting changed: the other Jacobians of
 #: :data:`cageless.simulation.solve.JACOBIANS` (the rows above use the structured one: what it saves, and what

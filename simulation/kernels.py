@@ -9,10 +9,11 @@ from __future__ import annotations
 
 import numba
 
-from cageless.simulation.models import implicit_damping, planar, spatial, textbook, two_balls
+from cageless.simulation.models import (implicit_normal, implicit_normal_spatial, planar, spatial, textbook,
+                                        two_balls)
 
 __all__ = ["PLANAR", "SPATIAL", "TWO_BALLS", "OSCILLATOR", "RICCATI", "DAMPED", "model_rhs", "model_post",
-           "model_signature", "model_ring_share", "model_gaps", "model_implicit"]
+           "model_signature", "model_ring_share", "model_gaps", "model_implicit", "model_filter_error"]
 
 PLANAR, TWO_BALLS, SPATIAL = planar.MODEL_ID, two_balls.MODEL_ID, spatial.MODEL_ID
 OSCILLATOR, RICCATI, DAMPED = textbook.OSCILLATOR, textbook.RICCATI, textbook.DAMPED
@@ -76,16 +77,28 @@ def model_ring_share(model_id, t, y, p, log, j, out):  # pragma: no cover - comp
 
 @numba.njit(cache=True)
 def model_implicit(model_id, t, y, p, hg, k_i, work):  # pragma: no cover - compiled
-    """The implicit part f_I of the model's IMEX split into ``k_i`` (see
-    :mod:`cageless.simulation.models.implicit_damping`); with ``hg > 0`` the stage equation
+    """The implicit part f_I of the model's IMEX split into ``k_i`` (the race contacts' normal forces and the
+    balls' radial and axial kinematics, per ball: :mod:`cageless.simulation.models.implicit_normal`,
+    :mod:`cageless.simulation.models.implicit_normal_spatial`); with ``hg > 0`` the stage equation
     y = y_Z + hg f_I(y) is solved first, in place on ``y`` (the predictor y_Z on entry). ``work`` (12) is scratch.
     A model without a split has f_I = 0 (every term explicit)."""
     if model_id == PLANAR:
-        implicit_damping.planar_implicit(y, p, hg, k_i, work)
+        implicit_normal.planar_implicit_normal(y, p, hg, k_i)
     elif model_id == SPATIAL:
-        implicit_damping.spatial_implicit(y, p, hg, k_i, work)
+        implicit_normal_spatial.spatial_implicit_normal(y, p, hg, k_i)
     elif model_id == DAMPED:
         textbook.damped_implicit(y, p, hg, k_i)
     else:
         for i in range(k_i.shape[0]):
             k_i[i] = 0.0
+
+
+@numba.njit(cache=True)
+def model_filter_error(model_id, y, p, hg, e):  # pragma: no cover - compiled
+    """Filter an IMEX error estimate ``e`` in place through the implicit part's stiffness at ``y``,
+    (I - hg J_I)^-1 e, where the model has such a filter (the planar model's race normal forces:
+    :func:`cageless.simulation.models.implicit_normal.planar_filter_error`); unchanged otherwise."""
+    if model_id == PLANAR:
+        implicit_normal.planar_filter_error(y, p, hg, e)
+    elif model_id == SPATIAL:
+        implicit_normal_spatial.spatial_filter_error(y, p, hg, e)

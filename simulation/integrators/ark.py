@@ -1,10 +1,13 @@
 """An additive Runge-Kutta IMEX method, ARK4(3)6L[2]SA, with its whole loop compiled (numba).
 
 Why: the explicit DP5's step is held at about 1.1 us by the race lubricant damping (2 C_ho / m = 2.8e6 1/s),
-a stability limit. Treated implicitly, per ball and in closed form
-(:mod:`cageless.simulation.models.implicit_damping`), that damping no longer limits the step; what is left
-explicit (Hertz contacts, traction, the ring, the ball-ball contacts) has its fastest modes near
-|lambda| = 2e5 1/s, oscillatory (3000 rpm, 500 N, planar, settled; benchmarks/ark_speed.py prints them).
+a stability limit, and behind it the Hertz oscillations of the loaded balls (|lambda| = 2.1e5 1/s) set the
+next one. Both are local to a ball: the implicit part is each ball's race normal forces (Hertz spring and
+damping, clamped as the models clamp them) and its radial (and axial) kinematics, solved per ball by a
+few Newton iterations on a 2 x 2 (planar) or 3 x 3 (spatial) system
+(:mod:`cageless.simulation.models.implicit_normal`, :mod:`cageless.simulation.models.implicit_normal_spatial`).
+What is left explicit (traction, spin, the ring, the ball-ball contacts) has its fastest modes near
+|lambda| = 2e4 1/s at 3000 rpm, 500 N (planar, settled; benchmarks/ark_speed.py prints them).
 
 The method is Kennedy & Carpenter, "Additive Runge-Kutta schemes for convection-diffusion-reaction
 equations", Appl. Numer. Math. 44 (2003) 139-181, ARK4(3)6L[2]SA: six stages, order 4 with an embedded
@@ -12,23 +15,26 @@ order 3, an explicit table (ERK) for f_E and an L-stable, stiffly accurate ESDIR
 sharing the stage times and weights. The coefficients are the paper's, as SUNDIALS ARKODE ships them
 (``ARKODE_ARK436L2SA_ERK_6_3_4`` and ``ARKODE_ARK436L2SA_DIRK_6_3_4``). Because the weights are shared, a
 step is y + h sum_i b_i f(Y_i) with the full right-hand side of each stage, and its error estimate is
-h sum_i (b_i - b_hat_i) f(Y_i).
+h sum_i (b_i - b_hat_i) f(Y_i), filtered through (I - h gamma J_I)^-1 per ball (Shampine's filter, as in
+RADAU5; ``model_filter_error``): unfiltered, the stiff normal modes that the L-stable table damps dominate
+the estimate (a loaded ball's radial speed in every accepted step) and hold the step near 9 us.
 
 A stage is Y_i = Z_i + h/4 f_I(Y_i) with the explicit predictor
 Z_i = y + h sum_{j<i} (aE_ij f_E(Y_j) + aI_ij f_I(Y_j)); the model solves it (``model_implicit``), and
 f_E(Y_i) = f(Y_i) - f_I(Y_i). So a step costs five right-hand sides and five per-ball solves, plus the
 right-hand side at its end (the next step's first stage, the dense output and the force-jump test).
 
-Everything around the step is DP5's (:mod:`cageless.simulation.integrators.dp5`, reused, not changed):
-the contact-onset and force-jump retries, cubic Hermite samples between step ends, the model's bookkeeping
-after every accepted step (the contact log), the step-size bounds and the statistics layout. The step
-controller is Hairer's PI controller (Solving ODEs I, sect. II.4) with the exponents of an order-3 error
-estimate: 1/4 - 0.75 beta and beta = 0.04, with no growth right after a rejected step (Hairer & Wanner's
-facmax = 1). Its step sits at the stability edge of the explicit part (the Hertz modes), where the error
-estimate oscillates: 13 % of the steps are rejected settled at 3000 rpm, 500 N, 26 % in the 1800 rpm
-bunching start. Gustafsson's beta = 0.1 for steps held at a stability boundary cut that to 6 % in both, but
-cost 30 % more right-hand sides settled, so it is not used. The step after the end of a span starts from
-the controller's proposal, not from the step the span's end clipped, so that a run in chunks keeps its step.
+Around the step everything is DP5's (:mod:`cageless.simulation.integrators.dp5`, reused, not changed): the
+contact-onset and force-jump retries, cubic Hermite samples between step ends, the model's bookkeeping
+after every accepted step (the contact log), the step-size bounds and the statistics layout, with one
+addition: a step refused because a contact opened or closed in it is retried up to the change, located on
+the straight line between the contact gaps at its ends, and the next step crosses it at about the onset
+length (:func:`_onset_retry`), where DP5 retries at the onset length and then steps up to the change by
+onset-length retries (3-5 refused steps per change at 3000 rpm, 500 N). The step controller is Hairer's PI
+controller (Solving ODEs I, sect. II.4) with the exponents of an order-3 error estimate: 1/4 - 0.75 beta
+and beta = 0.04, with no growth right after a rejected step (Hairer & Wanner's facmax = 1). The step after
+the end of a span starts from the controller's proposal, not from the step the span's end clipped, so that
+a run in chunks keeps its step.
 """
 
 from __future__ import annotations
@@ -38,7 +44,7 @@ import numpy as np
 
 from cageless.simulation.integrators.dp5 import (STATUS_NONFINITE, STATUS_OK, _accept, _before_step, _controls,
                                                  _retry_step, _samples_before, _write_stats)
-from cageless.simulation.kernels import model_implicit, model_rhs, model_signature
+from cageless.simulation.kernels import model_filter_error, model_gaps, model_implicit, model_rhs, model_signature
 
 __all__ = ["ark_integrate", "AE", "AI", "B", "B_HAT", "C", "GAMMA"]
 
@@ -81,6 +87,9 @@ def ark_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_st
     yt = np.empty(n)
     ynew = np.empty(n)
     f_end = np.empty(n)
+    e = np.empty(n)
+    g0 = np.zeros(n)  # contact gaps at the step's start and end (3 Z of them in the bearing models, n >= 3 Z)
+    g1 = np.zeros(n)
     work = np.empty(12)
     cnt = np.zeros(8, dtype=np.int64)
     t = t0
@@ -96,8 +105,11 @@ def ark_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_st
     t_end = t_out[t_out.shape[0] - 1]
     tiny = 1e-13 * max(abs(t_end), t_end - t0)
     h_want = h  # the controller's proposal before the end of the span clipped it: where the next span starts
+    t_cross = -np.inf  # a contact change located ahead (see _onset_retry): the step that crosses it is short
     while k < t_out.shape[0]:
         h_want = h
+        if t_cross > t:
+            h = min(h, max(h_onset, t_cross - t + 0.5 * h_onset))
         stop, h = _before_step(cnt, max_steps, t, t_end, h, h_max, tiny)
         if stop >= 0:
             if stop == STATUS_OK:
@@ -107,7 +119,7 @@ def ark_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_st
         _ark_stages(model_id, t, h, y, p, log, f, ki, yt, ynew, work)
         model_rhs(model_id, t + h, ynew, p, log, f_end)
         cnt[_RHS] += 6
-        err = _ark_error(h, y, ynew, f, atol, rtol)
+        err = _ark_error(model_id, p, h, y, ynew, f, atol, rtol, e)
         if not np.isfinite(err) or err > 1.0:
             cnt[_REJ] += 1
             held = True
@@ -117,7 +129,11 @@ def ark_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_st
                 break
             continue
         verdict, sig = _controls(model_id, ynew, p, sig, h, h_onset, f[0], f_end, jump_floor, force_jump)
-        if verdict == 1 or verdict == 2:
+        if verdict == 1:
+            h_retry = _retry_step(verdict, h, h_onset, cnt)
+            h, t_cross = _onset_retry(model_id, p, t, h, y, ynew, h_retry, g0, g1)
+            continue
+        if verdict == 2:
             h = _retry_step(verdict, h, h_onset, cnt)
             continue
         cnt[5] += verdict == 3  # contact changes (dp5's counter)
@@ -154,17 +170,43 @@ def _ark_stages(model_id, t, h, y, p, log, f, ki, yt, ynew, work):  # pragma: no
 
 
 @numba.njit(cache=True, inline="always")
-def _ark_error(h, y, ynew, f, atol, rtol):  # pragma: no cover - compiled
+def _onset_retry(model_id, p, t, h, y, ynew, h_onset, g0, g1):  # pragma: no cover - compiled
+    """Where to retry a step refused because a contact opened or closed in it (longer than ``h_onset``):
+    (the retry's length, the estimated time of the change). The change is located on the straight line
+    between the contact gaps at the step's two ends (the earliest sign change); the retry ends half an onset
+    step before it, and the step after it is held to end half an onset step past it (the loop's ``t_cross``),
+    so that the change is crossed by one short step instead of by a run of onset steps. Without a located
+    change (or one within an onset step of the start) the retry is the onset step itself, as DP5's."""
+    model_gaps(model_id, y, p, g0)
+    model_gaps(model_id, ynew, p, g1)
+    frac = 1.0
+    found = False
+    for i in range(g0.shape[0]):
+        if (g0[i] > 0.0) != (g1[i] > 0.0):
+            found = True
+            frac = min(frac, g0[i] / (g0[i] - g1[i]))
+    if not found or frac * h - 0.5 * h_onset <= h_onset:
+        return h_onset, -np.inf
+    return frac * h - 0.5 * h_onset, t + frac * h
+
+
+@numba.njit(cache=True, inline="always")
+def _ark_error(model_id, p, h, y, ynew, f, atol, rtol, e):  # pragma: no cover - compiled
     """The RMS of err_i / (atol_i + rtol max(|y_i|, |ynew_i|)) of the embedded order-3 estimate
-    h sum_j (b_j - b_hat_j) f(Y_j); inf when the new state is not finite."""
+    h sum_j (b_j - b_hat_j) f(Y_j), filtered through the implicit part's stiffness at y
+    (:func:`cageless.simulation.kernels.model_filter_error`); inf when the new state is not finite.
+    ``e`` (n) is scratch."""
     n = y.shape[0]
-    err = 0.0
     for q in range(n):
         if not np.isfinite(ynew[q]):
             return np.inf
-        e = 0.0
+        acc = 0.0
         for j in range(6):
-            e += _E[j] * f[j, q]
+            acc += _E[j] * f[j, q]
+        e[q] = h * acc
+    model_filter_error(model_id, y, p, h * GAMMA, e)
+    err = 0.0
+    for q in range(n):
         sc = atol[q] + rtol * max(abs(y[q]), abs(ynew[q]))
-        err += (h * e / sc) ** 2
+        err += (e[q] / sc) ** 2
     return np.sqrt(err / n)

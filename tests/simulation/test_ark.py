@@ -149,3 +149,49 @@ def test_spatial_bearing_against_the_tight_reference():
     sol = solve(pr, t, method="ark4", rtol=1e-6)
     assert sol.success and np.all(np.isfinite(sol.y))
     assert 100 * np.max(np.abs(sol.y[:, 3 * z:4 * z] - ref.y[:, 3 * z:4 * z])) / cage < 0.01
+
+
+def _implicit(pr, y, hg):
+    from cageless.simulation.kernels import model_implicit
+
+    k_i = np.empty_like(y)
+    model_implicit(pr.model_id, 0.0, y, pr.params, hg, k_i, np.zeros(12))
+    return k_i
+
+
+def test_stage_equation_is_solved_per_ball(settled):
+    """Y = Z + h gamma f_I(Y) at a 20 us stage from the settled state, to the Newton tolerance: the loaded
+    balls' normal forces (the Hertz spring and the damping) are implicit, so the stage moves their radii."""
+    pr, _ = settled
+    z = pr.n_balls
+    hg = 20e-6 * GAMMA
+    y_z = pr.y0.copy()
+    y = y_z.copy()
+    k_i = _implicit(pr, y, hg)
+    assert np.max(np.abs(y - y_z - hg * k_i)) < 1e-12
+    assert np.max(np.abs(y[:z] - y_z[:z])) > 1e-9  # r moved with r' (the radial kinematics are implicit)
+    assert np.array_equal(y[z:2 * z], y_z[z:2 * z]) and np.array_equal(y[4 * z:], y_z[4 * z:])
+
+
+def test_explicit_part_keeps_no_hertz_modes(settled):
+    """The fastest modes of f - f_I at the settled 3000 rpm, 500 N state are ten times slower than the Hertz
+    oscillations (2.1e5 1/s) and the damping (2.8e6 1/s) that limit an explicit step."""
+    from cageless.simulation.kernels import model_rhs
+
+    pr, _ = settled
+    n = pr.y0.size
+    log = pr.log.copy()
+
+    def explicit(y):
+        out = np.empty(n)
+        model_rhs(pr.model_id, 0.0, y, pr.params, log, out)
+        return out - _implicit(pr, y.copy(), 0.0)
+
+    jac = np.empty((n, n))
+    for i in range(n):
+        e = max(1e-7 * abs(pr.y0[i]), 1e-2 * pr.atol[i])
+        up, down = pr.y0.copy(), pr.y0.copy()
+        up[i] += e
+        down[i] -= e
+        jac[:, i] = (explicit(up) - explicit(down)) / (2 * e)
+    assert np.max(np.abs(np.linalg.eigvals(jac))) < 5e4

@@ -70,7 +70,7 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--rtol", type=finite_float, default=1e-6, help="relative tolerance (default 1e-6)")
     p.add_argument("--max-step", type=finite_float, default=None,
                    help="largest step (s; default 2e-6, and 5e-6 for CVODE, also after an automatic switch, "
-                   "1e-5 for rosw, 2e-5 for ark4)")
+                   "1e-5 for rosw, 5e-5 for ark4)")
     p.add_argument("--restitution", type=finite_float,
                    help="ball-ball coefficient of restitution R, 0 <= R <= 1, 0 perfectly plastic (same as --set "
                    "restitution=R)")
