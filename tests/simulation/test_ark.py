@@ -174,8 +174,10 @@ def test_stage_equation_is_solved_per_ball(settled):
 
 
 def test_explicit_part_keeps_no_hertz_modes(settled):
-    """The fastest modes of f - f_I at the settled 3000 rpm, 500 N state are ten times slower than the Hertz
-    oscillations (2.1e5 1/s) and the damping (2.8e6 1/s) that limit an explicit step."""
+    """The fastest modes of f - f_I at the settled 3000 rpm, 500 N state are well below the race Hertz
+    oscillations (2.1e5 1/s) and the damping (2.8e6 1/s) that limit an explicit step: 2.1e4 1/s (a loaded
+    ball's spin) where no neighbours touch; a ball-ball contact, which stays explicit, gave 6.1e4 1/s
+    (-4.06e3 +- 6.09e4j) at the state this fixture settles to on the merged tree."""
     from cageless.simulation.kernels import model_rhs
 
     pr, _ = settled
@@ -194,4 +196,4 @@ def test_explicit_part_keeps_no_hertz_modes(settled):
         up[i] += e
         down[i] -= e
         jac[:, i] = (explicit(up) - explicit(down)) / (2 * e)
-    assert np.max(np.abs(np.linalg.eigvals(jac))) < 5e4
+    assert np.max(np.abs(np.linalg.eigvals(jac))) < 1e5
