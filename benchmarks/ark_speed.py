@@ -22,44 +22,12 @@ import logging
 from dataclasses import replace
 from pathlib import Path
 
-import numpy as np
 
 from cageless.atomic import atomic_write_text
-from cageless.simulation.kernels import model_implicit, model_rhs
+from cageless.simulation.bench import fastest_modes
 from solver_speed import _cases, format_rows, measure  # the sibling script (benchmarks/ is on sys.path)
 
 log = logging.getLogger("ark_speed")
-
-
-def fastest_modes(pr, count: int = 2) -> dict[str, list[complex]]:  # noqa: ANN001
-    """The ``count`` largest eigenvalues (1/s) of the Jacobian of f and of f - f_I at the problem's start
-    (central differences, steps 1e-2 of each state's absolute tolerance)."""
-    n = pr.y0.size
-    log_ = pr.log.copy()
-    work = np.zeros(12)
-
-    def full(y):  # noqa: ANN001, ANN202
-        out = np.empty(n)
-        model_rhs(pr.model_id, 0.0, y, pr.params, log_, out)
-        return out
-
-    def explicit(y):  # noqa: ANN001, ANN202
-        k_i = np.empty(n)
-        model_implicit(pr.model_id, 0.0, y.copy(), pr.params, 0.0, k_i, work)
-        return full(y) - k_i
-
-    result = {}
-    for name, fun in (("f", full), ("f - f_I", explicit)):
-        jac = np.empty((n, n))
-        for i in range(n):
-            e = max(1e-7 * abs(pr.y0[i]), 1e-2 * pr.atol[i])
-            up, down = pr.y0.copy(), pr.y0.copy()
-            up[i] += e
-            down[i] -= e
-            jac[:, i] = (fun(up) - fun(down)) / (2 * e)
-        ev = np.linalg.eigvals(jac)
-        result[name] = list(ev[np.argsort(-np.abs(ev))[:count]])
-    return result
 
 
 def main() -> None:

@@ -48,7 +48,7 @@ from cageless.simulation.simulation import Choices, Simulation
 from cageless.simulation.solve import solve, step_cvode, step_scipy
 
 __all__ = ["accuracy_study", "format_accuracy", "plot_accuracy", "model_study", "format_models", "effects_study",
-           "format_effects"]
+           "format_effects", "fastest_modes"]
 
 #: (method, rtol, max_step in s). The step cap is an accuracy knob of its own for the implicit CVODE,
 #: whose steps are otherwise set by accuracy alone: the default 2 us keeps ~15 steps inside a ball-ball
@@ -342,3 +342,38 @@ def format_effects(result: dict[str, Any]) -> str:
         lines.append(f"| {r['removed']} | {r['peak_slip_pct']:.2f} | {r['profile_change_pp']:.2f} | {r['wall_s']:.1f} | "
                      f"{r['saving_pct']:.0f} % |")
     return "\n".join(lines)
+
+
+def fastest_modes(pr: Problem, count: int = 2) -> dict[str, list[complex]]:
+    """The ``count`` largest eigenvalues (1/s) of the Jacobian of f and of f - f_I at the problem's start
+    (central differences, steps 1e-2 of each state's absolute tolerance): what limits an explicit step, and
+    what ``ark4``'s implicit part (:func:`~cageless.simulation.kernels.model_implicit`) leaves to the explicit
+    one."""
+    from cageless.simulation.kernels import model_implicit, model_rhs
+
+    n = pr.y0.size
+    log_ = pr.log.copy()
+    work = np.zeros(12)
+
+    def full(y: np.ndarray) -> np.ndarray:
+        out = np.empty(n)
+        model_rhs(pr.model_id, 0.0, y, pr.params, log_, out)
+        return out
+
+    def explicit(y: np.ndarray) -> np.ndarray:
+        k_i = np.empty(n)
+        model_implicit(pr.model_id, 0.0, y.copy(), pr.params, 0.0, k_i, work)
+        return full(y) - k_i
+
+    result = {}
+    for name, fun in (("f", full), ("f - f_I", explicit)):
+        jac = np.empty((n, n))
+        for i in range(n):
+            e = max(1e-7 * abs(pr.y0[i]), 1e-2 * pr.atol[i])
+            up, down = pr.y0.copy(), pr.y0.copy()
+            up[i] += e
+            down[i] -= e
+            jac[:, i] = (fun(up) - fun(down)) / (2 * e)
+        ev = np.linalg.eigvals(jac)
+        result[name] = list(ev[np.argsort(-np.abs(ev))[:count]])
+    return result
