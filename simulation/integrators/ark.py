@@ -80,18 +80,8 @@ def ark_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_st
     """Integrate from ``t0`` and write ``y`` at each ``t_out[k]`` into ``out[k]``: the signature, controls,
     statistics and status codes of :func:`cageless.simulation.integrators.dp5.dp5_integrate` (no stiffness
     counter: ``stats[7]`` stays 0)."""  # noqa: D401
-    n = y0.shape[0]
     y = y0.copy()
-    f = np.empty((6, n))  # f(Y_i), the full right-hand side of each stage
-    ki = np.empty((6, n))  # f_I(Y_i)
-    yt = np.empty(n)
-    ynew = np.empty(n)
-    f_end = np.empty(n)
-    e = np.empty(n)
-    g0 = np.zeros(n)  # contact gaps at the step's start and end (3 Z of them in the bearing models, n >= 3 Z)
-    g1 = np.zeros(n)
-    work = np.empty(12)
-    cnt = np.zeros(8, dtype=np.int64)
+    f, ki, yt, ynew, f_end, e, g0, g1, work, cnt = _buffers(y0.shape[0])
     t = t0
     model_rhs(model_id, t, y, p, log, f[0])
     model_implicit(model_id, t, y, p, 0.0, ki[0], work)
@@ -121,9 +111,8 @@ def ark_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_st
         cnt[_RHS] += 6
         err = _ark_error(model_id, p, h, y, ynew, f, atol, rtol, e)
         if not np.isfinite(err) or err > 1.0:
-            cnt[_REJ] += 1
             held = True
-            h = h * 0.25 if not np.isfinite(err) else h / min(5.0, err ** 0.25 / 0.9)
+            h = _rejected(err, h, cnt)
             if h < tiny and not np.isfinite(err):
                 status = STATUS_NONFINITE
                 break
@@ -147,6 +136,22 @@ def ark_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_st
         h = h / fac
     _write_stats(stats, cnt, max(h, h_want) if status == STATUS_OK else h)
     return status
+
+
+@numba.njit(cache=True, inline="always")
+def _buffers(n):  # pragma: no cover - compiled
+    """The work arrays of :func:`ark_integrate`: f(Y_i) and f_I(Y_i) of the six stages, a stage's state, the
+    step's end state and right-hand side, the error vector, the contact gaps at the step's start and end (3 Z
+    of them in the bearing models, n >= 3 Z), the implicit solves' scratch and the counters."""
+    return (np.empty((6, n)), np.empty((6, n)), np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.zeros(n),
+            np.zeros(n), np.empty(12), np.zeros(8, dtype=np.int64))
+
+
+@numba.njit(cache=True, inline="always")
+def _rejected(err, h, cnt):  # pragma: no cover - compiled
+    """The next trial step after the error test refused one of length ``h`` (counted in ``cnt``)."""
+    cnt[_REJ] += 1
+    return h * 0.25 if not np.isfinite(err) else h / min(5.0, err ** 0.25 / 0.9)
 
 
 @numba.njit(cache=True, inline="always")
