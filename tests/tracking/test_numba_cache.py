@@ -2,7 +2,7 @@
 
 numba keys a cached function on its own file only, and ``link_kernel.run_block`` compiles in the centroid of
 ``detect.py``: an edit to ``detect.py`` alone left the loop running the old centroid (seen in this project's
-speed benchmark, which timed a version of the centroid two edits old)."""
+speed benchmark, which timed the centroid of the previous edit)."""
 
 from __future__ import annotations
 
