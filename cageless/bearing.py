@@ -19,7 +19,8 @@ from typing import Any
 
 from cageless.errors import GeometryError, ParameterError, suggest
 
-__all__ = ["Geometry", "Material", "Masses", "Lubricant", "Bearing", "default_bearing"]
+__all__ = ["Geometry", "Material", "Masses", "Lubricant", "Bearing", "default_bearing", "clearance_note",
+           "CLEARANCE_NAME"]
 
 #: Clearances smaller than this (m) are round-off of the race diameters and are taken as 0.
 _CLEARANCE_ROUND_OFF_M = 1e-12
@@ -299,21 +300,40 @@ class Bearing:
     def with_overrides(self, overrides: Mapping[str, Any]) -> Bearing:
         """Return a copy with dotted-name overrides applied, e.g. ``{"geometry.n_balls": 13}``.
 
+        ``geometry.diametral_clearance_m`` (m, >= 0) is accepted too: after the other overrides, the races
+        move apart symmetrically to that clearance, the pitch diameter kept
+        (:meth:`Geometry.with_diametral_clearance`).
+
         Raises
         ------
         ParameterError
-            For an unknown name (with a suggestion) or an invalid value.
+            For an unknown name (with a suggestion) or an invalid value (a negative clearance is a
+            :class:`~cageless.errors.GeometryError` naming ``geometry.diametral_clearance_m``).
         """
         data = self.to_dict()
-        valid = sorted(_dotted_names(data))
+        valid = sorted([*_dotted_names(data), CLEARANCE_NAME])
+        clearance = None
         for key, value in overrides.items():
             section, _, name = key.partition(".")
             if key not in valid:
                 if section == "lubricant" and data.get("lubricant") is None:
                     raise ParameterError(key, "the bearing is dry; set the whole lubricant section")
                 raise ParameterError(key, "is not a bearing parameter" + suggest(key, valid))
+            if key == CLEARANCE_NAME:
+                clearance = value
+                continue
             data[section][name] = value
-        return Bearing.from_dict(data)
+        bearing = Bearing.from_dict(data)
+        if clearance is None:
+            return bearing
+        if isinstance(clearance, bool) or not isinstance(clearance, int | float):
+            raise ParameterError(CLEARANCE_NAME, "must be a number in metres, e.g. 32e-6", clearance)
+        return dataclasses.replace(bearing, geometry=bearing.geometry.with_diametral_clearance(float(clearance)))
+
+
+#: The dotted name that sets the diametral clearance in overrides, ``--config`` and sweeps (not a stored field:
+#: the clearance follows from the race diameters).
+CLEARANCE_NAME = "geometry.diametral_clearance_m"
 
 
 _SECTIONS: dict[str, type] = {
@@ -352,3 +372,11 @@ def default_bearing() -> Bearing:
 
     return wang2026.bearing()
 
+
+def clearance_note(geometry: Geometry) -> str:
+    """One line for ``--explain``: the diametral clearance of ``geometry`` (um) and where it comes from."""
+    from cageless.parameter_sets import wang2026
+
+    source = ("Table 1 of Wang et al. 2026 as printed" if geometry == wang2026.geometry()
+              else "as given: --clearance-um, geometry.diametral_clearance_m or the race diameters")
+    return f"diametral clearance {geometry.diametral_clearance_m * 1e6:.3f} um ({source})"

@@ -6,6 +6,8 @@ A configuration file is TOML with two kinds of table:
   ``[bearing.lubricant]`` override fields of the default bearing, by the
   dataclass field names (SI units in the names, e.g. ``ball_diameter_m``);
   ``[bearing] lubricant = false`` makes the bearing dry;
+  ``[bearing.geometry] diametral_clearance_m = 32e-6`` sets the diametral clearance, the races moved apart
+  symmetrically about the pitch circle (the default bearing has Table 1's zero clearance);
 * ``[<subcommand>]`` tables (e.g. ``[info]``) give option defaults for that
   subcommand, by the option's long name with ``-`` or ``_``
   (``speed_rpm = 6000``). Options given on the command line win.

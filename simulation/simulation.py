@@ -144,6 +144,13 @@ class Simulation:
         rate = self.choices.sample_rate_hz
         return np.arange(0.0, self.scene.duration_s + 0.5 / rate, 1.0 / rate)
 
+    def _clearance(self) -> dict[str, Any]:
+        """The diametral clearance the run used and where it comes from, for the provenance."""
+        from cageless.bearing import clearance_note
+
+        g = self.scene.bearing.geometry
+        return {"diametral_clearance_m": g.diametral_clearance_m, "note": clearance_note(g)}
+
     def run(self, out: str | Path | None = None, progress: bool = False,
             config: dict[str, Any] | None = None) -> Trace:
         """Solve, build the trace and (with ``out``) write it atomically; ``config`` adds to its recorded
@@ -158,7 +165,7 @@ class Simulation:
         c = self.choices
         prov = Provenance.start(config={"scene": self.scene.to_dict(), "model": json.loads(self.model.to_json()),
                                         "solver": c.solver_config(), "parameters": self.parameters.to_dict(),
-                                        "peak_estimator": peak_estimator(),
+                                        "peak_estimator": peak_estimator(), "clearance": self._clearance(),
                                         **(config or {})})
         pr = self.build()
         t = self.sample_times()

@@ -5,7 +5,8 @@ at 1800 rpm). Each grid point runs ``seeds`` simulations; the result is the peak
 profile in the unloaded zone after the start-up, per run, and its mean and seed spread
 per point. A parameter name is a scene quantity (``speed_rpm``, ``radial_load_n``, ``axial_load_n``),
 an open model parameter (``cho_n_s_m``, ``film_thickness_m``, ...) or a dotted bearing field
-(``lubricant.dynamic_viscosity_pa_s``; ``lubricant.viscosity`` is accepted for it).
+(``lubricant.dynamic_viscosity_pa_s``; ``lubricant.viscosity`` is accepted for it; ``geometry.diametral_clearance_m``
+moves the races apart about the pitch circle).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from cageless.atomic import atomic_write_text
-from cageless.bearing import Bearing, default_bearing
+from cageless.bearing import CLEARANCE_NAME, Bearing, default_bearing
 from cageless.errors import ParameterError, suggest
 
 __all__ = ["parse_vary", "sweep_grid", "run_sweep", "simulate_point", "sweep_base", "summarise", "plot_sweep", "SCENE_NAMES", "ALIASES"]
@@ -53,7 +54,7 @@ def parse_vary(items: Sequence[str], bearing: Bearing | None = None) -> dict[str
     bearing = bearing or default_bearing()
     model = list(BUILT_IN_NAMES)
     dotted = [f"{s}.{k}" for s, d in bearing.to_dict().items() if isinstance(d, dict) for k in d]
-    known = [*SCENE_NAMES, *model, *dotted, *ALIASES]
+    known = [*SCENE_NAMES, *model, *dotted, CLEARANCE_NAME, *ALIASES]
     out: dict[str, list[float]] = {}
     for item in items:
         name, sep, spec = item.partition("=")

@@ -82,6 +82,45 @@ def test_a_clearance_moves_the_races_apart_about_the_pitch_circle():
         assert err.value.parameter == "geometry.diametral_clearance_m"
 
 
+def test_the_clearance_is_a_bearing_override_and_the_default_has_none():
+    """``geometry.diametral_clearance_m`` in overrides (and so in ``--config`` and sweeps) moves the races apart
+    about the pitch circle; the default bearing is Table 1 of Wang et al. 2026 as printed, with P_d = 0."""
+    b = default_bearing()
+    assert b.geometry.diametral_clearance_m == 0.0
+    c4 = b.with_overrides({"geometry.diametral_clearance_m": 32e-6})  # ISO 5753-1 C4 for a 25 mm bore: 23-41 um
+    assert c4.geometry.diametral_clearance_m == pytest.approx(32e-6, rel=1e-9)
+    assert c4.geometry.pitch_diameter_m == pytest.approx(b.geometry.pitch_diameter_m, abs=1e-15)
+    # the other overrides first, then the clearance about the new pitch circle
+    both = b.with_overrides({"geometry.diametral_clearance_m": 20e-6, "geometry.n_balls": 13})
+    assert both.geometry.n_balls == 13 and both.geometry.diametral_clearance_m == pytest.approx(20e-6, rel=1e-9)
+    for bad, kind in ((-1e-6, GeometryError), ("20 um", ParameterError), (True, ParameterError)):
+        with pytest.raises(kind) as err:
+            b.with_overrides({"geometry.diametral_clearance_m": bad})
+        assert err.value.parameter == "geometry.diametral_clearance_m"
+
+
+def test_the_clearance_from_a_config_file_reaches_explain_the_trace_and_sweeps(capsys, tmp_path):
+    from cageless.app.cli import main
+    from cageless.simulation.sweep import parse_vary
+    from cageless.trace import read_trace
+
+    assert main(["simulate", "--speed-rpm", "3000", "--explain"]) == 0
+    line = capsys.readouterr().out.splitlines()[-1]
+    assert line == "bearing: wang2026, diametral clearance 0.000 um (Table 1 of Wang et al. 2026 as printed)"
+    config = tmp_path / "c4.toml"
+    config.write_text("[bearing.geometry]\ndiametral_clearance_m = 32e-6\n", encoding="utf-8")
+    assert main(["simulate", "--config", str(config), "--speed-rpm", "3000", "--explain"]) == 0
+    assert "diametral clearance 32.000 um (as given" in capsys.readouterr().out
+    out = tmp_path / "x.trace.h5"
+    assert main(["simulate", "--config", str(config), "--speed-rpm", "3000", "--radial-load-n", "500",
+                 "--duration", "0.003", "-q", "-o", str(out)]) == 0
+    assert read_trace(out).config["clearance"]["diametral_clearance_m"] == pytest.approx(32e-6, rel=1e-9)
+    config.write_text("[bearing.geometry]\ndiametral_clearance_m = -1e-6\n", encoding="utf-8")
+    assert main(["simulate", "--config", str(config), "--speed-rpm", "3000", "--explain"]) == 2
+    assert "geometry.diametral_clearance_m" in capsys.readouterr().err
+    assert parse_vary(["geometry.diametral_clearance_m=0,32e-6"]) == {"geometry.diametral_clearance_m": [0.0, 32e-6]}
+
+
 def test_material_and_lubricant_rules():
     with pytest.raises(ParameterError, match=r"\(-1, 0.5\)") as err:
         Material(density_kg_m3=7810.0, youngs_modulus_pa=208e9, poisson_ratio=0.5)

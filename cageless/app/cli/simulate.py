@@ -114,7 +114,8 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     if args.explain:
         _parameters(args, config)  # the same checks of --parameter-set, --config and --set as a run
         choice = Simulation(scene, choices=choices).model  # the choice alone: nothing is built or compiled
-        print(choice.to_json() if args.json else f"{choice.explain()}\n{_parameter_line(args, config)}")
+        print(choice.to_json() if args.json else
+              f"{choice.explain()}\n{_parameter_line(args, config)}\nbearing: {_bearing_line(scene.bearing)}")
         return 0
     return _run(args, scene, choices, config)
 
@@ -155,6 +156,13 @@ def _validate(args: argparse.Namespace, bearing: Any) -> None:
     elif args.ensemble == 1:
         check_output_file(f"sim_{args.speed_rpm:g}rpm_Fr{args.radial_load_n:g}.trace.h5", "the default output",
                           overwrite=args.overwrite)
+
+
+def _bearing_line(bearing: Any) -> str:
+    """The bearing's name and its diametral clearance with the clearance's source."""
+    from cageless.bearing import clearance_note
+
+    return f"{bearing.name}, {clearance_note(bearing.geometry)}"
 
 
 def _parameter_line(args: argparse.Namespace, config: dict[str, Any]) -> str:
