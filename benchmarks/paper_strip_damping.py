@@ -169,7 +169,7 @@ def table(speed_rpm: float, radial_load_n: float, m: int) -> str:
     mu = traction_peak()
     out = [f"u = {u:.3f} m/s, mu_peak = {mu:g}, m = {m} strips, d(delta)/dt = 0", "",
            "| contact | Q (N) | C_ho (N s/m) | C_ho u b/R_x (N) | reading | approach | delta/delta_H | F_n (N) | "
-           "F_n/Q | mu_peak F_n (N) | moment (D/2) mu_peak F_n (mN m) | strips loaded |",
+           "F_n/Q | mu_peak F_n (N) | moment (D/2) mu_peak F_n (mN m) | strips in compression |",
            "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for c in cs:
         for cho in CHO_N_S_M:
@@ -178,7 +178,8 @@ def table(speed_rpm: float, radial_load_n: float, m: int) -> str:
                                                  ("B, clipped", "held", False, True),
                                                  ("B, clipped", "free", True, True)):
                 r = evaluate(c, u if reading.startswith("B") else 0.0, cho, m, free, clip)
-                out.append(f"| {c.label} | {c.load_n:.3g} | {cho:g} | {cho * u * c.b_coeff * c.load_n ** (1 / 3) / c.r_x:.3g} | "
+                edge = cho * u * c.b_coeff * c.load_n ** (1.0 / 3.0) / c.r_x
+                out.append(f"| {c.label} | {c.load_n:.3g} | {cho:g} | {edge:.3g} | "
                            f"{reading} | {approach} | {r['delta_ratio']:.3g} | {r['f_n']:.4g} | "
                            f"{r['f_n'] / c.load_n:.3g} | {mu * r['f_n']:.3g} | {0.5 * d * mu * r['f_n'] * 1e3:.3g} | "
                            f"{r['strips_loaded']}/{m} |")
