@@ -22,6 +22,10 @@ is not resolved.
     python benchmarks/lubricant_sensitivity.py               # 2 seeds, 0.1 s each: about 10 min, 2 loaded cores
     python benchmarks/lubricant_sensitivity.py --seeds 1 --duration 0.05
     python benchmarks/lubricant_sensitivity.py --rows cho_n_s_m film_thickness_m --seeds 4 --duration 0.2
+    python benchmarks/lubricant_sensitivity.py --rows cho_n_s_m --effect strip_damping=on   # the paper's strips
+
+``--effect NAME=on|off`` (repeatable) applies to every row, on top of the row's own effects, as in
+``cageless sweep --effect``.
 """
 
 from __future__ import annotations
@@ -47,7 +51,18 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--speed-rpm", type=float, default=1800.0)
     ap.add_argument("--rows", nargs="*", default=None, help="only the rows of these parameters (default: all)")
+    ap.add_argument("--effect", action="append", default=[], metavar="NAME=on|off",
+                    help="an effect override for every row (repeatable)")
+    ap.add_argument("--values", nargs="*", type=float, default=None,
+                    help="the values to sweep between the row's ends (default: its two ends)")
     args = ap.parse_args(argv)
+    from cageless.errors import UsageError
+    from cageless.simulation.effects import parse_effect_overrides
+
+    try:
+        extra = parse_effect_overrides(args.effect)
+    except UsageError as exc:
+        ap.error(str(exc))
     known = {row[0] for row in STUDY}
     if args.rows and not set(args.rows) <= known:
         ap.error(f"--rows: unknown {sorted(set(args.rows) - known)}; the rows are {sorted(known)}")
@@ -59,7 +74,9 @@ def main(argv: list[str] | None = None) -> int:
     for name, lo, hi, effects, paper_pct in STUDY:
         if args.rows and name not in args.rows:
             continue
-        vary = parse_vary([f"{name}={lo:g},{hi:g}"])
+        effects = {**effects, **extra}
+        values = sorted({lo, hi, *(args.values or ())})
+        vary = parse_vary([f"{name}=" + ",".join(f"{v:g}" for v in values)])
         runs = run_sweep(vary, args.seeds, args.speed_rpm, 500.0, duration_s=args.duration, workers=args.workers,
                          progress=False, effects=effects)
         summ = summarise(runs, list(vary)).reset_index(drop=True)
@@ -69,12 +86,15 @@ def main(argv: list[str] | None = None) -> int:
         sd_lo, sd_hi = (summ.peak_slip_std_pct.iloc[i] * (n / max(n - 1, 1)) ** 0.5
                         for i, n in ((0, n_lo), (-1, n_hi)))
         se = (sd_lo ** 2 / n_lo + sd_hi ** 2 / n_hi) ** 0.5 / s_lo
-        label = name + (" (ehl_film off)" if effects else "")
+        label = name + "".join(f" ({k} {'on' if v else 'off'})" for k, v in effects.items())
         paper = "— | —" if paper_pct is None else \
             f"{paper_pct[0]} -> {paper_pct[1]} | {(paper_pct[1] - paper_pct[0]) / paper_pct[0]:+.0%}"
         out.append(f"| {label} | {lo:g} -> {hi:g} | {s_lo:.2f} -> {s_hi:.2f} | {(s_hi - s_lo) / s_lo:+.0%} +- {se:.0%} | "
                    f"{paper} |")
-        cmd = (f"cageless sweep --speed-rpm {args.speed_rpm:g} --radial-load-n 500 --vary {name}={lo:g},{hi:g} "
+        if len(summ) > 2:
+            out.append("|  | all values | " + " -> ".join(f"{v:.2f}" for v in summ.peak_slip_mean_pct) + " |  |  |  |")
+        cmd = (f"cageless sweep --speed-rpm {args.speed_rpm:g} --radial-load-n 500 --vary {name}="
+               + ",".join(f"{v:g}" for v in values) + " "
                f"--seeds {args.seeds} --duration {args.duration:g}"
                + "".join(f" --effect {k}={'on' if v else 'off'}" for k, v in effects.items()))
         sys.stderr.write(cmd + "\n")

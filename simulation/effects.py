@@ -59,6 +59,11 @@ class EffectSpec:
     #: False for the contacts without which there is no bearing model (race and ball-ball contact): the
     #: effect ablation (``cageless bench effects``) removes every other effect in turn.
     removable: bool = True
+    #: True for an alternative law that no scene switches on by itself (its rule says off): ``--effect NAME=on``
+    #: chooses it without ``--force`` (``strip_damping``, the paper's formulation, kept for reproducing it).
+    opt_in: bool = False
+    #: Levels the effect is built into (an opt-in law may exist in one model only).
+    levels: tuple[str, ...] = ("planar", "spatial")
 
 
 def _always(what: str) -> Callable[[Scene], tuple[bool, str]]:
@@ -71,6 +76,14 @@ def _lubricated(s: Scene) -> tuple[bool, str]:
 
 def _gravity(s: Scene) -> tuple[bool, str]:
     return (True, f"g = {s.gravity_m_s2:g} m/s^2") if s.gravity_m_s2 > 0 else (False, "g = 0")
+
+
+#: Why the paper's strip formulation of the race damping is off unless asked for.
+STRIP_DAMPING_OFF = ("opt-in (--effect strip_damping=on): the paper's strip formulation of C_ho, for reproducing "
+                     "the paper; not the default physics")
+#: What the explanation says when it is on.
+STRIP_DAMPING_ON = ("on by the user: the paper's strip formulation of C_ho (Wang et al. 2026, sec. 2.2), for "
+                    "reproducing the paper; not the default physics")
 
 
 def _dry(s: Scene) -> tuple[bool, str]:
@@ -94,6 +107,12 @@ EFFECTS: tuple[EffectSpec, ...] = (
                _always("balls always touch the races"), flag="F_RACE", slots=("KI", "KO"), removable=False),
     EffectSpec("lubricant_damping", "normal damping C_ho d(delta)/dt at race contacts, never tensile", _lubricated,
                needs_lubricant=True, flag="F_LUB", slots=("CHO",)),
+    EffectSpec("strip_damping", "the paper's strip formulation of the race damping: C_ho spread over strips of the "
+               "contact ellipse along the rolling direction, each at its own normal speed d(delta)/dt + u x / R_x "
+               "(the contact-point velocity omega_b x r_x + v_b), no strip tensile (Wang et al. 2026, sec. 2.2)",
+               lambda s: (False, STRIP_DAMPING_OFF), needs_lubricant=True, flag="F_STRIP",
+               slots=("SB_I", "SB_O", "SRX_I", "SRX_O"), acts_on=("lubricant_damping",), opt_in=True,
+               levels=("planar",)),
     EffectSpec("race_traction", "traction mu(slip) at race contacts (dry: Coulomb-Stribeck)",
                _always("traction drives the balls"), flag="F_TRAC", slots=("TA", "TB", "TC", "TD", "U_FLOOR")),
     EffectSpec("ehl_film", "Hamrock-Dowson central and minimum film at race contacts", _lubricated,
@@ -231,6 +250,10 @@ def choose_model(scene: Scene, level: str | None = None, effects: Mapping[str, b
         if spec.name in overrides and overrides[spec.name] != on:
             want = overrides[spec.name]
             check_lubricant({spec.name: want}, scene.lubricated)
+            if want and spec.opt_in:
+                choices.append(EffectChoice(spec.name, True, STRIP_DAMPING_ON if spec.name == "strip_damping"
+                                            else f"on by the user ({reason})"))
+                continue
             if not force:
                 raise UsageError(f"--effect {spec.name}={'on' if want else 'off'} contradicts the scene "
                                  f"({reason}). Add --force to override.")
@@ -240,6 +263,11 @@ def choose_model(scene: Scene, level: str | None = None, effects: Mapping[str, b
             choices.append(EffectChoice(spec.name, on, reason))
     choices = _without_idle(choices, overrides)
     check_lubricant({c.name: c.on for c in choices}, scene.lubricated)
+    for c in choices:
+        if c.on and chosen_level not in _BY_NAME[c.name].levels:
+            raise UsageError(f"--effect {c.name}=on: it is built into the {' and '.join(_BY_NAME[c.name].levels)} "
+                             f"model only, and this scene runs at the {chosen_level} level ({level_reason}): drop "
+                             f"--effect {c.name}=on, or run a pure radial load on an aligned bearing.")
     return ModelChoice(level=chosen_level, level_reason=level_reason, effects=tuple(choices))
 
 
@@ -321,8 +349,9 @@ def parse_effect_overrides(items: list[str]) -> dict[str, bool]:
 
 
 def removable_effects() -> tuple[str, ...]:
-    """The effects an ablation removes in turn: every row of the table but the contacts that make the model."""
-    return tuple(e.name for e in EFFECTS if e.removable)
+    """The effects an ablation removes in turn: every row of the table but the contacts that make the model and
+    the opt-in alternatives (no scene has them on)."""
+    return tuple(e.name for e in EFFECTS if e.removable and not e.opt_in)
 
 
 def describe_table() -> list[dict[str, str]]:

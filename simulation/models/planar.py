@@ -12,7 +12,8 @@ Effects, each gated by its flag so that an effect that is off is never evaluated
 * race contact: Hertz, ball to outer groove delta = r + D/2 - d_o/2, ball to the
   displaced inner groove delta = d_i/2 + D/2 - |P - C|;
 * lubricant damping C_ho d(delta)/dt at the race contacts, the total normal
-  force never tensile (default C_ho from :class:`~cageless.simulation.parameters.ModelParameters`);
+  force never tensile (default C_ho from :class:`~cageless.simulation.parameters.ModelParameters`); or, opt-in
+  for reproducing the paper, its strip formulation (:mod:`cageless.simulation.models.strip_damping`);
 * race traction: the tangential force of :mod:`cageless.simulation.traction` against the
   sliding of the ball surface on the race surface, with its moment on the spin;
   the ring's share is the drive's input power;
@@ -65,6 +66,7 @@ from cageless.simulation.models.contact_log import (EVENT_FIELDS, ONSET_RESOLUTI
 from cageless.simulation.models.contact_laws import RACE_LAWS, ball_churning, ball_drag, race_extra, tangential
 from cageless.simulation.models.regime import oil_viscosity as par_viscosity, race_tangential, regime_slots
 from cageless.simulation.models.rolling import race_rolling, rolling_slots
+from cageless.simulation.models.strip_damping import P_F_STRIP, strip_normal, strip_slots
 
 __all__ = [
     "PlanarLayout", "planar_problem", "planar_energy", "packed_start", "contact_events", "DEFAULT_CHO_N_S_M",
@@ -101,7 +103,10 @@ def _outer_race(y, p, j, z, c, s, obs):  # pragma: no cover - compiled
         if obs is not None:
             obs[OBS_OUTER_NORMAL] = q
         if p[P_F_LUB] > 0.5:
-            q_d = max(q + p[P_CHO] * rd, 0.0)  # d(delta_o)/dt = r'; never tensile
+            if p[P_F_STRIP] > 0.5:  # the paper's strips (models/strip_damping.py), opt-in
+                q_d = strip_normal(q, d_o, rd, 0.5 * (r * thd + half * om - p[P_DO] * thd), False, p)
+            else:
+                q_d = max(q + p[P_CHO] * rd, 0.0)  # d(delta_o)/dt = r'; never tensile
             p_diss += (q_d - q) * rd
             q = q_d
         if RACE_LAWS:
@@ -152,7 +157,11 @@ def _inner_race(y, p, j, z, w_i, c, s, fy, fz, torque, p_diss, obs):  # pragma: 
             obs[OBS_INNER_NORMAL] = q
         if p[P_F_LUB] > 0.5:
             ddot = -(vx * nx + vz * nz)
-            q_d = max(q + p[P_CHO] * ddot, 0.0)
+            if p[P_F_STRIP] > 0.5:
+                r_i, vt = 0.5 * p[P_DI], vx * tx + vz * tz
+                q_d = strip_normal(q, d_i, ddot, 0.5 * (vt * (1.0 - 2.0 * r_i / ln) - half * om + w_i * r_i), True, p)
+            else:
+                q_d = max(q + p[P_CHO] * ddot, 0.0)
             p_diss += (q_d - q) * ddot
             q = q_d
         if RACE_LAWS:
@@ -451,6 +460,8 @@ def _params(bearing: Bearing, radial_load_n: float, gravity_m_s2: float, inner_s
                         "V_STRIBECK": par.stribeck_speed_m_s})
     if p[P_F_ROLL]:
         LAYOUT.fill(p, rolling_slots(bearing, par))
+    if p[P_F_STRIP]:
+        LAYOUT.fill(p, strip_slots(bearing))
     if lubricated:  # the oil at its temperature; the regime traction's constants (models/regime.py)
         LAYOUT.fill(p, {"ETA0": par_viscosity(bearing, par)})
         if p[LAYOUT.index("F_FTRAC")]:

@@ -502,6 +502,9 @@ def spatial_problem(bearing: Bearing, theta0: npt.ArrayLike, radius0: npt.ArrayL
     """
     if not (isinstance(strips, int) and 1 <= strips <= 101):
         raise P.ParameterError("strips", "must be a whole number in 1..101", strips)
+    if (kw.get("effects") or {}).get("strip_damping"):  # type: ignore[union-attr]
+        raise P.ParameterError("strip_damping", "the paper's strip formulation of C_ho is built into the planar "
+                               "model only: switch it off for the spatial model", True)
     flat = P.planar_problem(bearing, theta0, radius0, ring0, radial_load_n, **kw)  # type: ignore[arg-type]
     g = bearing.geometry
     z = g.n_balls

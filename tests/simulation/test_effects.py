@@ -93,7 +93,7 @@ def test_the_parameter_layout_comes_from_the_table():
 
 
 def test_every_effect_has_a_rule_and_physics():
-    assert len({e.name for e in EFFECTS}) == len(EFFECTS) == 12
+    assert len({e.name for e in EFFECTS}) == len(EFFECTS) == 13
     for e in EFFECTS:
         on, reason = e.rule(scene())
         assert isinstance(on, bool) and reason and e.physics
@@ -103,7 +103,7 @@ def test_simulate_explain_cli(capsys):
     assert main(["simulate", "--speed-rpm", "3000", "--radial-load-n", "500", "--axial-load-n", "400",
                  "--explain", "--json"]) == 0
     d = json.loads(capsys.readouterr().out)
-    assert d["level"] == "spatial" and len(d["effects"]) == 12
+    assert d["level"] == "spatial" and len(d["effects"]) == 13
     assert main(["simulate", "--speed-rpm", "3000", "--effect", "drag=maybe", "--explain"]) == 2
     assert "write NAME=on or NAME=off" in capsys.readouterr().err
     assert main(["simulate", "--speed-rpm", "3000", "--set", "cho_n_s=1"]) == 2
