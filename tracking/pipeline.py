@@ -41,6 +41,7 @@ from cageless.tracking.locate_motion import (DROPOUT_GAIN, frame_gains, holds_th
                                              plausible_band)
 from cageless.tracking.qc import QCReport, build_qc, slip_warnings, write_qc, write_selection_qc
 from cageless.tracking.select import SPEED_BAND, Selection, SelectionError, select_balls
+from cageless.tracking.position_bias import remove_place_bias
 
 __all__ = ["TrackOptions", "TrackResult", "track_video"]
 
@@ -500,6 +501,7 @@ def _finish(path: Path, video: FrameSource, table: pd.DataFrame, loc: BearingLoc
     roll = math.radians(conditions.camera_roll_deg or 0.0)
     angle, valid, direction, order = orbital_angles(table, orbit, roll, steady=options.window)
     times = video.times
+    angle, place = remove_place_bias(times, angle, valid, orbit.radius)
     try:
         angle, valid = robust_track_fit(times, angle, valid, options.track_fit)
     except ParameterError as exc:
@@ -515,6 +517,7 @@ def _finish(path: Path, video: FrameSource, table: pd.DataFrame, loc: BearingLoc
     slip = slip_rate(speed, omega_c)
     qc.warnings.extend(slip_warnings(angle, speed, slip, valid, omega_c, conditions.speed_rpm))
     qc.selection = selection or {}
+    qc.place_bias = place.to_dict()
     meta = video.metadata
     fps = meta.extra.get("fps_override") or meta.timestamp_fps or meta.header_fps or float("nan")
     trace = Trace(

@@ -72,6 +72,7 @@ class QCReport:
     warnings: list[str] = field(default_factory=list)
     overlays: list[str] = field(default_factory=list)
     selection: dict[str, Any] = field(default_factory=dict)
+    place_bias: dict[str, Any] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready summary."""

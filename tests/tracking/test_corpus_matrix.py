@@ -1,4 +1,4 @@
-"""Issue 14's bars on every clip of the independent corpus, both seed sets (tracking/synthetic/matrix.py).
+"""Issue 14's bars on every clip of the independent corpus, all three seed sets (tracking/synthetic/matrix.py).
 
 Bars (issue 14, "A corpus that does not flatter the tracker"): exactly Z balls, 0 identity swaps, angle
 RMS <= 0.5 mrad, speed RMS <= 0.5 % of the cage speed, slip-profile MAE <= 0.3 pp (scorer:
@@ -6,7 +6,8 @@ tracking/synthetic/score.py; a perfect highlight detector passes all of them on 
 test_corpus_renderer.py).
 
 CI runs the first block of 8 seeds of each set (each block covers every factor's range ends); the other
-clips and the long variants are ``slow`` (``--runslow``). Clips render once per session into
+clips and the long variants are ``slow`` (``--runslow``). The long variants are those of TUNING and HOLDOUT
+(FRESH's were not rendered). Clips render once per session into
 ``$CAGELESS_CORPUS_CACHE`` (default: a pytest temporary folder, each video deleted once scored) on two
 processes.
 
@@ -21,12 +22,13 @@ from pathlib import Path
 
 import pytest
 
-from cageless.tracking.synthetic.matrix import HOLDOUT, TUNING
+from cageless.tracking.synthetic.matrix import FRESH, HOLDOUT, TUNING
 from cageless.tracking.synthetic.runner import run_seeds
 from cageless.tracking.synthetic.score import BARS
 
-CI_SEEDS = (*TUNING[:8], *HOLDOUT[:8])
-ALL = [("TUNING", s) for s in TUNING] + [("HOLDOUT", s) for s in HOLDOUT]
+CI_SEEDS = (*TUNING[:8], *HOLDOUT[:8], *FRESH[:8])
+ALL = [("TUNING", s) for s in TUNING] + [("HOLDOUT", s) for s in HOLDOUT] + [("FRESH", s) for s in FRESH]
+ALL_LONG = [(name, s) for name, s in ALL if name != "FRESH"]
 
 #: Seeds today's tracker fails on the short clips, with how (benchmarks/tracking_corpus.py, 2026-11-23: the
 #: tracker of commit e3726da passed TUNING 4 of 32 and HOLDOUT 1 of 32; with the ball selection stage
@@ -63,14 +65,28 @@ ALL = [("TUNING", s) for s in TUNING] + [("HOLDOUT", s) for s in HOLDOUT]
 #: thresholds from the pixel noise (detect.pixel_noise; branch track-acc, commits 50d94af and dc7245f, reverted):
 #: TUNING 30, no clip failing anew (1011 0.643 mrad, speed 0.735 %; 1022 0.597 mrad), but HOLDOUT, run once, 27:
 #: 7022 failed (0.506 mrad, speed 0.545 %), 7004 speed 0.69 %, 7009 0.621, 7018 1.27, 7026 2.19 mrad.
+#: With the error tied to a place on the circle removed (tracking/position_bias.py; 2026-11-27): TUNING 30
+#: (1011 0.656 -> 0.573 mrad, speed 0.703 -> 0.664 %; 1022 0.553 -> 0.536 mrad; angle RMS 3.8 % lower, geometric
+#: mean). HOLDOUT, run once: 28 (7018 1.28 -> 0.811 mrad, 7026 2.18 -> 1.28 mrad and speed 1.71 -> 0.472 %, 7009
+#: 0.625 -> 0.618, 7004 speed 0.698 %). FRESH (seeds never run before), run once beside the tracker before the
+#: change: 24 against 23 (7111 passes, 0.616 -> 0.469 mrad; none fails anew; 3 clips refused by both, the ball
+#: selection finding 9, 17 and 12 of 16, 18 and 16 balls).
 #: Remove a seed when it passes.
 KNOWN_FAILURES: dict[int, str] = {
-    1011: "angle_rms 0.656 mrad > 0.5; speed_rms 0.703 % of cage speed > 0.5; slip_mae 0.476 pp > 0.3",
-    1022: "angle_rms 0.553 mrad > 0.5",
+    1011: "angle_rms 0.573 mrad > 0.5; speed_rms 0.664 % of cage speed > 0.5; slip_mae 0.44 pp > 0.3",
+    1022: "angle_rms 0.536 mrad > 0.5",
     7004: "speed_rms 0.698 % of cage speed > 0.5",
-    7009: "angle_rms 0.625 mrad > 0.5",
-    7018: "angle_rms 1.28 mrad > 0.5",
-    7026: "angle_rms 2.18 mrad > 0.5; speed_rms 1.71 % of cage speed > 0.5; slip_mae 0.381 pp > 0.3",
+    7009: "angle_rms 0.618 mrad > 0.5",
+    7018: "angle_rms 0.811 mrad > 0.5",
+    7026: "angle_rms 1.28 mrad > 0.5",
+    7110: "refused: found 9 balls moving together along one circle, but 16 are expected",
+    7112: "angle_rms 0.504 mrad > 0.5",
+    7116: "angle_rms 0.534 mrad > 0.5",
+    7117: "angle_rms 0.707 mrad > 0.5; speed_rms 0.641 % of cage speed > 0.5",
+    7118: "refused: found 17 balls moving together along one circle, but 18 are expected",
+    7123: "refused: found 12 balls moving together along one circle, but 16 are expected",
+    7124: "angle_rms 1.36 mrad > 0.5; speed_rms 0.71 % of cage speed > 0.5",
+    7134: "angle_rms 0.924 mrad > 0.5",
 }
 
 #: The same for the long variants (one cage revolution each), "" = passes: all 64 seeds measured with the tracker of
@@ -154,7 +170,7 @@ _REASON = "tracker not yet robust to this footage (issue 14)"
 def _params(long: bool = False) -> list:
     out = []
     known = KNOWN_FAILURES_LONG if long else KNOWN_FAILURES
-    for name, seed in ALL:
+    for name, seed in ALL_LONG if long else ALL:
         marks = []
         if long or seed not in CI_SEEDS:
             marks.append(pytest.mark.slow)
@@ -182,13 +198,13 @@ def corpus_results(request, corpus_dir):
 
 @pytest.fixture(scope="session")
 def corpus_results_long(corpus_dir):
-    return {r.seed: r for r in run_seeds([s for _, s in ALL], corpus_dir / "long", workers=2, long=True,
+    return {r.seed: r for r in run_seeds([s for _, s in ALL_LONG], corpus_dir / "long", workers=2, long=True,
                                          progress=False, keep=False)}
 
 
 def test_every_long_variant_has_a_measured_entry():
     """Every seed's long clip was run with a recent tracker (no entry carried over from an older baseline)."""
-    assert sorted(_LONG_MEASURED) == sorted(s for _, s in ALL)
+    assert sorted(_LONG_MEASURED) == sorted(s for _, s in ALL_LONG)
 
 
 def _assert_bars(result) -> None:

@@ -21,7 +21,7 @@ from cageless.units import rpm_to_rad_s
 from cageless.tracking.io import open_video
 from cageless.tracking.synthetic.appearance import draw_params
 from cageless.tracking.synthetic.corpus import clip_truth, render_clip, simulate_motion
-from cageless.tracking.synthetic.matrix import HOLDOUT, SETS, TUNING, coverage
+from cageless.tracking.synthetic.matrix import FRESH, HOLDOUT, SETS, TUNING, coverage
 from cageless.tracking.synthetic.scene3d import FrameState, SceneRenderer
 from cageless.tracking.synthetic.score import BARS, ideal_trace, score_trace, truth_arrays
 
@@ -139,6 +139,14 @@ def test_each_set_covers_every_factor(name):
 
 def test_sets_are_disjoint():
     assert not set(TUNING) & set(HOLDOUT)
+    assert not (set(TUNING) | set(HOLDOUT)) & set(FRESH)
+
+
+def test_each_set_is_whole_blocks():
+    """Each set is whole blocks of 8 seeds starting at a multiple of 8 (the Latin hypercube of appearance.py)."""
+    for seeds in SETS.values():
+        assert len(seeds) % 8 == 0 and all(s % 8 == 0 for s in seeds[::8])
+        assert list(seeds) == list(range(seeds[0], seeds[0] + len(seeds)))
 
 
 # -- the scorer ------------------------------------------------------------------------------------------
@@ -207,9 +215,9 @@ def test_noise_and_extra_balls_fail_the_bars(clip):
 
 def test_a_perfect_detector_meets_the_bars_on_every_clip():
     """Fairness of the corpus: true highlight positions, one circle fit and the tracker's speed filter pass
-    every bar with room to spare on all 64 clips (lens distortion is limited for this)."""
+    every bar with room to spare on all 96 clips (lens distortion is limited for this)."""
     worst = 0.0
-    for seed in (*TUNING, *HOLDOUT):
+    for seed in (*TUNING, *HOLDOUT, *FRESH):
         p, truth, _ = clip_truth(seed)
         s = score_trace(ideal_trace(p, truth), truth, p.bearing)
         assert s.passed, (seed, s.failures)
