@@ -19,7 +19,7 @@
   plus 17 us (planar) to 30 us (spatial) of Python and dense linear algebra;
 * ``"RK45"``, ``"DOP853"``, ``"LSODA"``, ``"BDF"``, ``"Radau"``: scipy's ``solve_ivp`` steppers on the
   same compiled right-hand side, as references; the implicit ones get the structured Jacobian too;
-* ``"auto"``: compiled DP5 switching to CVODE where that pays (:mod:`cageless.simulation.auto_switch`).
+* ``"auto"``: compiled DP5 switching to CVODE or ``ark4`` where that pays (:mod:`cageless.simulation.auto_switch`).
 
 CVODE and scipy's steppers are stepped one accepted step at a time here, so the accepted-step
 bookkeeping (contact episodes) runs after every step as it does in the compiled loop. They cannot
