@@ -158,15 +158,11 @@ def _rosw_blocks(pr: Problem, ring_implicit: bool = True,
 ROSW_ATOL_FACTOR = 1e-2
 
 
-#: ark4's absolute tolerance on the speeds it integrates implicitly (each ball's radial, and at the spatial level
-#: axial, speed: :func:`cageless.simulation.kernels.implicit_speed_rows`), as a factor on the problem's. Its error
-#: test is set by those rows (a loaded ball's radial speed leads the filtered estimate in every accepted step),
-#: whose estimate grows only as h^1.3 from 10 to 40 us (the stiff normal modes' order reduction), while the
-#: L-stable implicit table damps the error itself. Over 5 ms at 3000 rpm, 500 N (planar, settled; the tight DP5
-#: reference of benchmarks/ark_speed.py): right-hand sides 1639 -> 1273 at x10, slip error 0.0019 -> 0.0026 pp,
-#: energy drift 1.2e-8 -> 4.7e-8 of the input work; x100 took no fewer (1267). At the spatial level (500 N +
-#: 400 N axial) 1057 -> 1009 at 0.0010 -> 0.0027 pp. A factor of 10 on every row instead: planar 1207 at
-#: 0.0025 pp, but spatial 0.011 pp, past the 0.01 pp the solvers are held to.
+#: ark4's absolute tolerance on the speeds it integrates implicitly
+#: (:func:`cageless.simulation.kernels.implicit_speed_rows`) as a factor on the problem's: their filtered error
+#: estimate sets its steps, though the L-stable implicit table damps the error itself (docs/imex.md: planar
+#: 3000 rpm, 500 N, 1639 -> 1273 right-hand sides per 5 ms at x10, slip error 0.0019 -> 0.0026 pp; x10 on every
+#: row took the spatial case past 0.01 pp).
 ARK_SPEED_ATOL_FACTOR = 10.0
 
 

@@ -106,8 +106,7 @@ def ark_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_st
                 out[k:, :] = y
             status = stop
             break
-        if h_onset > 0.0 and t_cross <= t and h > 3.0 * h_onset:
-            h, t_cross = _onset_ahead(model_id, p, t, h, y, f[0], h_onset, g0, g1, yt)
+        h, t_cross = _onset_ahead(model_id, p, t, h, y, f[0], h_onset, t_cross, g0, g1, yt)
         _ark_stages(model_id, t, h, y, p, log, f, ki, yt, ynew, work)
         model_rhs(model_id, t + h, ynew, p, log, f_end)
         cnt[_RHS] += 6
@@ -226,12 +225,15 @@ def _onset_retry(model_id, p, t, h, y, ynew, f0, f1, h_onset, g0, g1, yt):  # pr
 
 
 @numba.njit(cache=True, inline="always")
-def _onset_ahead(model_id, p, t, h, y, f0, h_onset, g0, g1, yt):  # pragma: no cover - compiled
+def _onset_ahead(model_id, p, t, h, y, f0, h_onset, t_cross, g0, g1, yt):  # pragma: no cover - compiled
     """A step of length ``h`` shortened to end half an onset step before a contact change predicted inside it
     (the gaps at y and at the Euler predictor y + h f0, the earliest sign change of the straight line between
-    them), with the change's time for the loop's ``t_cross``; ``(h, -inf)`` when none is predicted (or one
+    them), with the change's time for the loop's ``t_cross``; ``(h, t_cross)`` unchanged when a change is
+    already located ahead or the step is within three onset steps, ``(h, -inf)`` when none is predicted (or one
     within two onset steps of the start, which the onset control handles). Without it every contact change
     cost a refused step first."""
+    if h_onset <= 0.0 or t_cross > t or h <= 3.0 * h_onset:
+        return h, t_cross
     for i in range(y.shape[0]):
         yt[i] = y[i] + h * f0[i]
     model_gaps(model_id, y, p, g0)

@@ -195,7 +195,8 @@ def test_spatial_newton_jacobian_matches_difference_quotients(settled_spatial):
     of the forces themselves (1e-9 m/s), along (r', r theta', x') with the position fixed (the filter's K_v), moving
     with the velocity (hr = 1, the filter's K_v + K_x) and at a stage (hr = 5 us): within 1e-4 of the largest entry
     (2.5e-5 measured: the quotients' rounding, two race forces of hundreds of newtons cancelling to about one;
-    without the damping's change through the tilting ring's surface motion it was 5.8e-3). Then the stage equation of every ball is solved to the Newton tolerance."""
+    without the damping's change through the tilting ring's surface motion it was 5.8e-3). Then the stage equation
+    of every ball is solved to the Newton tolerance."""
     from cageless.simulation.models import implicit_normal_spatial as sp
     from cageless.simulation.models.implicit_normal import TOL_V
 
