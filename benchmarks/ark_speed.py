@@ -7,7 +7,8 @@ The cases, the tight reference (DP5, rtol 1e-10, 0.25 us cap), the error measure
 samples in percentage points of the cage speed; the first 2 ms of the 20 ms runs from the start, which
 are chaotic after that; the energy balance's drift over the input work) and the interleaved best-of-N
 timing (CPU seconds of the process per simulated second; the machine is shared) are those of
-``benchmarks/solver_speed.py``, which this runs with the ``ark4`` rows. Ratios are to the first candidate
+``benchmarks/solver_speed.py``, which this runs with the ``ark4`` rows (``auto-cvode``: the switch before ark4 was one
+of its backends). Ratios are to the first candidate
 (``auto``) in the same run. Before the table it prints, for the settled planar case, the fastest modes of the
 Jacobian of the whole right-hand side and of its explicit part (the whole minus the implicit race normal
 forces and radial kinematics of :mod:`cageless.simulation.models.implicit_normal`), which set DP5's and

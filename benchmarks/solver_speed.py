@@ -14,7 +14,9 @@ Cases (every effect of a lubricated scene):
 
 ``--candidates`` picks rows by key (:data:`CANDIDATES`); ``auto-before`` is the automatic switch as it was
 before it probed from the start (no pilot, probes at chunks 5 and 20, a way back for good, the earlier cost
-figures: :data:`cageless.simulation.auto_switch.RHS_COST_US_BEFORE`), run in the same process.
+figures: :data:`cageless.simulation.auto_switch.RHS_COST_US_BEFORE`), and ``auto-cvode`` as it was before it
+probed ``ark4`` beside CVODE (:data:`cageless.simulation.auto_switch.STIFF_METHODS`), both run in the same
+process.
 
 The settled cases measure the slip error as ``cageless bench accuracy`` does (largest difference of the
 balls' orbital speed over all balls and samples, in percentage points of the cage speed) against a DP5
@@ -58,6 +60,7 @@ log = logging.getLogger("solver_speed")
 CANDIDATES = {
     "auto": ("auto (today's default)", "auto", 1e-6, None),
     "auto-before": ("auto before (probes at chunks 5, 20)", "auto-before", 1e-6, None),
+    "auto-cvode": ("auto, CVODE the only stiff backend (before ark4 was one)", "auto-cvode", 1e-6, None),
     "dp5": ("dp5, rtol 1e-6, cap 2 us", "dp5", 1e-6, 2e-6),
     "CVODE": ("CVODE throughout (rtol 3e-8, cap 5 us)", "CVODE", 1e-6, None),
     "rosw6": ("rosw, rtol 1e-6 (cap 10 us)", "rosw", 1e-6, None),
@@ -82,6 +85,17 @@ def _switch_before():  # noqa: ANN202
     finally:
         (switch.PROBE_CHUNKS, switch.PROBE_BACKOFF, switch.RHS_COST_US, switch.STEP_COST_US,
          switch.SWITCH_GAIN, switch.PILOT_FRACTION) = saved
+
+
+@contextmanager
+def _cvode_only():  # noqa: ANN202
+    """The automatic switch with CVODE as its only stiff backend, as it was before ark4 became a candidate."""
+    saved = switch.STIFF_METHODS
+    switch.STIFF_METHODS = ("CVODE",)
+    try:
+        yield
+    finally:
+        switch.STIFF_METHODS = saved
 
 
 def _from_start(rpm: float, load_n: float, axial_n: float = 0.0, level: str | None = None):  # noqa: ANN202
@@ -109,7 +123,10 @@ def _cases(window: float, names: list[str], duration: float = 0.03) -> dict[str,
 def _run(pr: Any, t: np.ndarray, method: str, rtol: float, cap: float | None) -> Any:
     kw = {} if cap is None else {"max_step": cap}
     if method == "auto-before":
-        with _switch_before():
+        with _switch_before(), _cvode_only():
+            return solve(pr, t, method="auto", rtol=rtol)
+    if method == "auto-cvode":
+        with _cvode_only():
             return solve(pr, t, method="auto", rtol=rtol)
     if method == "auto" and cap is None:
         return solve(pr, t, method="auto", rtol=rtol)

@@ -5,10 +5,16 @@ kept, internal steps not). With ``method="auto"`` it starts with the compiled DP
 stiffness test (:func:`cageless.simulation.integrators.dp5.dp5_integrate`, Hairer & Wanner's h |lambda| > 3.25).
 When most steps of a chunk sit at the stability edge (fraction >= :data:`STIFF_FRACTION`), the
 step is set by stiffness rather than accuracy, as the paper's "Adams-GSTIFF" scheme switches to its
-stiff branch once contacts stiffen. The driver then probes the stiff backend,
-SUNDIALS CVODE's variable-order BDF (:data:`STIFF_METHOD`), on the same chunk from the same state, and
-switches if its cost is clearly smaller. The probe's result is discarded, so the trajectory up to the
-switch is DP5's. The first probe runs on the first chunk (:data:`PROBE_CHUNKS`); a probe that does not
+stiff branch once contacts stiffen. The driver then probes the stiff backends (:data:`STIFF_METHODS`),
+SUNDIALS CVODE's variable-order BDF and, at the planar level (:data:`ARK_MODELS`), the compiled IMEX method
+``ark4``, on the same chunk from the same state, and switches to the cheaper if its cost is clearly smaller
+than DP5's (``ark4`` over CVODE only when clearly smaller than CVODE's too). The probes' results are
+discarded, so the trajectory up to the switch is DP5's. ``ark4`` pays past the start-up at ordinary loads
+(2.6-2.8 times cheaper than CVODE by the cost model in the default 3000 rpm, 500 N scene), but its explicit
+part keeps the spin modes against the traction slope, which under 20 kN hold its step near 57 ns (20 times
+CVODE's cost): its probe has a step budget (:func:`_ark_budget`), the steps that the cost it must beat would
+buy it, and a probe that runs out of it stops there and does not switch.
+The first probe runs on the first chunk (:data:`PROBE_CHUNKS`); a probe that does not
 switch makes the next one wait twice as many chunks as the last (:data:`PROBE_BACKOFF`: 1, 2, 4, ...), so
 a run where CVODE never pays spends a handful of chunks on probes, and one where it pays once the violent
 start is over (a BDF restarting from order 1 costs 2-2.7 times DP5 over the first 1.2 ms of a 30 ms run at
@@ -17,10 +23,11 @@ start is over (a BDF restarting from order 1 costs 2-2.7 times DP5 over the firs
 
 The decision must not depend on timing, or the same scene would give different traces on a busy
 machine (the determinism rule of the project). It compares a cost model instead: each solver's
-right-hand-side evaluations times the model's cost per evaluation (:data:`RHS_COST_US`) plus its steps
-times the method's Python overhead per step (:data:`STEP_COST_US`), constants measured on this
-project's scenes, and switches when the stiff backend's cost is below :data:`SWITCH_GAIN` of DP5's.
-Each probe and switch is recorded in the solution (``extra["switches"]``) and from there in the
+right-hand-side evaluations times the model's cost per evaluation (:data:`RHS_COST_US`) plus its trial steps
+(accepted and rejected, where the method counts them) times the method's overhead per step
+(:data:`STEP_COST_US`), constants measured on this project's scenes, and switches when the cheaper stiff
+backend's cost is below :data:`SWITCH_GAIN` of DP5's. Each probe and switch is recorded in the solution
+(``extra["switches"]``: the backend chosen, its cost ratio and every candidate's) and from there in the
 trace's solver statistics.
 
 A probe sees one chunk only. After a switch, the stiff backend's mean cost per simulated second over
@@ -55,7 +62,7 @@ from cageless.simulation.problem import Problem
 from cageless.simulation.solve import CvodeSession, Solution, solve, step_cvode
 
 __all__ = ["solve_chunks", "default_max_step", "CONTACT_MAX_STEP_S", "MAX_STEP_S", "RTOL_FACTOR", "STIFF_FRACTION",
-           "RHS_COST_US", "STEP_COST_US", "SWITCH_GAIN", "STIFF_METHOD", "PROBE_CHUNKS",
+           "RHS_COST_US", "STEP_COST_US", "SWITCH_GAIN", "STIFF_METHODS", "ARK_MODELS", "PROBE_CHUNKS",
            "BACK_WINDOW", "SWITCH_WHEN_DRY", "PROBE_BACKOFF", "PILOT_FRACTION"]
 
 #: The progress bar shows simulated seconds without tqdm's rate, which for a simulation slower than real
@@ -66,8 +73,13 @@ _BAR_FORMAT = "{desc}: {percentage:3.0f}%|{bar}| {n:.4g}/{total:.4g} s [{elapsed
 #: at 3000 rpm: the default 500 N scene 0.82 (the race damping), R = 0 0.74, a 20 kN load 0.99; only the
 #: first milliseconds after the start, while the balls spread, fall below it.
 STIFF_FRACTION = 0.6
-#: The stiff backend the switch goes to.
-STIFF_METHOD = "CVODE"
+#: The stiff backends the switch probes, in order: a later one is chosen over an earlier only when clearly cheaper
+#: (see :func:`_probe`).
+STIFF_METHODS: tuple[str, ...] = ("CVODE", "ark4")
+#: The models on which ``ark4`` is probed. Not the spatial one: there the switch took the spatial hard cases to
+#: ark4 after 1.6-2 ms, and over 20 ms it refused 21 % (500 N axial only) and 14 % (1 mrad tilt) of its steps,
+#: above the 10 % the hard cases allow (tests/validation/test_spatial.py; with CVODE 1.3 % and below).
+ARK_MODELS: frozenset[int] = frozenset({PLANAR})
 #: Cost of one right-hand-side evaluation by model id (us), the compiled DP5 loop's own work included (its
 #: step overhead is spread over its six evaluations a step). Measured as the process's CPU time over
 #: evaluations, chunk by chunk, over 30 ms from the start of six lubricated scenes (3000 rpm 500 N, 1800 rpm,
@@ -83,9 +95,13 @@ RHS_COST_US: dict[int, float] = {PLANAR: 4.1, SPATIAL: 8.9}
 #: scenes (modelled 0.03, 0.72, 0.27, 0.66, 0.51, 0.50; CPU 0.03, 0.73, 0.27, 0.66, 0.46, 0.44). scipy's LSODA
 #: ~21 (its Python step loop; measured against the earlier figures below). The compiled DP5 0.
 #: Pairs without an entry count 30.
+#: The IMEX method ``ark4`` counts six right-hand sides a trial step; beyond them a trial runs five implicit
+#: stages, the error filter and the implicit part at its end: 1.9 + 0.89 + 0.60 us planar against 4.4 us a
+#: right-hand side, 6.1 + 2.7 + 1.3 us spatial against 11.7 (CPU time per call at the settled 3000 rpm, 500 N
+#: state, in one process), i.e. 0.40 and 0.50 of its six right-hand sides: 9.8 and 27 us at the costs above.
 STEP_COST_US: dict[tuple[str, int], float] = {
     ("CVODE", PLANAR): 22.0, ("CVODE", SPATIAL): 34.0, ("LSODA", PLANAR): 21.0, ("LSODA", SPATIAL): 21.0,
-    ("dp5", PLANAR): 0.0, ("dp5", SPATIAL): 0.0,
+    ("dp5", PLANAR): 0.0, ("dp5", SPATIAL): 0.0, ("ark4", PLANAR): 9.8, ("ark4", SPATIAL): 27.0,
 }
 #: The figures the switch used before, from wall time over 5 ms settled windows on a quieter machine and
 #: before the rolling losses and drag made each evaluation dearer: they put DP5's evaluation at 1.8 us
@@ -149,16 +165,43 @@ PROBE_BACKOFF: int | None = 2
 
 def _cost(sol: Solution, model_id: int) -> float:
     """Modelled cost of a solve in us (see :data:`RHS_COST_US` and :data:`STEP_COST_US`)."""
-    return sol.n_rhs * RHS_COST_US.get(model_id, 1.0) + sol.n_steps * STEP_COST_US.get((sol.method, model_id), 30.0)
+    trials = sol.n_steps + sol.n_rejected  # CVODE's and scipy's rejections are not counted (0)
+    return sol.n_rhs * RHS_COST_US.get(model_id, 1.0) + trials * STEP_COST_US.get((sol.method, model_id), 30.0)
+
+
+def _ark_budget(target_cost: float, model_id: int) -> int:
+    """The trial steps of an ``ark4`` probe that together cost ``target_cost`` (six right-hand sides and
+    :data:`STEP_COST_US` each): past them it cannot win, and it stops."""
+    per_trial = 6 * RHS_COST_US.get(model_id, 1.0) + STEP_COST_US.get(("ark4", model_id), 30.0)
+    return max(1, int(target_cost / per_trial))
 
 
 def _probe(part: Problem, t: npt.NDArray[np.float64], sol: Solution, time_s: float,
            kw: dict[str, Any]) -> dict[str, Any]:
-    """Run the stiff backend over the chunk ``sol`` covered and say whether it pays."""
-    trial = solve(part, t, method=STIFF_METHOD, **_settings(STIFF_METHOD, kw))
-    ratio = _cost(trial, part.model_id) / max(_cost(sol, part.model_id), 1.0)
-    return {"time_s": time_s, "stiff_fraction": sol.n_stiff_steps / max(sol.n_steps, 1), "cost_ratio": ratio,
-            "switch": bool(trial.success and ratio < SWITCH_GAIN), "to": STIFF_METHOD, "wall_s": trial.wall_s}
+    """Run each stiff backend (:data:`STIFF_METHODS`, in order) over the chunk ``sol`` covered and say whether
+    the chosen one pays. A later backend replaces the one chosen so far only when it costs below
+    :data:`SWITCH_GAIN` of it, as a switch from DP5 needs: the cost model is off by up to 0.06 of the ratio, and
+    on near ties (1800 rpm bunching: CVODE 0.48, ark4 0.45 of DP5) the run keeps CVODE, as before ark4 was a
+    candidate. An ``ark4`` probe stops at the step budget of that bar (:func:`_ark_budget`) and then counts as
+    inf. The record names the choice (``to``), its cost ratio to DP5 and every candidate's (``costs``)."""
+    dp5_cost = max(_cost(sol, part.model_id), 1.0)
+    costs: dict[str, float] = {}
+    best, wall = STIFF_METHODS[0], 0.0
+    for method in STIFF_METHODS:
+        if method == "ark4" and part.model_id not in ARK_MODELS:
+            continue
+        settings = _settings(method, kw)
+        incumbent = costs.get(best, np.inf)  # what the method must beat: the choice so far if it pays, else DP5
+        bar = SWITCH_GAIN * (incumbent if incumbent < SWITCH_GAIN else 1.0) * dp5_cost
+        if method == "ark4":
+            settings["max_steps"] = min(settings["max_steps"], _ark_budget(bar, part.model_id))
+        trial = solve(part, t, method=method, **settings)
+        wall += trial.wall_s
+        costs[method] = _cost(trial, part.model_id) / dp5_cost if trial.success else np.inf
+        if method != best and costs[method] * dp5_cost < bar:
+            best = method
+    return {"time_s": time_s, "stiff_fraction": sol.n_stiff_steps / max(sol.n_steps, 1), "cost_ratio": costs[best],
+            "switch": bool(costs[best] < SWITCH_GAIN), "to": best, "costs": costs, "wall_s": wall}
 
 
 def _pilot(pr: Problem, t_first: float, kw: dict[str, Any]) -> dict[str, Any] | None:
@@ -266,7 +309,7 @@ def _begin(pr: Problem, t: npt.NDArray[np.float64], edges: npt.NDArray[np.int64]
         return "dp5", np.inf, 0.0, []
     rate = pilot.pop("dp5_rate")
     if pilot["switch"]:
-        return STIFF_METHOD, rate, pilot["wall_s"], [pilot]
+        return pilot["to"], rate, pilot["wall_s"], [pilot]
     return "dp5", np.inf, pilot["wall_s"], [pilot]
 
 
@@ -303,7 +346,7 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
             if not sol.success:
                 break
             rate = _cost(sol, pr.model_id) / float(t[b] - t[a])
-            if auto and current == STIFF_METHOD:
+            if auto and current != "dp5":
                 stiff_rates.append(rate)
                 back = _go_back(stiff_rates, dp5_rate, float(t[b]))
                 if back is not None:
@@ -315,7 +358,7 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
                     probes.append(_probe(part, t[a + 1:b + 1], sol, float(t[b]), kw))
                     wall += probes[-1]["wall_s"]
                     if probes[-1]["switch"]:
-                        current, dp5_rate = STIFF_METHOD, rate
+                        current, dp5_rate, warm = probes[-1]["to"], rate, None
                     else:
                         schedule.wait_longer(i)
                 else:

@@ -13,7 +13,8 @@ from cageless.simulation.models import (implicit_normal, implicit_normal_spatial
                                         two_balls)
 
 __all__ = ["PLANAR", "SPATIAL", "TWO_BALLS", "OSCILLATOR", "RICCATI", "DAMPED", "model_rhs", "model_post",
-           "model_signature", "model_ring_share", "model_gaps", "model_implicit", "model_filter_error"]
+           "model_signature", "model_ring_share", "model_gaps", "model_implicit", "model_filter_error",
+           "implicit_speed_rows"]
 
 PLANAR, TWO_BALLS, SPATIAL = planar.MODEL_ID, two_balls.MODEL_ID, spatial.MODEL_ID
 OSCILLATOR, RICCATI, DAMPED = textbook.OSCILLATOR, textbook.RICCATI, textbook.DAMPED
@@ -91,6 +92,17 @@ def model_implicit(model_id, t, y, p, hg, k_i, work):  # pragma: no cover - comp
     else:
         for i in range(k_i.shape[0]):
             k_i[i] = 0.0
+
+
+def implicit_speed_rows(model_id: int, n_balls: int) -> list[int]:
+    """The state rows of the speeds that :func:`model_implicit` integrates implicitly with the race normal
+    forces: each ball's radial speed r' (planar), and its axial speed x' (spatial); none for other models."""
+    z = n_balls
+    if model_id == PLANAR:
+        return list(range(2 * z, 3 * z))
+    if model_id == SPATIAL:
+        return list(range(2 * z, 3 * z)) + list(range(6 * z + 6, 7 * z + 6))
+    return []
 
 
 @numba.njit(cache=True)

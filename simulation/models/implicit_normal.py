@@ -30,15 +30,33 @@ from __future__ import annotations
 import math
 
 import numba
+import numpy as np
 
 from cageless.simulation.models import base as B
 
-__all__ = ["planar_implicit_normal", "planar_filter_error", "TOL_V", "MAX_NEWTON"]
+__all__ = ["planar_implicit_normal", "planar_filter_error", "converged", "TOL_V", "MAX_NEWTON"]
 
-#: Newton's stopping test on the update of r' and r theta' (m/s): 1e-4 of the radial speeds' absolute tolerance.
+#: Newton's tolerance on the distance of r' and r theta' from the solution (m/s): 1e-4 of the radial speeds'
+#: absolute tolerance.
 TOL_V = 1e-11
 #: Newton iterations per ball and stage at most (the residual contracts by ~1e-3 per iteration when settled).
 MAX_NEWTON = 12
+
+
+@numba.njit(cache=True, inline="always")
+def converged(step, last):  # pragma: no cover - compiled
+    """Newton's stopping test after an update of size ``step`` (the one before: ``last``, inf at the first):
+    the update itself within :data:`TOL_V`, or, from the contraction theta = step / last, the distance left to
+    the solution, theta / (1 - theta) step (Hairer & Wanner, Solving ODEs II, sect. IV.8, eq. 8.10-8.11).
+    Newton's method converges quadratically here (updates 1e-4, 6e-10, 1e-14 m/s per ball at a 30 us step,
+    3000 rpm, 500 N, settled), so the second update already shows the third to be below the tolerance: two
+    force evaluations per ball and stage instead of three."""
+    if step <= TOL_V:
+        return True
+    if not np.isfinite(last):
+        return False
+    theta = step / last
+    return theta < 1.0 and theta / (1.0 - theta) * step <= TOL_V
 
 
 @numba.njit(cache=True, inline="always")
@@ -83,6 +101,7 @@ def _ball_stage(r_z, rd_z, thd_z, c, s, ring, p, hg):  # pragma: no cover - comp
     m = p[B.P_M]
     rd, thd = rd_z, thd_z
     r = r_z + hg * rd
+    last = np.inf
     for _ in range(MAX_NEWTON):
         fr, ft, a, b, cc, d = _forces(r, rd, thd, c, s, ring, p, hg)
         g1 = rd - rd_z - hg * fr / m
@@ -95,8 +114,10 @@ def _ball_stage(r_z, rd_z, thd_z, c, s, ring, p, hg):  # pragma: no cover - comp
         rd -= drd
         thd -= dth
         r = r_z + hg * rd
-        if abs(drd) <= TOL_V and abs(dth) * r <= TOL_V:
+        step = max(abs(drd), abs(dth) * r)
+        if converged(step, last):
             break
+        last = step
     return r, rd, thd
 
 
