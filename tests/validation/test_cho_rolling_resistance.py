@@ -19,23 +19,21 @@ Closed forms (our derivations, which the numerical solution must meet):
 
 from __future__ import annotations
 
-import importlib
 import math
 import sys
 from pathlib import Path
 
 import pytest
 
-BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
+sys.path.insert(0, str(Path(__file__).parent))
+from effect_helpers import benchmark_module  # noqa: E402
+
 
 
 @pytest.fixture(scope="module")
 def mod():
-    sys.path.insert(0, str(BENCHMARKS))
-    try:
-        yield importlib.import_module("cho_rolling_resistance")
-    finally:
-        sys.path.remove(str(BENCHMARKS))
+    with benchmark_module("cho_rolling_resistance") as module:
+        yield module
 
 
 # an arbitrary contact: 1 N on a 0.1 mm x 20 um ellipse at 0.1 um approach, rolling at 1 m/s

@@ -21,7 +21,6 @@ Closed forms (our derivations, from those lines and the Hertz pressure, whose li
 
 from __future__ import annotations
 
-import importlib
 import math
 import sys
 from pathlib import Path
@@ -29,16 +28,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
+sys.path.insert(0, str(Path(__file__).parent))
+from effect_helpers import benchmark_module  # noqa: E402
+
 
 
 @pytest.fixture(scope="module")
 def mod():
-    sys.path.insert(0, str(BENCHMARKS))
-    try:
-        yield importlib.import_module("paper_strip_damping")
-    finally:
-        sys.path.remove(str(BENCHMARKS))
+    with benchmark_module("paper_strip_damping") as module:
+        yield module
 
 
 @pytest.fixture(scope="module")

@@ -14,7 +14,6 @@ damper's.
 
 from __future__ import annotations
 
-import importlib
 import math
 import sys
 from pathlib import Path
@@ -33,19 +32,15 @@ from cageless.simulation.scene import Scene
 from cageless.simulation.solve import solve
 
 sys.path.insert(0, str(Path(__file__).parent))
-from effect_helpers import effect_contribution  # noqa: E402
+from effect_helpers import benchmark_module, effect_contribution  # noqa: E402
 
-BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
 ON = {"race_contact": True, "lubricant_damping": True, "strip_damping": True}
 
 
 @pytest.fixture(scope="module")
 def hand():
-    sys.path.insert(0, str(BENCHMARKS))
-    try:
-        yield importlib.import_module("paper_strip_damping")
-    finally:
-        sys.path.remove(str(BENCHMARKS))
+    with benchmark_module("paper_strip_damping") as module:
+        yield module
 
 
 def _problem(effects=ON):
