@@ -11,6 +11,7 @@ changes an open model parameter (:class:`cageless.simulation.parameters.ModelPar
 from __future__ import annotations
 
 import argparse
+import re
 from typing import Any
 
 from cageless.app.cli.common import add_parameter_set_option, finite_float
@@ -239,7 +240,8 @@ def _summary_line(trace: Any, sol: Any, out: str) -> str:
     else:  # a start-up transient's peak is not a slip anyone should quote
         slip = (f"no settled slip: the run is within the {1e3 * startup:.0f} ms start-up that compare and report "
                 f"leave out (simulate at least --duration {startup + 0.1:.2g})")
-    compiled_only = sol.method in ("dp5", "auto: dp5", "ark4", "rosw")  # the compiled methods count their own
+    # the compiled methods count their own rejections; CVODE and scipy's do not report theirs
+    compiled_only = not re.search(r"CVODE|RK45|DOP853|LSODA|BDF|Radau", sol.method)
     by, uncounted = ("", "") if compiled_only else (" by DP5", "; CVODE's and scipy's own rejections are not counted")
     return (f"{trace.status} ({sol.method}): {sol.n_steps} steps, {sol.n_rejected} rejected{by} "
             f"({sol.n_onset_retries} at contact onsets, {sol.n_force_jump_retries} at force jumps; "
