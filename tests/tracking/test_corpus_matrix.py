@@ -95,8 +95,8 @@ KNOWN_FAILURES: dict[int, str] = {
 #: HOLDOUT 21, with 7010 and 7021 refused). 1012 and 1014 re-measured with commit 1b9ce63 (each frame's own centre,
 #: lint subtracted): both pass (1012 angle 0.279 mrad, speed 0.357 %; 1014 angle 0.283 mrad, speed 0.065 %);
 #: with commit 4946aa3, 7008 passes (0.561 -> 0.436 mrad) and 1000, 1023 still pass (0.366, 0.186 mrad);
-#: the others not re-measured with these changes. The seven known failures re-measured with the place-bound error
-#: removed (tracking/position_bias.py, merge 304fdd1; 2026-11-27): all still fail, the reasons below are those runs.
+#: all 64 re-measured with the place-bound error removed (tracking/position_bias.py, merge 304fdd1; 2026-11-27): the
+#: 57 marked "" pass, the seven known failures still fail, and the reasons below are those runs.
 _LONG_MEASURED: dict[int, str] = {
     1000: "",
     1001: "",
