@@ -29,7 +29,8 @@ import numpy as np
 from cageless.tracking.io.base import FrameSource
 from cageless.tracking.locate import BearingLocation, _to_u8, fit_circle
 
-__all__ = ["motion_map", "moving_pixels", "frame_gains", "frame_level", "DROPOUT_GAIN", "locate_by_motion", "plausible_band", "holds_the_motion"]
+__all__ = ["motion_map", "moving_pixels", "frame_gains", "frame_level", "DROPOUT_GAIN", "locate_by_motion",
+           "plausible_band", "holds_the_motion"]
 
 log = logging.getLogger(__name__)
 
