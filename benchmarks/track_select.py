@@ -25,7 +25,7 @@ from cageless.conditions import OperatingConditions
 from cageless.tracking.io import open_video
 from cageless.tracking.link import track_frames
 from cageless.tracking.locate import background_frame, locate_bearing
-from cageless.tracking.pipeline import TrackOptions, _CroppedFrames, _setup
+from cageless.tracking.pipeline import SELECT_K_SIGMA, TrackOptions, _CroppedFrames, _setup
 
 
 def main() -> None:
@@ -41,7 +41,8 @@ def main() -> None:
         rows, cols = loc.crop(video.frame_shape)
         frames = _CroppedFrames(video, rows, cols, options.chunk)
         t0 = time.perf_counter()
-        setup, sel = _setup(video, loc, bg, bearing, options, frames, OperatingConditions(args.speed_rpm), args.clip)
+        setup, sel = _setup(video, loc, bg, bearing, options, frames, OperatingConditions(args.speed_rpm), args.clip,
+                            SELECT_K_SIGMA[0])
         t_select = time.perf_counter() - t0
         plain = dataclasses.replace(setup, ring=None, anchors=())
         times = video.times

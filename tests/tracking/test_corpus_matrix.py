@@ -1,4 +1,4 @@
-"""Issue 14's bars on every clip of the independent corpus, all three seed sets (tracking/synthetic/matrix.py).
+"""Issue 14's bars on every clip of the independent corpus, all four seed sets (tracking/synthetic/matrix.py).
 
 Bars (issue 14, "A corpus that does not flatter the tracker"): exactly Z balls, 0 identity swaps, angle
 RMS <= 0.5 mrad, speed RMS <= 0.5 % of the cage speed, slip-profile MAE <= 0.3 pp (scorer:
@@ -7,7 +7,7 @@ test_corpus_renderer.py).
 
 CI runs the first block of 8 seeds of each set (each block covers every factor's range ends); the other
 clips and the long variants are ``slow`` (``--runslow``). The long variants are those of TUNING and HOLDOUT
-(FRESH's were not rendered). Clips render once per session into
+(FRESH's and FRESH2's were not rendered). Clips render once per session into
 ``$CAGELESS_CORPUS_CACHE`` (default: a pytest temporary folder, each video deleted once scored) on two
 processes.
 
@@ -22,13 +22,14 @@ from pathlib import Path
 
 import pytest
 
-from cageless.tracking.synthetic.matrix import FRESH, HOLDOUT, TUNING
+from cageless.tracking.synthetic.matrix import FRESH, FRESH2, HOLDOUT, TUNING
 from cageless.tracking.synthetic.runner import run_seeds
 from cageless.tracking.synthetic.score import BARS
 
-CI_SEEDS = (*TUNING[:8], *HOLDOUT[:8], *FRESH[:8])
-ALL = [("TUNING", s) for s in TUNING] + [("HOLDOUT", s) for s in HOLDOUT] + [("FRESH", s) for s in FRESH]
-ALL_LONG = [(name, s) for name, s in ALL if name != "FRESH"]
+CI_SEEDS = (*TUNING[:8], *HOLDOUT[:8], *FRESH[:8], *FRESH2[:8])
+ALL = ([("TUNING", s) for s in TUNING] + [("HOLDOUT", s) for s in HOLDOUT] + [("FRESH", s) for s in FRESH]
+       + [("FRESH2", s) for s in FRESH2])
+ALL_LONG = [(name, s) for name, s in ALL if name in ("TUNING", "HOLDOUT")]
 
 #: Seeds today's tracker fails on the short clips, with how (benchmarks/tracking_corpus.py, 2026-11-23: the
 #: tracker of commit e3726da passed TUNING 4 of 32 and HOLDOUT 1 of 32; with the ball selection stage
@@ -71,22 +72,35 @@ ALL_LONG = [(name, s) for name, s in ALL if name != "FRESH"]
 #: 0.625 -> 0.618, 7004 speed 0.698 %). FRESH (seeds never run before), run once beside the tracker before the
 #: change: 24 against 23 (7111 passes, 0.616 -> 0.469 mrad; none fails anew; 3 clips refused by both, the ball
 #: selection finding 9, 17 and 12 of 16, 18 and 16 balls).
+#: With a small bearing located in a wide frame (the faces and the motion re-thresholded on the full stretch when the
+#: usual one finds no ring or splits the still pixels' noise) and the ball selection retried from 3-sigma candidates
+#: when 4 sigma shows fewer than Z balls (2026-11-27; all four sets run once with the final change, the tree before
+#: it beside it, tracked and scored as tracking/synthetic/runner.py does, without the oracle): TUNING 30 -> 30 (1011
+#: 0.573 -> 0.592 mrad; 1029, located from the faces instead of the motion, 0.121 -> 0.448 mrad), HOLDOUT 28 -> 28
+#: (7018 0.811 -> 0.651, 7009 0.618 -> 0.633 mrad), FRESH 24 -> 27 (7110, 7118 and 7123 pass: 0.120, 0.110, 0.179
+#: mrad; no clip fails anew) and FRESH2 (seeds 7200-7231, added before the change and never tuned on) 25 -> 25 (7201
+#: 2.32 -> 2.20 mrad, still failing; 7220 refused by both: 71 % of the ball positions lost; 7218 a trace 17.1 mrad
+#: off with every ball found, both).
 #: Remove a seed when it passes.
 KNOWN_FAILURES: dict[int, str] = {
-    1011: "angle_rms 0.573 mrad > 0.5; speed_rms 0.664 % of cage speed > 0.5; slip_mae 0.44 pp > 0.3",
+    1011: "angle_rms 0.592 mrad > 0.5; speed_rms 0.687 % of cage speed > 0.5; slip_mae 0.407 pp > 0.3",
     1022: "angle_rms 0.536 mrad > 0.5",
     7004: "speed_rms 0.698 % of cage speed > 0.5",
-    7009: "angle_rms 0.618 mrad > 0.5",
-    7018: "angle_rms 0.811 mrad > 0.5",
+    7009: "angle_rms 0.633 mrad > 0.5",
+    7018: "angle_rms 0.651 mrad > 0.5",
     7026: "angle_rms 1.28 mrad > 0.5",
-    7110: "refused: found 9 balls moving together along one circle, but 16 are expected",
     7112: "angle_rms 0.504 mrad > 0.5",
     7116: "angle_rms 0.534 mrad > 0.5",
     7117: "angle_rms 0.707 mrad > 0.5; speed_rms 0.641 % of cage speed > 0.5",
-    7118: "refused: found 17 balls moving together along one circle, but 18 are expected",
-    7123: "refused: found 12 balls moving together along one circle, but 16 are expected",
     7124: "angle_rms 1.36 mrad > 0.5; speed_rms 0.71 % of cage speed > 0.5",
     7134: "angle_rms 0.924 mrad > 0.5",
+    7201: "angle_rms 2.2 mrad > 0.5; speed_rms 1.5 % of cage speed > 0.5; slip_mae 0.867 pp > 0.3",
+    7209: "angle_rms 2.69 mrad > 0.5; speed_rms 2.26 % of cage speed > 0.5; slip_mae 0.467 pp > 0.3",
+    7218: "angle_rms 17.1 mrad > 0.5; speed_rms 2.02 % of cage speed > 0.5; slip_mae 1.12 pp > 0.3",
+    7220: "refused: 71% of the ball positions were lost (limit 30%)",
+    7224: "angle_rms 0.724 mrad > 0.5; speed_rms 1.63 % of cage speed > 0.5; slip_mae 0.522 pp > 0.3",
+    7226: "angle_rms 0.614 mrad > 0.5",
+    7228: "angle_rms 0.735 mrad > 0.5",
 }
 
 #: The same for the long variants (one cage revolution each), "" = passes: all 64 seeds measured with the tracker of
@@ -96,7 +110,10 @@ KNOWN_FAILURES: dict[int, str] = {
 #: lint subtracted): both pass (1012 angle 0.279 mrad, speed 0.357 %; 1014 angle 0.283 mrad, speed 0.065 %);
 #: with commit 4946aa3, 7008 passes (0.561 -> 0.436 mrad) and 1000, 1023 still pass (0.366, 0.186 mrad);
 #: all 64 re-measured with the place-bound error removed (tracking/position_bias.py, merge 304fdd1; 2026-11-27): the
-#: 57 marked "" pass, the seven known failures still fail, and the reasons below are those runs.
+#: 57 marked "" pass, the seven known failures still fail, and the reasons below are those runs. With the small-bearing
+#: localisation and the selection retry (2026-11-27), the nine seeds whose short clip is now located differently were
+#: re-measured (not the other 55): 1011 0.637 -> 0.701 mrad, 7009 0.604 -> 0.623, 7018 0.695 -> 0.641 (still failing);
+#: 1029 passes at 0.487 mrad, 7002 0.328, and 1009, 7011, 7024, 7025 pass.
 _LONG_MEASURED: dict[int, str] = {
     1000: "",
     1001: "",
@@ -109,7 +126,7 @@ _LONG_MEASURED: dict[int, str] = {
     1008: "",
     1009: "",
     1010: "",
-    1011: "angle_rms 0.637 mrad > 0.5; speed_rms 0.73 % of cage speed > 0.5; slip_mae 0.474 pp > 0.3",
+    1011: "angle_rms 0.701 mrad > 0.5; speed_rms 0.825 % of cage speed > 0.5; slip_mae 0.45 pp > 0.3",
     1012: "",
     1013: "",
     1014: "",
@@ -139,7 +156,7 @@ _LONG_MEASURED: dict[int, str] = {
     7006: "",
     7007: "",
     7008: "",
-    7009: "angle_rms 0.604 mrad > 0.5",
+    7009: "angle_rms 0.623 mrad > 0.5",
     7010: "",
     7011: "",
     7012: "",
@@ -148,7 +165,7 @@ _LONG_MEASURED: dict[int, str] = {
     7015: "",
     7016: "",
     7017: "",
-    7018: "angle_rms 0.695 mrad > 0.5",
+    7018: "angle_rms 0.641 mrad > 0.5",
     7019: "",
     7020: "",
     7021: "",

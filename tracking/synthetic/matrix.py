@@ -1,4 +1,4 @@
-"""The corpus test matrix: three named seed sets and their factor coverage.
+"""The corpus test matrix: four named seed sets and their factor coverage.
 
 ``TUNING``
     32 seeds (four blocks of 8) that a tracker may be tuned on.
@@ -10,6 +10,10 @@
     32 further seeds (four more blocks), added once ``HOLDOUT`` had been scored
     after several changes in turn and so could no longer count as unseen. The same
     rule: never tune on them; score them once, after a change is final.
+``FRESH2``
+    32 further seeds (four more blocks), added before the ball-selection and localisation changes of
+    issue 14's robustness round, once ``FRESH`` had been scored and the render parameters of its
+    refused clips read. The same rule: never tune on them; score them once, after a change is final.
 
 Each block of 8 consecutive seeds is a Latin hypercube over every factor
 (:mod:`cageless.tracking.synthetic.appearance`), so each set reaches both ends of every
@@ -25,13 +29,15 @@ from typing import Any
 
 from cageless.tracking.synthetic.appearance import CONTAINERS, RESOLUTIONS, ClipParams, draw_params
 
-__all__ = ["TUNING", "HOLDOUT", "FRESH", "SETS", "CHECKS", "coverage", "format_coverage"]
+__all__ = ["TUNING", "HOLDOUT", "FRESH", "FRESH2", "SETS", "CHECKS", "coverage", "format_coverage"]
 
 TUNING: tuple[int, ...] = tuple(range(1000, 1032))
 HOLDOUT: tuple[int, ...] = tuple(range(7000, 7032))
 #: Starts at a multiple of 8, so its four blocks are whole Latin hypercubes.
 FRESH: tuple[int, ...] = tuple(range(7104, 7136))
-SETS: dict[str, tuple[int, ...]] = {"TUNING": TUNING, "HOLDOUT": HOLDOUT, "FRESH": FRESH}
+#: The same.
+FRESH2: tuple[int, ...] = tuple(range(7200, 7232))
+SETS: dict[str, tuple[int, ...]] = {"TUNING": TUNING, "HOLDOUT": HOLDOUT, "FRESH": FRESH, "FRESH2": FRESH2}
 
 
 def _close(a: float, b: float) -> bool:
