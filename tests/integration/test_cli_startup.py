@@ -54,3 +54,34 @@ def test_summaries_match_the_registered_help():
     registered = {a.dest: a.help for a in sub._choices_actions}
     assert registered == SUMMARIES
     assert tuple(SUMMARIES) == SUBCOMMANDS
+
+
+def test_track_parser_states_the_tracking_defaults():
+    """``cageless track`` writes out the detector names and speed window instead of importing them (the modules
+    that define them bring in numba and SciPy); they must stay the tracking package's."""
+    from cageless.app.cli import track
+    from cageless.tracking.detect import DETECTORS
+    from cageless.tracking.kinematics import DEFAULT_WINDOW
+
+    assert track.DETECTORS == DETECTORS
+    assert track.DEFAULT_WINDOW == DEFAULT_WINDOW
+
+
+def test_track_starts_hashing_before_the_heavy_imports(tmp_path):
+    """The input's hash starts (in a thread) before numba, SciPy or OpenCV is imported, so that it runs on the
+    other core during those imports (benchmarks/track.py --speed measures the cold run)."""
+    from pathlib import Path
+
+    clip = Path(__file__).resolve().parents[2] / "sample_data" / "lab" / "clip_3000rpm.mkv"
+    probe = (
+        "import sys, json, cageless.provenance as pv\n"
+        "def seen(*a, **k):\n"
+        "    print(json.dumps(sorted(m for m in ('numba', 'scipy', 'cv2', 'cageless.tracking') if m in sys.modules)))\n"
+        "    raise SystemExit(0)\n"
+        "pv.prefetch_hash = seen\n"
+        "from cageless.app.cli import main\n"
+        f"main(['track', {str(clip)!r}, '--speed-rpm', '3000', '-o', {str(tmp_path / 'out')!r}, '-q'])\n"
+    )
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert json.loads(out.stdout.strip().splitlines()[-1]) == []

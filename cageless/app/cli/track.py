@@ -42,11 +42,16 @@ examples:
 """
 
 
+#: :data:`cageless.tracking.detect.DETECTORS` and :data:`cageless.tracking.kinematics.DEFAULT_WINDOW`, written out
+#: (and tested equal) so that building the parser imports neither module: they bring in numba, SciPy and
+#: pandas, and the input's hash starts only after the parser is built (:func:`run`), so that it runs on the
+#: other core during those imports instead of after them.
+DETECTORS = ("mask", "weighted", "window")
+DEFAULT_WINDOW = 21
+
+
 def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     """Add the ``track`` subcommand."""
-    from cageless.tracking.detect import DETECTORS
-    from cageless.tracking.kinematics import DEFAULT_WINDOW
-
     p = subparsers.add_parser(
         "track", parents=[parent], help="track the balls in videos and write trace files",
         description="Track every ball in bearing videos and write <video>.trace.h5 plus QC "
