@@ -9,14 +9,18 @@ Cases (every effect of a lubricated scene):
 * ``spatial``: 3000 rpm, 500 N radial + 400 N axial, 5 strips, the same;
 * ``bunching``: 1800 rpm, 500 N, from the packed start (the balls bunch), 20 ms;
 * ``20kN``: 3000 rpm, 20 kN, from the start, 20 ms;
+* ``axial-only``, ``tilt``: the spatial hard cases of tests/validation/test_spatial.py, 3000 rpm with 500 N axial
+  load only, and 500 N radial with the ring misaligned by 1 mrad, from the start, 20 ms;
 * ``planar-start``, ``spatial-start``, ``6000rpm``, ``lowload``: 3000 rpm 500 N (planar), 500 N + 400 N
   axial (spatial, 5 strips), 6000 rpm 500 N and 3000 rpm 5 N, from the start, 30 ms (``--duration``).
 
 ``--candidates`` picks rows by key (:data:`CANDIDATES`); ``auto-before`` is the automatic switch as it was
 before it probed from the start (no pilot, probes at chunks 5 and 20, a way back for good, the earlier cost
 figures: :data:`cageless.simulation.auto_switch.RHS_COST_US_BEFORE`), and ``auto-cvode`` as it was before it
-probed ``ark4`` beside CVODE (:data:`cageless.simulation.auto_switch.STIFF_METHODS`), both run in the same
-process.
+probed ``ark4`` beside CVODE (:data:`cageless.simulation.auto_switch.STIFF_METHODS`), and ``auto-planar-ark`` as it
+was before it probed ``ark4`` at the spatial level (:data:`cageless.simulation.auto_switch.ARK_MODELS`, no
+:data:`~cageless.simulation.auto_switch.ARK_REFUSAL_BOUND`, ark4's force-jump test on the ring's rows), all run in
+the same process.
 
 The settled cases measure the slip error as ``cageless bench accuracy`` does (largest difference of the
 balls' orbital speed over all balls and samples, in percentage points of the cage speed) against a DP5
@@ -48,6 +52,7 @@ from cageless.atomic import atomic_write_text
 from cageless.conditions import OperatingConditions
 from cageless.kinematics import theoretical_cage_speed
 from cageless.simulation.bench import _errors, _settled_problem
+from cageless.simulation.kernels import PLANAR
 from cageless.simulation.parameters import ModelParameters
 from cageless.simulation.run import energy_balance
 from cageless.simulation.scene import Scene
@@ -61,6 +66,8 @@ CANDIDATES = {
     "auto": ("auto (today's default)", "auto", 1e-6, None),
     "auto-before": ("auto before (probes at chunks 5, 20)", "auto-before", 1e-6, None),
     "auto-cvode": ("auto, CVODE the only stiff backend (before ark4 was one)", "auto-cvode", 1e-6, None),
+    "auto-planar-ark": ("auto, ark4 planar only (before it was probed at the spatial level)", "auto-planar-ark", 1e-6,
+                        None),
     "dp5": ("dp5, rtol 1e-6, cap 2 us", "dp5", 1e-6, 2e-6),
     "CVODE": ("CVODE throughout (rtol 3e-8, cap 5 us)", "CVODE", 1e-6, None),
     "rosw6": ("rosw, rtol 1e-6 (cap 10 us)", "rosw", 1e-6, None),
@@ -98,8 +105,24 @@ def _cvode_only():  # noqa: ANN202
         switch.STIFF_METHODS = saved
 
 
-def _from_start(rpm: float, load_n: float, axial_n: float = 0.0, level: str | None = None):  # noqa: ANN202
-    scene = Scene(conditions=OperatingConditions(rpm, load_n, axial_n))
+@contextmanager
+def _ark_planar_only():  # noqa: ANN202
+    """The automatic switch as it was before it probed ark4 at the spatial level: ark4 at the planar level only, no
+    bound on its refusals, and ark4 with the force-jump test on the ring's rows (commit 4536761)."""
+    import cageless.simulation.solve as solve_module
+
+    saved = switch.ARK_MODELS, switch.ARK_REFUSAL_BOUND, solve_module._ark_jump_floor
+    switch.ARK_MODELS, switch.ARK_REFUSAL_BOUND = frozenset({PLANAR}), {}
+    solve_module._ark_jump_floor = lambda pr: pr
+    try:
+        yield
+    finally:
+        switch.ARK_MODELS, switch.ARK_REFUSAL_BOUND, solve_module._ark_jump_floor = saved
+
+
+def _from_start(rpm: float, load_n: float, axial_n: float = 0.0, level: str | None = None,
+                **scene_kw: Any):  # noqa: ANN202
+    scene = Scene(conditions=OperatingConditions(rpm, load_n, axial_n), **scene_kw)
     pr = Simulation(scene, ModelParameters(), Choices(level=level)).build()
     return pr, theoretical_cage_speed(scene.bearing.geometry, scene.conditions.speed_rad_s)
 
@@ -116,6 +139,8 @@ def _cases(window: float, names: list[str], duration: float = 0.03) -> dict[str,
         "spatial-start": lambda: (*_from_start(3000, 500, 400, level="spatial"), start),
         "6000rpm": lambda: (*_from_start(6000, 500), start),
         "lowload": lambda: (*_from_start(3000, 5), start),
+        "axial-only": lambda: (*_from_start(3000, 0, 500, level="spatial"), np.linspace(0, 0.02, 201)),
+        "tilt": lambda: (*_from_start(3000, 500, level="spatial", misalignment_rad=1e-3), np.linspace(0, 0.02, 201)),
     }
     return {name: table[name]() for name in names}
 
@@ -127,6 +152,9 @@ def _run(pr: Any, t: np.ndarray, method: str, rtol: float, cap: float | None) ->
             return solve(pr, t, method="auto", rtol=rtol)
     if method == "auto-cvode":
         with _cvode_only():
+            return solve(pr, t, method="auto", rtol=rtol)
+    if method == "auto-planar-ark":
+        with _ark_planar_only():
             return solve(pr, t, method="auto", rtol=rtol)
     if method == "auto" and cap is None:
         return solve(pr, t, method="auto", rtol=rtol)

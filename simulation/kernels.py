@@ -14,7 +14,7 @@ from cageless.simulation.models import (implicit_normal, implicit_normal_spatial
 
 __all__ = ["PLANAR", "SPATIAL", "TWO_BALLS", "OSCILLATOR", "RICCATI", "DAMPED", "model_rhs", "model_post",
            "model_signature", "model_ring_share", "model_gaps", "model_implicit", "model_filter_error",
-           "implicit_speed_rows"]
+           "implicit_speed_rows", "ring_rows"]
 
 PLANAR, TWO_BALLS, SPATIAL = planar.MODEL_ID, two_balls.MODEL_ID, spatial.MODEL_ID
 OSCILLATOR, RICCATI, DAMPED = textbook.OSCILLATOR, textbook.RICCATI, textbook.DAMPED
@@ -102,6 +102,16 @@ def implicit_speed_rows(model_id: int, n_balls: int) -> list[int]:
         return list(range(2 * z, 3 * z))
     if model_id == SPATIAL:
         return list(range(2 * z, 3 * z)) + list(range(6 * z + 6, 7 * z + 6))
+    return []
+
+
+def ring_rows(model_id: int, n_balls: int) -> list[int]:
+    """The state rows every ball reaches (the ring's accelerations and the energy counters; see
+    :attr:`cageless.simulation.jacobian.JacobianStructure.ring_rows`); none for models without a ring."""
+    if model_id == PLANAR:
+        return planar.planar_ring_rows(n_balls)
+    if model_id == SPATIAL:
+        return spatial.spatial_ring_rows(n_balls)
     return []
 
 

@@ -107,10 +107,7 @@ def ark_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_st
             status = stop
             break
         h, t_cross = _onset_ahead(model_id, p, t, h, y, f[0], h_onset, t_cross, g0, g1, yt)
-        _ark_stages(model_id, t, h, y, p, log, f, ki, yt, ynew, work)
-        model_rhs(model_id, t + h, ynew, p, log, f_end)
-        cnt[_RHS] += 6
-        err = _ark_error(model_id, p, h, y, ynew, f, atol, rtol, e)
+        err = _ark_trial(model_id, t, h, y, p, log, f, ki, yt, ynew, f_end, work, atol, rtol, e, cnt)
         if not np.isfinite(err) or err > 1.0:
             held = True
             h = _rejected(err, h, cnt)
@@ -130,10 +127,8 @@ def ark_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_st
         fac = max(1.0 if held else 0.1, min(5.0, err ** 0.22 / err_old ** 0.04 / 0.9))
         held = False
         err_old = max(err, 1e-4)
-        k = _accept(model_id, t, h, y, ynew, f[0], f_end, p, log, t_out, out, k)  # y, f[0] <- ynew, f_end
-        model_implicit(model_id, t + h, y, p, 0.0, ki[0], work)
+        k = _ark_accept(model_id, t, h, y, ynew, f, f_end, ki, work, p, log, t_out, out, k, cnt)
         t = t + h
-        cnt[_STEPS] += 1
         h = h / fac
     _write_stats(stats, cnt, max(h, h_want) if status == STATUS_OK else h)
     return status
@@ -146,6 +141,26 @@ def _buffers(n):  # pragma: no cover - compiled
     of them in the bearing models, n >= 3 Z), the implicit solves' scratch and the counters."""
     return (np.empty((6, n)), np.empty((6, n)), np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.zeros(n),
             np.zeros(n), np.empty(12), np.zeros(8, dtype=np.int64))
+
+
+@numba.njit(cache=True, inline="always")
+def _ark_trial(model_id, t, h, y, p, log, f, ki, yt, ynew, f_end, work, atol, rtol, e, cnt):  # pragma: no cover
+    """One trial step of length ``h`` from (t, y): the stages (:func:`_ark_stages`), the right-hand side at its
+    end into ``f_end`` (six counted in ``cnt``) and the error norm of :func:`_ark_error`, returned."""
+    _ark_stages(model_id, t, h, y, p, log, f, ki, yt, ynew, work)
+    model_rhs(model_id, t + h, ynew, p, log, f_end)
+    cnt[_RHS] += 6
+    return _ark_error(model_id, p, h, y, ynew, f, atol, rtol, e)
+
+
+@numba.njit(cache=True, inline="always")
+def _ark_accept(model_id, t, h, y, ynew, f, f_end, ki, work, p, log, t_out, out, k, cnt):  # pragma: no cover
+    """Accept the step from t to t + h: DP5's samples and bookkeeping (y, f[0] <- ynew, f_end), the implicit
+    part at the new state into ki[0], the step counted; the next sample index."""
+    k = _accept(model_id, t, h, y, ynew, f[0], f_end, p, log, t_out, out, k)
+    model_implicit(model_id, t + h, y, p, 0.0, ki[0], work)
+    cnt[_STEPS] += 1
+    return k
 
 
 @numba.njit(cache=True, inline="always")

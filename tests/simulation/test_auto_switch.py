@@ -123,3 +123,38 @@ def test_an_unknown_method_or_a_bad_cap_is_refused_before_anything_runs():
         simulate(scene, choose_model(scene), max_step=0.0, progress=False)
     with pytest.raises(ParameterError, match="Did you mean 'LSODA'"):
         simulate(scene, choose_model(scene), method="LSDOA", progress=False)
+
+
+def test_ark4_is_left_once_the_runs_refusals_reach_the_hard_cases_bound():
+    """At the spatial level the run's refused steps, judged from simulation.auto_switch.ARK_JUDGE_STEPS (50) accepted
+    steps on, may not reach ARK_REFUSAL_BOUND (0.1, the hard cases' bound on a run) of them while ark4 runs: a run that reaches it
+    leaves ark4, to CVODE where the probe that chose ark4 found CVODE paying (below SWITCH_GAIN, 0.8, of DP5),
+    else to DP5; the record carries the run's refused share."""
+    from cageless.simulation.auto_switch import _ark_refusing, _leave_ark
+    from cageless.simulation.kernels import PLANAR, SPATIAL
+
+    chosen = {"costs": {"CVODE": 0.3, "ark4": 0.1}}
+    assert _leave_ark(60, 5, SPATIAL, chosen, 0.01) is None  # 8.3 %
+    assert _leave_ark(49, 30, SPATIAL, chosen, 0.01) is None  # too few steps to judge
+    assert _leave_ark(60, 30, PLANAR, chosen, 0.01) is None  # no bound at the planar level
+    left = _leave_ark(60, 6, SPATIAL, chosen, 0.01)
+    assert left["switch"] and left["to"] == "CVODE" and left["run_refused"] == pytest.approx(0.1)
+    assert left["time_s"] == 0.01 and left["cost_ratio"] == pytest.approx(0.3)
+    assert _leave_ark(60, 6, SPATIAL, {"costs": {"CVODE": 0.85, "ark4": 0.1}}, 0.01)["to"] == "dp5"
+    assert _ark_refusing(500, 50, SPATIAL) and not _ark_refusing(500, 49, SPATIAL)
+
+
+def test_ark4_runs_without_the_force_jump_test_on_the_ring_rows():
+    """The ring's accelerations are a small difference of every ball's race forces (simulation.solve._ark_jump_floor):
+    at the spatial level ark4 keeps the force-jump test on every other row that has one, DP5 on all of them."""
+    from cageless.simulation.kernels import ring_rows
+    from cageless.simulation.simulation import Choices, Simulation
+    from cageless.simulation.solve import _ark_jump_floor
+
+    scene = Scene(conditions=OperatingConditions(3000.0, 0.0, 500.0))
+    pr = Simulation(scene, None, Choices()).build()
+    ark = _ark_jump_floor(pr)
+    rows = ring_rows(pr.model_id, pr.n_balls)
+    changed = np.flatnonzero(ark.jump_floor != pr.jump_floor)
+    assert changed.tolist() == sorted(r for r in rows if pr.jump_floor[r] > 0)  # ring y'', z'', x'', tilt''
+    assert len(changed) == 5 and np.all(ark.jump_floor[rows] == 0.0)

@@ -66,7 +66,7 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--explain", action="store_true", help="print the level and effects with reasons; do not solve")
     p.add_argument("--json", action="store_true", help="with --explain: print JSON")
     p.add_argument("--solver", default="auto", help="integrator: auto (default: compiled dp5, switching to CVODE "
-                   "(BDF), or to ark4 at the planar level, when stiffness makes that cheaper), "
+                   "(BDF) or ark4 when stiffness makes that cheaper and ark4 refuses under 10 %% of its steps), "
                    "dp5, ark4 (compiled IMEX, the race normal forces "
                    "implicit), rosw, CVODE, RK45, DOP853, LSODA, BDF, Radau")
     p.add_argument("--rtol", type=finite_float, default=1e-6, help="relative tolerance (default 1e-6)")
