@@ -28,12 +28,18 @@ from cageless.balls import ball_order, normalise_unwrapped
 from cageless.tracking.kinematics import DEFAULT_WINDOW, robust_track_fit
 from cageless.tracking.locate import fit_circle
 
-__all__ = ["Orbit", "fit_orbit", "frame_shifts", "orbital_angles"]
+__all__ = ["Orbit", "FRAME_JUMP", "fit_orbit", "frame_shifts", "frame_jumps", "orbital_angles"]
 
 #: Fewest highlights a frame needs for its own centre (three fix a circle; the rest make it robust).
 MIN_FRAME_BALLS = 6
 
 _MAX_FIT_POINTS = 50_000
+#: A frame whose highlights share a translation this far (a share of the orbit radius) from the smoothed one has
+#: its samples flagged not valid: every highlight of it was measured off its ball alike. FRESH2 seed 7209 (two
+#: saturated lights' highlights 10 px apart): the tracker started on the second light's and drifted to the first
+#: over two frames, 0.049 and 0.034 of the radius off (46 mrad); none flagged on the 32 TUNING clips (the largest
+#: translation off a clip's median 0.0024, 1014).
+FRAME_JUMP = 0.01
 
 
 @dataclass(frozen=True)
@@ -80,6 +86,12 @@ def _interpolate(t: np.ndarray, a: np.ndarray, ok: np.ndarray) -> np.ndarray:
 
 def frame_shifts(t: np.ndarray, u: np.ndarray, v: np.ndarray, orbit: Orbit,
                  frames: int = DEFAULT_WINDOW) -> npt.NDArray[np.float64]:
+    """:func:`frame_jumps`' smoothed translations only (px), shape (T, 2)."""
+    return frame_jumps(t, u, v, orbit, frames)[0]
+
+
+def frame_jumps(t: np.ndarray, u: np.ndarray, v: np.ndarray, orbit: Orbit, frames: int = DEFAULT_WINDOW
+                ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
     """Each frame's common translation (du, dv) of the highlights off the whole-video circle (px), shape (T, 2).
 
     In each frame with at least :data:`MIN_FRAME_BALLS` highlights, the radial residuals
@@ -93,11 +105,17 @@ def frame_shifts(t: np.ndarray, u: np.ndarray, v: np.ndarray, orbit: Orbit,
     instead of 21, corpus seed 1002 read 0.483 instead of 0.450 mrad, an elongated highlight being less
     precise across the orbit than along it); frames without a solution take their neighbours'.
     ``frames = 0`` gives zeros.
+
+    Returns
+    -------
+    shift, jump
+        The smoothed translation (du, dv) of each frame (px), shape (T, 2), and how far each frame's own solution
+        lies from it (px), shape (T,): 0 where the frame had no solution or nothing is smoothed.
     """
     n = len(t)
     out = np.zeros((n, 2))
     if frames == 0:
-        return out
+        return out, np.zeros(n)
     cx, cy = orbit.centre
     du, dv = u - cx, v - cy
     rho = np.hypot(du, dv)
@@ -105,14 +123,16 @@ def frame_shifts(t: np.ndarray, u: np.ndarray, v: np.ndarray, orbit: Orbit,
     nu, nv = np.where(ok, du / np.where(ok, rho, 1.0), 0.0), np.where(ok, dv / np.where(ok, rho, 1.0), 0.0)
     res = np.where(ok, rho - orbit.radius, 0.0)
     scale = 1.4826 * float(np.median(np.abs(res[ok]))) if ok.any() else 0.0
-    out, solved = _frame_solutions(nu, nv, res, ok, 4.0 * max(scale, 1e-6))
+    raw, solved = _frame_solutions(nu, nv, res, ok, 4.0 * max(scale, 1e-6))
     if not solved.any():
-        return np.zeros((n, 2))
+        return np.zeros((n, 2)), np.zeros(n)
+    out = raw.copy()
     for k in range(2):
         out[~solved, k] = np.interp(t[~solved], t[solved], out[solved, k])
-    if frames > 1 and n >= frames:
-        out, _ = robust_track_fit(t, out, np.repeat(solved[:, None], 2, axis=1), frames)
-    return out
+    if not (frames > 1 and n >= frames):
+        return out, np.zeros(n)
+    out, _ = robust_track_fit(t, out, np.repeat(solved[:, None], 2, axis=1), frames)
+    return out, np.where(solved, np.hypot(*(raw - out).T), 0.0)
 
 
 def _frame_solutions(nu: np.ndarray, nv: np.ndarray, res: np.ndarray, ok: np.ndarray,
@@ -144,7 +164,8 @@ def orbital_angles(table: pd.DataFrame, orbit: Orbit, roll_rad: float = 0.0, ste
     """Unwrapped bearing-frame orbital angles (T, Z), validity, direction and the ball relabelling.
 
     The angles are measured about each frame's centre (:func:`frame_shifts` with ``frames = steady``;
-    0: about the whole-video centre).
+    0: about the whole-video centre). A frame whose own translation lies more than :data:`FRAME_JUMP` of the
+    radius from the smoothed one has its samples flagged not valid (:func:`frame_jumps`).
 
     Returns
     -------
@@ -159,8 +180,8 @@ def orbital_angles(table: pd.DataFrame, orbit: Orbit, roll_rad: float = 0.0, ste
     """
     u, v = _grid(table)
     t = table.time_s.to_numpy().reshape(u.shape)[:, 0]
-    ok = np.isfinite(u)
-    shift = frame_shifts(t, u, v, orbit, steady)
+    shift, jump = frame_jumps(t, u, v, orbit, steady)
+    ok = np.isfinite(u) & (jump <= FRAME_JUMP * orbit.radius)[:, None]
     cx, cy = orbit.centre[0] + shift[:, :1], orbit.centre[1] + shift[:, 1:]
     theta = np.arctan2(-(v - cy), u - cx) - roll_rad
     angle = np.empty_like(theta)

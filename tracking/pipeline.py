@@ -253,7 +253,8 @@ def _setup(video: FrameSource, loc: BearingLocation, background: np.ndarray, bea
     sel = select_balls(frames, video.times, sel_bg, mask, z=z, ball_diameter_m=g.ball_diameter_m,
                        pitch_diameter_m=g.pitch_diameter_m, omega_i=conditions.speed_rad_s, centre0=centre0,
                        r_prior=r_prior, path=path, prior_known=known, k_sigma=k_sigma,
-                       pixel_threshold=options.detector.weight_sigma * sigma)
+                       pixel_threshold=options.detector.weight_sigma * sigma,
+                       scale_stated=bool(conditions.px_per_mm))
     ring = sel.ring
     ball_px = 2 * g.ball_diameter_m / g.pitch_diameter_m * ring.radius  # now from the measured ball circle
     h, w = mask.shape

@@ -54,8 +54,8 @@ from cageless.tracking.candidates import (Tracklet, bin_mask, find_candidates, l
 from cageless.tracking.cyclic import cyclic_select
 from cageless.tracking.locate import fit_circle
 
-__all__ = ["SPEED_BAND", "MIN_SPACING", "BallRing", "Anchor", "Selection", "SelectionError", "select_balls",
-           "anchor_at", "cyclic_select"]
+__all__ = ["SPEED_BAND", "MIN_SPACING", "PRIOR_RADIUS_TOL", "BallRing", "Anchor", "Selection", "SelectionError",
+           "select_balls", "check_radius", "anchor_at", "cyclic_select"]
 
 log = logging.getLogger(__name__)
 
@@ -78,6 +78,12 @@ MIN_COVER = 0.5
 #: (hysteresis): a highlight over a textured or bright face, whose response noise the moving balls raise,
 #: flickers about the start threshold from frame to frame.
 EXTEND_SHARE = 0.6
+#: Largest distance of the chosen circle's radius from the pitch radius at a stated ``px_per_mm``, in ball
+#: diameters. The bright wedges between neighbouring balls travel like balls, Z on one circle, but about a third
+#: of a ball off the pitch circle (FRESH2 seed 7218: 0.31 D inside; its dim, doubled highlights gave fewer
+#: tracklets, 17.1 mrad RMS); the highlights' circle is the pitch circle shifted (<= 0.017 D off on TUNING).
+#: A stated scale off by a fraction e moves it by e d_m / (2 D) ball diameters (7 % at d_m = 4 D).
+PRIOR_RADIUS_TOL = 0.15
 #: Window radius of the blob centroid that places each candidate, in ball diameters: a highlight (even
 #: saturated, elongated or two lights' run together) is a small part of its ball (the per-frame tracker
 #: takes blobs up to a quarter ball wide), and distinct blobs of one ball lie further apart than this.
@@ -471,7 +477,8 @@ def _ball_circle(tracks: list[Tracklet], feats: list[dict[str, Any]], movers: np
 def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, background: np.ndarray,
                  mask: np.ndarray, *, z: int, ball_diameter_m: float, pitch_diameter_m: float, omega_i: float,
                  centre0: tuple[float, float], r_prior: float, path: object = "video", n_bursts: int = 6,
-                 k_sigma: float = 4.0, prior_known: bool = True, pixel_threshold: float = 0.0) -> Selection:
+                 k_sigma: float = 4.0, prior_known: bool = True, pixel_threshold: float = 0.0,
+                 scale_stated: bool = False) -> Selection:
     """Choose exactly ``z`` ball tracks from bursts spread over the clip (see the module docstring).
 
     Parameters
@@ -490,11 +497,15 @@ def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, backgro
         False when ``r_prior`` is only a rough scale (then the circle is chosen by its support).
     pixel_threshold
         Per-pixel weight threshold of the centroid that places each candidate (DN; a few noise sigmas).
+    scale_stated
+        True when ``r_prior`` is the pitch radius at a stated scale: the chosen circle must then lie within
+        :data:`PRIOR_RADIUS_TOL` ball diameters of it (:func:`check_radius`).
 
     Raises
     ------
     SelectionError
-        When the clip shows a count other than ``z``, or the chosen tracks fail the checks.
+        When the clip shows a count other than ``z``, the chosen tracks fail the checks, or (``scale_stated``)
+        their circle is not the pitch circle.
     """
     ctx = _context(z, ball_diameter_m, pitch_diameter_m, omega_i, centre0, r_prior, k_sigma,
                    prior_known=prior_known, pixel_threshold=pixel_threshold)
@@ -527,6 +538,8 @@ def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, backgro
     log.info("%s: ball circle r = %.1f px, counts per burst %s, %d of %d bursts with %d balls", path, circle[2],
              counts, len(good), len(spans), z)
     _check_count(path, z, found, len(good), len(spans), table, ring)
+    if scale_stated:
+        check_radius(path, circle[2], r_prior, ctx.ball_px, table=table, ring=ring, found=found)
     return Selection(ring=ring, anchors=good, table=table, counts=counts)
 
 
@@ -551,6 +564,23 @@ def _check_count(path: object, z: int, found: int, n_good: int, n_spans: int, ta
         raise SelectionError(path, f"{z} consistent balls were found in only {n_good} of {n_spans} sampled "
                              "stretches of the clip.", "Check the lighting and focus; the QC image shows what "
                              "was found.", table=table, found=found, ring=ring)
+
+
+def check_radius(path: object, radius: float, r_prior: float, ball_px: float, *, table: pd.DataFrame | None = None,
+                 ring: BallRing | None = None, found: int | None = None) -> None:
+    """Refuse a ball circle of ``radius`` px more than :data:`PRIOR_RADIUS_TOL` ball diameters (``ball_px``) from
+    the pitch radius ``r_prior`` px of the stated scale (:class:`SelectionError`, with ``table`` and ``ring`` for QC).
+    """
+    off = (radius - r_prior) / ball_px
+    if abs(off) <= PRIOR_RADIUS_TOL:
+        return
+    raise SelectionError(path, f"the tracks chosen as balls travel a circle of radius {radius:.1f} px, but the "
+                         f"pitch circle at the stated px_per_mm is {r_prior:.1f} px ({off:+.2f} ball diameters, "
+                         f"limit {PRIOR_RADIUS_TOL}): they are not the balls' highlights (the bright gaps between "
+                         "balls travel with them, inside or outside the pitch circle).",
+                         "Check px_per_mm and the bearing's pitch diameter; if they are right, the highlights are "
+                         "too faint to be chosen over the gaps. The QC image shows the circle and every candidate.",
+                         table=table, found=found, ring=ring)
 
 
 def anchor_at(frames: Callable[[int], np.ndarray], times: np.ndarray, background: np.ndarray, mask: np.ndarray,

@@ -95,9 +95,12 @@ KNOWN_FAILURES: dict[int, str] = {
     7124: "angle_rms 1.36 mrad > 0.5; speed_rms 0.71 % of cage speed > 0.5",
     7134: "angle_rms 0.924 mrad > 0.5",
     7201: "angle_rms 2.2 mrad > 0.5; speed_rms 1.5 % of cage speed > 0.5; slip_mae 0.867 pp > 0.3",
-    7209: "angle_rms 2.69 mrad > 0.5; speed_rms 2.26 % of cage speed > 0.5; slip_mae 0.467 pp > 0.3",
-    7218: "angle_rms 17.1 mrad > 0.5; speed_rms 2.02 % of cage speed > 0.5; slip_mae 1.12 pp > 0.3",
-    7220: "refused: 71% of the ball positions were lost (limit 30%)",
+    7209: "angle_rms 0.736 mrad > 0.5; speed_rms 0.651 % of cage speed > 0.5 (2.69 mrad, 2.26 % before frames whose "
+          "highlights jump together were flagged)",
+    7218: "refused: the chosen circle (84.2 px, the bright gaps between balls) is -0.31 ball diameters off the "
+          "pitch circle (99.5 px); before the check a trace 17.1 mrad RMS off",
+    7220: "refused: the chosen circle (161.3 px, the gaps between balls) is -0.33 ball diameters off the pitch "
+          "circle (187.4 px); before the check refused later, 71 % of the ball positions lost",
     7224: "angle_rms 0.724 mrad > 0.5; speed_rms 1.63 % of cage speed > 0.5; slip_mae 0.522 pp > 0.3",
     7226: "angle_rms 0.614 mrad > 0.5",
     7228: "angle_rms 0.735 mrad > 0.5",

@@ -1,11 +1,11 @@
-"""Each frame's angles about its own centre (tracking/geometry.py: frame_shifts, orbital_angles)."""
+"""Each frame's angles about its own centre (tracking/geometry.py: frame_shifts, frame_jumps, orbital_angles)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pandas as pd
 
-from cageless.tracking.geometry import Orbit, frame_shifts, orbital_angles
+from cageless.tracking.geometry import FRAME_JUMP, Orbit, frame_jumps, frame_shifts, orbital_angles
 
 
 def _table(n: int = 400, z: int = 12, shake_px: float = 0.0, noise_px: float = 0.0, seed: int = 0):
@@ -63,3 +63,25 @@ def test_an_outlier_does_not_move_the_frame():
     orbit = Orbit(centre=(320.0, 240.0), radius=200.0, residual=0.0)
     found = frame_shifts(t, u, v, orbit, frames=1)
     assert np.max(np.abs(found[50])) < 0.03
+
+
+def test_a_frame_whose_highlights_jump_together_is_not_valid():
+    """FRESH2 seed 7209: the tracker started on the second light's highlights and drifted onto the first over two
+    frames, every highlight of frame 0 moved alike by 6.2 px and of frame 1 by 4.3 px (0.049 and 0.034 of the
+    127.5 px radius; 46 mrad at worst). Those frames' samples are flagged not valid; a smooth 0.5 px shake is not."""
+    t, truth, _, table = _table(n=100, noise_px=0.01)
+    u = table.u_px.to_numpy().reshape(len(t), -1).copy()
+    v = table.v_px.to_numpy().reshape(len(t), -1).copy()
+    u[0] += 6.1 * 200 / 127.5
+    v[0] -= 3.2 * 200 / 127.5
+    u[1] += 4.3 * 200 / 127.5
+    v[1] -= 2.2 * 200 / 127.5
+    jumped = table.assign(u_px=u.ravel(), v_px=v.ravel())
+    orbit = Orbit(centre=(320.0, 240.0), radius=200.0, residual=0.0)
+    _, jump = frame_jumps(t, u, v, orbit, frames=21)
+    assert jump[0] > 9.0 and jump[1] > 6.5 and jump[2:].max() < 0.05
+    _, valid, _, _ = orbital_angles(jumped, orbit, steady=21)
+    assert np.flatnonzero(~valid.all(axis=1)).tolist() == [0, 1] and valid[2:].all()
+    _, _, _, still = _table(n=100, shake_px=0.5)
+    assert FRAME_JUMP * 200 == 2.0
+    assert orbital_angles(still, orbit, steady=21)[1].all()
