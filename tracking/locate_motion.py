@@ -27,7 +27,7 @@ import cv2
 import numpy as np
 
 from cageless.tracking.io.base import FrameSource
-from cageless.tracking.locate import BearingLocation, _to_u8, fit_circle
+from cageless.tracking.locate import _STRETCH_TOPS, BearingLocation, _to_u8, fit_circle
 
 __all__ = ["motion_map", "moving_pixels", "frame_gains", "frame_level", "DROPOUT_GAIN", "locate_by_motion",
            "plausible_band", "holds_the_motion"]
@@ -109,7 +109,7 @@ def moving_pixels(spread: np.ndarray) -> np.ndarray | None:
     med = float(np.median(spread))
     floor = med + NOISE_MARGIN * 1.4826 * float(np.median(np.abs(spread - med)))
     moving = None
-    for top in (99.5, 100.0):
+    for top in _STRETCH_TOPS:  # the same stretches as the bright-face test of locate_bearing
         lo, hi = np.percentile(spread, [0.5, top])
         img8 = _to_u8(spread, top)
         if img8.max() == img8.min():
