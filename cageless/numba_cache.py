@@ -1,13 +1,22 @@
-"""Keys for numba's on-disk caches: the digest of all the sources of a package.
+"""Keys for numba's on-disk caches: the digest of the sources a package's kernels can compile in.
 
 numba keys a cached function on its own source file's timestamp. A kernel that calls, and inlines,
-functions of other modules of its package (the tracking loop in ``tracking/link_kernel.py`` calls the
-centroid of ``tracking/detect.py``; the simulator's integrators call the models and forces) keeps a
-stale cache when only a callee's module is edited: it would run the old code. So every kernel of a
-registered package is cached under an explicit key: its own file's stamp together with the SHA-256 of
-every ``.py`` file of the package (:func:`source_digest`, computed once per process) and, optionally, a
-key of the package's run-time extensions. A cache written under another digest no longer matches;
-numba recompiles and overwrites it. :func:`clear` removes a package's cache files when asked.
+functions of other modules (the tracking loop in ``tracking/link_kernel.py`` calls the centroid of
+``tracking/detect.py``; the simulator's integrators call the models and forces) or reads their
+module-level constants, which numba freezes at compile time, keeps a stale cache when only a callee's
+module is edited: it would run the old code. So every kernel of a registered package is cached under an
+explicit key: its own file's stamp together with the SHA-256 of its package's *kernel closure*
+(:func:`source_digest`, computed once per process) and, optionally, a key of the package's run-time
+extensions.
+
+The kernel closure (:func:`kernel_sources`) is every ``.py`` file of the package that defines a numba
+kernel, and every module of this distribution that those files import, followed transitively through
+``import`` statements found anywhere in them (read with :mod:`ast`, without importing anything). A
+kernel can only reach a module its own module imports, so a file outside the closure (a benchmark
+helper, the solver's Python driver) is edited without recompiling anything, while a constant edited in
+a shared module outside the package (``cageless/units.py``) does recompile. A cache written under
+another digest no longer matches; numba recompiles and overwrites it. :func:`clear` removes a package's
+cache files when asked.
 
 :func:`register` must run before the package's first kernel is decorated: each package calls it from its
 ``__init__``. The caches stay where numba puts them (``NUMBA_CACHE_DIR``, else ``__pycache__`` beside the
@@ -16,7 +25,11 @@ sources, else numba's user-wide cache directory).
 
 from __future__ import annotations
 
+import ast
 import hashlib
+import os
+import re
+import sys
 from collections.abc import Callable, Hashable
 from functools import lru_cache
 from pathlib import Path
@@ -25,7 +38,7 @@ from typing import Any
 
 from numba.core import caching
 
-__all__ = ["SourcesLocator", "clear", "is_compiled", "register", "source_digest"]
+__all__ = ["SourcesLocator", "clear", "is_compiled", "kernel_sources", "register", "source_digest"]
 
 #: numba's cache implementation (renamed from ``_CacheImpl`` in numba 0.61).
 _IMPL = getattr(caching, "CacheImpl", None) or getattr(caching, "_CacheImpl")
@@ -33,17 +46,78 @@ _IMPL = getattr(caching, "CacheImpl", None) or getattr(caching, "_CacheImpl")
 _ROOTS: dict[Path, Callable[[], Hashable] | None] = {}
 
 
+#: A file defines a kernel when it mentions numba and one of its compiling decorators or calls.
+_KERNEL = re.compile(r"\b(njit|jit|cfunc|vectorize|guvectorize|register_jitable|overload|overload_method|"
+                     r"jitclass|generated_jit)\b")
+#: Absolute imports followed into other folders: this distribution's only (never numpy, numba, ...).
+_TOP = __name__.split(".")[0]
+
+
+def _module_file(base: Path) -> Path | None:
+    """``base.py`` or ``base/__init__.py``, whichever exists."""
+    for f in (base.with_suffix(".py"), base / "__init__.py"):
+        if f.is_file():
+            return f.resolve()
+    return None
+
+
+def _absolute(name: str) -> Path | None:
+    """The file of module ``name`` of this distribution, found from its nearest imported parent package."""
+    parts = name.split(".")
+    if parts[0] != _TOP:
+        return None
+    for k in range(len(parts), 0, -1):
+        mod = sys.modules.get(".".join(parts[:k]))
+        if mod is None:
+            continue
+        if k == len(parts):
+            f = getattr(mod, "__file__", None)
+            return Path(f).resolve() if f else None
+        found = (_module_file(Path(p).joinpath(*parts[k:])) for p in getattr(mod, "__path__", None) or [])
+        return next((f for f in found if f is not None), None)
+    return None
+
+
+def _imports(path: Path) -> set[Path]:
+    """The files of this distribution that ``path`` imports, anywhere in it (relative imports by folder)."""
+    out: set[Path | None] = set()
+    for node in ast.walk(ast.parse(path.read_bytes(), filename=str(path))):
+        if isinstance(node, ast.Import):
+            out |= {_absolute(a.name) for a in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.level:
+            base = path.parent if node.level == 1 else path.parents[node.level - 2]
+            target = base.joinpath(*node.module.split(".")) if node.module else base
+            out |= {_module_file(target), *(_module_file(target / a.name) for a in node.names)}
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            out |= {_absolute(node.module), *(_absolute(f"{node.module}.{a.name}") for a in node.names)}
+    return {p for p in out if p is not None}
+
+
+def kernel_sources(root: str | Path) -> list[Path]:
+    """The kernel closure of the package in ``root``: its files that define numba kernels and every module of
+    this distribution they import, transitively (sorted, resolved paths)."""
+    root = Path(root).resolve()
+    todo = [p for p in root.rglob("*.py") if "numba" in (text := p.read_text(encoding="utf-8")) and _KERNEL.search(text)]
+    seen: set[Path] = set()
+    while todo:
+        path = todo.pop()
+        if path not in seen:
+            seen.add(path)
+            todo.extend(_imports(path) - seen)
+    return sorted(seen)
+
+
 @lru_cache(maxsize=None)
 def _digest(root: Path) -> str:
     h = hashlib.sha256()
-    for path in sorted(root.rglob("*.py")):
-        h.update(path.relative_to(root).as_posix().encode())
+    for path in kernel_sources(root):
+        h.update(Path(os.path.relpath(path, root)).as_posix().encode())
         h.update(path.read_bytes())
     return h.hexdigest()
 
 
 def source_digest(root: Path) -> str:
-    """SHA-256 over the relative path and bytes of every ``.py`` file under ``root`` (read once per process)."""
+    """SHA-256 over the relative path and bytes of every file of :func:`kernel_sources` (read once per process)."""
     return _digest(Path(root).resolve())
 
 

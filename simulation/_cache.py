@@ -1,12 +1,14 @@
-"""The key of numba's on-disk caches of this package: the digest of all its sources.
+"""The key of numba's on-disk caches of this package: the digest of the sources its kernels import.
 
 numba keys a cached function on its own source file's timestamp. The compiled integrator
 (``integrators/dp5.py``) and the model switch (``kernels.py``) call, and inline, functions of other
 modules (``models/*``, ``forces.py``, ``traction.py``) and compile in their slot constants
 (``models/base.py``), so editing one of those would leave the callers' caches stale: they would run
 the old physics. So every kernel of this package is cached under an explicit key: its own file's
-stamp together with the SHA-256 of every ``.py`` file of the package (:func:`source_digest`, computed
-once, when the first kernel of the package is decorated) and the digest of the race-contact laws
+stamp together with the SHA-256 of the package's kernel closure: every file that defines a kernel and every
+module of ``cageless`` those import, transitively (:func:`source_digest`; see
+:func:`cageless.numba_cache.kernel_sources`; a driver such as ``solve.py`` or ``bench.py`` is outside it and is
+edited without a recompile) and the digest of the race-contact laws
 registered at run time (:func:`cageless.simulation.models.race_laws.key`). A cache written under another digest no
 longer matches; numba recompiles and overwrites it. Nothing is deleted behind the user's back:
 :func:`clear_cache` removes the package's cache files when asked.

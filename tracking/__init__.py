@@ -4,7 +4,7 @@ The pipeline lands with the video-input and tracking issues; this package
 imports only the shared core :mod:`cageless` and never ``simulation`` or
 ``comparison``.
 
-Its compiled kernels are cached by numba under the digest of the package's sources
+Its compiled kernels are cached by numba under the digest of the sources its kernels import
 (:mod:`cageless.numba_cache`): the tracking loop (``link_kernel.py``) compiles in the centroid of
 ``detect.py``, and numba's own key, the caller's file stamp, would keep running an edited callee's old code.
 """

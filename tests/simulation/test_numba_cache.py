@@ -10,16 +10,38 @@ import numba
 from cageless.simulation import _cache
 
 
-def test_the_key_follows_every_source_of_the_package(tmp_path):
-    """Editing any module (here a callee in models/) changes the digest every kernel's cache is stamped with."""
+def test_the_key_follows_the_sources_the_kernels_import(tmp_path):
+    """Editing a module a kernel imports (here a callee in models/, reached through a relative import) changes the
+    digest every kernel's cache is stamped with; editing a file no kernel imports (a benchmark helper) does not."""
     (tmp_path / "models").mkdir()
+    (tmp_path / "models" / "__init__.py").write_text("")
     model = tmp_path / "models" / "planar.py"
     model.write_text("K = 1\n")
-    (tmp_path / "kernels.py").write_text("import models\n")
+    (tmp_path / "kernels.py").write_text("import numba\nfrom .models import planar\n\n\n@numba.njit\n"
+                                         "def f(x):\n    return planar.K * x\n")
+    helper = tmp_path / "bench.py"
+    helper.write_text("from .kernels import f\n")
     before = _cache._digest.__wrapped__(tmp_path)
     assert _cache._digest.__wrapped__(tmp_path) == before  # same sources, same key
+    helper.write_text("from .kernels import f\nN = 2\n")
+    assert _cache._digest.__wrapped__(tmp_path) == before  # not imported by a kernel: no recompile
     model.write_text("K = 2\n")
     assert _cache._digest.__wrapped__(tmp_path) != before
+
+
+def test_the_closure_of_the_simulator_kernels():
+    """The models, forces and slot constants are in the closure, and so are the shared modules outside the package
+    that the kernels import (their constants compile in); the Python drivers are not."""
+    from cageless import numba_cache
+
+    root = Path(_cache.__file__).resolve().parent
+    closure = numba_cache.kernel_sources(root)
+    rel = {p.relative_to(root).as_posix() for p in closure if p.is_relative_to(root)}
+    outside = {p.name for p in closure if not p.is_relative_to(root)}
+    assert {"models/base.py", "models/planar.py", "forces.py", "traction.py", "kernels.py",
+            "integrators/dp5.py", "integrators/ark.py"} <= rel
+    assert not {"bench.py", "solve.py", "auto_switch.py", "run.py", "sweep.py"} & rel
+    assert "units.py" in outside  # cageless/units.py, outside the package folder
 
 
 def test_package_kernels_carry_the_digest_and_others_do_not():
