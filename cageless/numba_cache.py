@@ -97,7 +97,8 @@ def kernel_sources(root: str | Path) -> list[Path]:
     """The kernel closure of the package in ``root``: its files that define numba kernels and every module of
     this distribution they import, transitively (sorted, resolved paths)."""
     root = Path(root).resolve()
-    todo = [p for p in root.rglob("*.py") if "numba" in (text := p.read_text(encoding="utf-8")) and _KERNEL.search(text)]
+    todo = [p for p in root.rglob("*.py")
+            if "numba" in (text := p.read_text(encoding="utf-8")) and _KERNEL.search(text)]
     seen: set[Path] = set()
     while todo:
         path = todo.pop()

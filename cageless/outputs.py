@@ -216,6 +216,10 @@ def output_lock(folder: str | Path, what: str = "output folder") -> Iterator[Non
         yield
     finally:
         info_path.unlink(missing_ok=True)
+        try:  # no stray lock file is left in the user's folder (removed while still held: no other run saw it free)
+            lock_path.unlink(missing_ok=True)
+        except OSError:  # Windows: an open file cannot be removed; it stays, empty, as filelock leaves it
+            pass
         lock.release()
         _remove_if_empty(created, lock_path)
 

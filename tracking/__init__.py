@@ -14,3 +14,13 @@ from pathlib import Path as _Path
 from cageless import numba_cache as _numba_cache
 
 _numba_cache.register(_Path(__file__).resolve().parent)
+
+
+def compile_notice() -> str | None:
+    """A line for the user when the next tracking run compiles the tracking loop first (after an install or an
+    upgrade, one to two minutes on two cores), else ``None``."""
+    from cageless.tracking.link_kernel import run_block
+
+    if _numba_cache.is_compiled(run_block) is False:
+        return "compiling the tracker (first run after an install or upgrade only; 1-3 min, then it is cached)"
+    return None

@@ -81,6 +81,8 @@ class LabOptions:
     #: Where the parameters came from when a calibration file gave them (one line), or None.
     calibration: str | None = None
     n_balls: int | None = None
+    #: Track the complete frames of a cut-off ``.cine`` (``--allow-truncated``) instead of failing its row.
+    allow_truncated: bool = False
     #: What slip is referred to in the comparison (a key of ``cageless.comparison.compare.SLIP_REFERENCES``).
     slip_reference: str = "cage"
 
@@ -91,7 +93,8 @@ class LabOptions:
                 "force": self.force, "parameter_set": self.parameter_set, "parameters": dict(self.parameters),
                 "n_balls": self.n_balls,
                 "slip_reference": self.slip_reference, "peak_estimator": peak_estimator(),
-                **({"calibration": self.calibration} if self.calibration else {})}
+                **({"calibration": self.calibration} if self.calibration else {}),
+                **({"allow_truncated": True} if self.allow_truncated else {})}
 
 
 @dataclass
@@ -109,11 +112,12 @@ class LabResult:
 # -- jobs (top-level so processes and Dask workers can run them) --------------------------------------
 
 def _track_job(video: str, conditions: OperatingConditions, bearing: Bearing, out_dir: str,
-               n_balls: int | None = None) -> tuple[str, str]:
+               n_balls: int | None = None, allow_truncated: bool = False) -> tuple[str, str]:
     from cageless.tracking.pipeline import TrackOptions, track_video
 
+    options = TrackOptions(n_balls=n_balls, allow_truncated=allow_truncated)
     try:
-        res = track_video(video, conditions, bearing, TrackOptions(n_balls=n_balls), out_dir=out_dir, progress=False,
+        res = track_video(video, conditions, bearing, options, out_dir=out_dir, progress=False,
                           config={"command": "report"})
     except CagelessError as exc:
         return "failed", str(exc)
@@ -323,7 +327,7 @@ def _run_lab(folder: str | Path, out: Path, options: LabOptions | None, bearing:
     good = [e for e in entries if e.ok and e.video in bearings]
     with job_pool(options.workers, options.scheduler) as pool:
         t0 = time.perf_counter()
-        traces, n_skip = _track_all(pool, good, bearings, out, cache, progress, options.n_balls)
+        traces, n_skip = _track_all(pool, good, bearings, out, cache, progress, options)
         skipped += n_skip
         timings["tracking"] = time.perf_counter() - t0
         for e in good:
@@ -395,20 +399,27 @@ def _collect(results: dict[Any, Any], pending: list[Any], keys: list[str], outco
 
 
 def _track_all(pool: Any, entries: list[LabEntry], bearings: dict[Path, Bearing], out: Path, cache: _Cache,
-               progress: bool, n_balls: int | None = None) -> tuple[dict[Path, Any], int]:
+               progress: bool, options: LabOptions) -> tuple[dict[Path, Any], int]:
     traces: dict[Path, Any] = {}
     jobs, keys, pending = [], [], []
+    n_balls, cut = options.n_balls, {"allow_truncated": True} if options.allow_truncated else {}
     for e in entries:
         key = cache.key("track", {"input": hash_file(e.video, "blake3"), "conditions": e.resolved.conditions.to_dict(),
-                                  "bearing": bearings[e.video].to_dict(), "n_balls": n_balls})
+                                  "bearing": bearings[e.video].to_dict(), "n_balls": n_balls, **cut})
         hit = cache.hit(key)
         if hit:
             traces[e.video] = hit
             continue
         jobs.append((_track_job, (str(e.video), e.resolved.conditions, bearings[e.video], str(out / "traces"),
-                                  n_balls)))
+                                  n_balls, options.allow_truncated)))
         keys.append(key)
         pending.append(e.video)
+    if jobs and progress:
+        from cageless.tracking import compile_notice as tracking_compile_notice
+
+        notice = tracking_compile_notice()
+        if notice:
+            tqdm.write(notice, file=sys.stderr)
     _collect(traces, pending, keys, _run_jobs(pool, jobs, "tracking", progress, [p.name for p in pending]), cache)
     return traces, len(entries) - len(jobs)
 

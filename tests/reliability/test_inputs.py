@@ -89,6 +89,17 @@ def test_r31_truncated_cine_has_a_cli_flag(tmp_path, capsys, cine40):
     assert_clean(run, 1, "is truncated", "--allow-truncated")
     run = cli(capsys, "info", cut, "--allow-truncated")
     assert_clean(run, 0, "frames            34")
+    # report's track jobs take the flag too (its failed row gives the same hint)
+    from cageless.app.lab import _track_job
+    from cageless.conditions import OperatingConditions
+    from cageless.config import bearing_from_config
+
+    job = (str(cut), OperatingConditions(speed_rpm=3000.0, radial_load_n=500.0), bearing_from_config({}),
+           str(tmp_path / "r"), None)
+    status, why = _track_job(*job)
+    assert status == "failed" and "--allow-truncated" in why
+    status, path = _track_job(*job, True)
+    assert status == "ok" and Path(path).is_file()
 
 
 def test_r32_png_sequence_with_a_missing_frame_names_it(tmp_path, capsys, png30):
@@ -328,3 +339,18 @@ def test_an_empty_mp4_gives_one_line_not_ffmpegs_too(tmp_path):
     run = cli_subprocess("info", empty)
     assert_clean(run, 1, "OpenCV cannot open this video")
     assert run.err.count("\n") == 1 and "moov atom" not in run.err, run.err
+
+
+def test_a_typed_speed_that_the_file_name_overrules_is_not_dropped_silently(tmp_path, capsys, cine40):
+    """`--speed-rpm` stands in only where no source gives the conditions; where the file name does, the run says the
+    typed value is not used (a new user typed 3000 for n6000_*.cine and got 6000 without a word)."""
+    from cageless.app.cli.track import collect_inputs
+
+    clip = tmp_path / "n6000_Fr500.cine"
+    shutil.copy(cine40, clip)
+    (entry,) = collect_inputs([str(clip)], 3000.0)
+    assert entry.resolved.conditions.speed_rpm == 6000.0
+    err = capsys.readouterr().err
+    assert "--speed-rpm 3000 is not used: its file name gives 6000 r/min" in err
+    collect_inputs([str(clip)], 6000.0)  # the same value: nothing to say
+    assert capsys.readouterr().err == ""

@@ -25,8 +25,7 @@ def test_r01_sample_does_not_overwrite_a_users_recording(tmp_path, capsys):
     assert_clean(run, 2, "n6000_Fr500_Fa0.cine", "conditions.csv", "--overwrite")
     assert (lab / "n6000_Fr500_Fa0.cine").read_text() == "MINE\n"
     assert (lab / "conditions.csv").read_text() == "file,speed_rpm\nmine.cine,1000\n"
-    assert sorted(p.name for p in lab.iterdir() if not p.name.startswith(".")) == ["conditions.csv",
-                                                                                    "n6000_Fr500_Fa0.cine"]
+    assert sorted(p.name for p in lab.iterdir()) == ["conditions.csv", "n6000_Fr500_Fa0.cine"]  # no lock file left
 
 
 def test_r01_sample_may_replace_what_it_wrote_itself(tmp_path, capsys, monkeypatch):

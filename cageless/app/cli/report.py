@@ -53,6 +53,8 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
                    "numbers and conditions outside their plausible ranges")
     p.add_argument("--n-balls", type=int, metavar="N",
                    help="ball count the videos show, when it differs from the bearing's (default: the bearing's)")
+    p.add_argument("--allow-truncated", action="store_true",
+                   help="track the complete frames of a cut-off .cine instead of failing its row")
 
 
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
@@ -79,7 +81,8 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     options = LabOptions(duration_s=args.duration, settle_s=args.settle, revolutions=args.revolutions,
                          rtol=args.rtol, workers=args.workers,
                          scheduler=args.scheduler, force=args.force, parameters=values, calibration=note,
-                         n_balls=args.n_balls, slip_reference=args.slip_reference,
+                         n_balls=args.n_balls, allow_truncated=args.allow_truncated,
+                         slip_reference=args.slip_reference,
                          parameter_set=args.parameter_set or DEFAULT_SET)
     if not find_videos(args.lab):  # find_videos names a missing folder; say so before any output
         raise CagelessError(f"{args.lab}: no videos found. A lab folder holds videos (cine, avi/mp4/mkv or image "

@@ -96,15 +96,23 @@ def collect_inputs(inputs: list[str], speed_rpm: float | None) -> list[LabEntry]
             entries.extend(_with_speed(e, speed_rpm) for e in found)
         else:
             try:
-                entries.append(LabEntry(video=p, resolved=resolve_conditions(p)))
+                entries.append(_with_speed(LabEntry(video=p, resolved=resolve_conditions(p)), speed_rpm))
             except CagelessError as exc:
                 entries.append(_with_speed(LabEntry(video=p, error=exc), speed_rpm))
     return refuse_shared_names(entries)
 
 
 def _with_speed(entry: LabEntry, speed_rpm: float | None) -> LabEntry:
-    """Let --speed-rpm stand in where no source gave the conditions."""
-    if speed_rpm is None or entry.ok:
+    """Let --speed-rpm stand in where no source gave the conditions; say so where a source overrules it."""
+    if speed_rpm is None:
+        return entry
+    if entry.ok:
+        given = entry.resolved.conditions.speed_rpm
+        if given != speed_rpm:
+            source = entry.resolved.origin.get("speed_rpm", "its conditions")
+            print(f"warning: {entry.video}: --speed-rpm {speed_rpm:g} is not used: its {source} gives {given:g} r/min "
+                  "(the video's own conditions win; change them there, or copy the video under another name)",
+                  file=sys.stderr)
         return entry
     from cageless.conditions import ResolvedConditions
 
@@ -180,6 +188,7 @@ def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bear
                 print(failed_line(e.video, exc, shown=_shown(e.video)), file=sys.stderr)
                 failed += 1
     workers = max(1, min(args.workers, len(jobs)))
+    _say_if_compiling(bool(jobs) and not args.quiet)
     with tqdm(total=len(jobs), desc="videos", unit="video", disable=args.quiet or not jobs) as bar:
         results = _map(jobs, workers, bar)
         for (video, *_), (status, info) in zip(jobs, results, strict=True):
@@ -192,6 +201,16 @@ def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bear
                 tqdm.write(failed_line(video, info, shown=_shown(video)), file=sys.stderr)
                 failed += 1
     return 1 if failed else 0
+
+
+def _say_if_compiling(show: bool) -> None:
+    """Tell the user when the first video will wait for the tracker's one-off compile (the bar stands still)."""
+    if show:
+        from cageless.tracking import compile_notice
+
+        notice = compile_notice()
+        if notice:
+            tqdm.write(notice, file=sys.stderr)
 
 
 def _namer(inputs: list[str]) -> Callable[[Path], str]:
