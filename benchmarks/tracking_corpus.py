@@ -1,7 +1,7 @@
-"""The tracker on the independent corpus: every clip of the four seed sets, scored against issue 14's bars.
+"""The tracker on the independent corpus: every clip of the five seed sets, scored against issue 14's bars.
 
-    python benchmarks/tracking_corpus.py [--cache DIR] [--sets TUNING,HOLDOUT,FRESH,FRESH2] [--workers 2] [--long]
-                                         [--seeds 1000,1001] [--json out.json]
+    python benchmarks/tracking_corpus.py [--cache DIR] [--sets TUNING,HOLDOUT,FRESH,FRESH2,FRESH3] [--workers 2]
+                                         [--long] [--seeds 1000,1001] [--json out.json]
 
 Renders each clip once into ``--cache`` (default ``/tmp/cageless-corpus``; reused while the
 software version and the seed's parameters are unchanged), tracks it with the current tracker,
@@ -10,8 +10,8 @@ each highlight is: where it passes, the pixels support the bars) and the Cramér
 (tracking/synthetic/crb.py: under the bar, no clip is out of reach in principle) and prints, per set, one row per clip (its factors,
 balls found, identity swaps, angle / speed / slip-profile errors, pass or fail and why), the
 pass count and the worst clip. ``--long`` runs the long variants (one cage revolution each; their videos
-are deleted after scoring unless ``--keep``). The short clips take about 9 GB for two sets. Score HOLDOUT, FRESH
-and FRESH2 only once a change is final: they are never tuned on (tracking/synthetic/matrix.py).
+are deleted after scoring unless ``--keep``). The short clips take about 9 GB for two sets. Score HOLDOUT, FRESH,
+FRESH2 and FRESH3 only once a change is final: they are never tuned on (tracking/synthetic/matrix.py).
 """
 
 from __future__ import annotations
@@ -77,7 +77,7 @@ def format_set(name: str, results: list[ClipResult]) -> str:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--cache", type=Path, default=Path("/tmp/cageless-corpus"))
-    ap.add_argument("--sets", default="TUNING,HOLDOUT,FRESH,FRESH2")
+    ap.add_argument("--sets", default=",".join(SETS))
     ap.add_argument("--seeds", help="comma-separated seeds instead of whole sets")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--long", action="store_true")

@@ -1,4 +1,4 @@
-"""Issue 14's bars on every clip of the independent corpus, all four seed sets (tracking/synthetic/matrix.py).
+"""Issue 14's bars on every clip of the independent corpus, all five seed sets (tracking/synthetic/matrix.py).
 
 Bars (issue 14, "A corpus that does not flatter the tracker"): exactly Z balls, 0 identity swaps, angle
 RMS <= 0.5 mrad, speed RMS <= 0.5 % of the cage speed, slip-profile MAE <= 0.3 pp (scorer:
@@ -7,7 +7,7 @@ test_corpus_renderer.py).
 
 CI runs the first block of 8 seeds of each set (each block covers every factor's range ends); the other
 clips and the long variants are ``slow`` (``--runslow``). The long variants are those of TUNING and HOLDOUT
-(FRESH's and FRESH2's were not rendered). Clips render once per session into
+(FRESH's, FRESH2's and FRESH3's were not rendered). Clips render once per session into
 ``$CAGELESS_CORPUS_CACHE`` (default: a pytest temporary folder, each video deleted once scored) on two
 processes.
 
@@ -22,13 +22,13 @@ from pathlib import Path
 
 import pytest
 
-from cageless.tracking.synthetic.matrix import FRESH, FRESH2, HOLDOUT, TUNING
+from cageless.tracking.synthetic.matrix import FRESH, FRESH2, FRESH3, HOLDOUT, TUNING
 from cageless.tracking.synthetic.runner import run_seeds
 from cageless.tracking.synthetic.score import BARS
 
-CI_SEEDS = (*TUNING[:8], *HOLDOUT[:8], *FRESH[:8], *FRESH2[:8])
+CI_SEEDS = (*TUNING[:8], *HOLDOUT[:8], *FRESH[:8], *FRESH2[:8], *FRESH3[:8])
 ALL = ([("TUNING", s) for s in TUNING] + [("HOLDOUT", s) for s in HOLDOUT] + [("FRESH", s) for s in FRESH]
-       + [("FRESH2", s) for s in FRESH2])
+       + [("FRESH2", s) for s in FRESH2] + [("FRESH3", s) for s in FRESH3])
 ALL_LONG = [(name, s) for name, s in ALL if name in ("TUNING", "HOLDOUT")]
 
 #: Seeds today's tracker fails on the short clips, with how (benchmarks/tracking_corpus.py, 2026-11-23: the
@@ -81,29 +81,40 @@ ALL_LONG = [(name, s) for name, s in ALL if name in ("TUNING", "HOLDOUT")]
 #: mrad; no clip fails anew) and FRESH2 (seeds 7200-7231, added before the change and never tuned on) 25 -> 25 (7201
 #: 2.32 -> 2.20 mrad, still failing; 7220 refused by both: 71 % of the ball positions lost; 7218 a trace 17.1 mrad
 #: off with every ball found, both).
+#: With the backward pass started from where the forward pass settled (tracking/link.py SETTLE_FRAMES; 2026-11-27,
+#: all five sets run once with the final change, HOLDOUT, FRESH and FRESH2 beside main c3551a8, same renders, no
+#: oracle): TUNING 30 (1011 0.592, 1022 0.536 mrad as before), HOLDOUT 28 -> 28 (7026 1.28 -> 3.09 mrad: the backward
+#: pass slid onto the other light's lobe over frames 0-8 of one ball), FRESH 27 -> 27, FRESH2 25 -> 26 (7209 passes,
+#: 0.736 -> 0.279 mrad; 7224 0.724 -> 0.690) and FRESH3 (7304-7335, added before this change, never tuned on, run
+#: once) 28: 7304 and 7334 refused by the selection (7 of 16, 11 of 17 balls), 7317 and 7329 fail. The long variants
+#: were not re-run with this change.
 #: Remove a seed when it passes.
 KNOWN_FAILURES: dict[int, str] = {
-    1011: "angle_rms 0.592 mrad > 0.5; speed_rms 0.687 % of cage speed > 0.5; slip_mae 0.407 pp > 0.3",
+    1011: "angle_rms 0.592 mrad > 0.5; speed_rms 0.686 % of cage speed > 0.5; slip_mae 0.407 pp > 0.3",
     1022: "angle_rms 0.536 mrad > 0.5",
     7004: "speed_rms 0.698 % of cage speed > 0.5",
     7009: "angle_rms 0.633 mrad > 0.5",
-    7018: "angle_rms 0.651 mrad > 0.5",
-    7026: "angle_rms 1.28 mrad > 0.5",
+    7018: "angle_rms 0.65 mrad > 0.5",
+    7026: "angle_rms 3.09 mrad > 0.5; speed_rms 1.61 % of cage speed > 0.5; slip_mae 0.365 pp > 0.3",
     7112: "angle_rms 0.504 mrad > 0.5",
-    7116: "angle_rms 0.534 mrad > 0.5",
+    7116: "angle_rms 0.535 mrad > 0.5",
     7117: "angle_rms 0.707 mrad > 0.5; speed_rms 0.641 % of cage speed > 0.5",
-    7124: "angle_rms 1.36 mrad > 0.5; speed_rms 0.71 % of cage speed > 0.5",
+    7124: "angle_rms 1.35 mrad > 0.5; speed_rms 0.711 % of cage speed > 0.5",
     7134: "angle_rms 0.924 mrad > 0.5",
-    7201: "angle_rms 2.2 mrad > 0.5; speed_rms 1.5 % of cage speed > 0.5; slip_mae 0.867 pp > 0.3",
-    7209: "angle_rms 0.736 mrad > 0.5; speed_rms 0.651 % of cage speed > 0.5 (2.69 mrad, 2.26 % before frames whose "
-          "highlights jump together were flagged)",
+    7201: "angle_rms 2.2 mrad > 0.5; speed_rms 1.5 % of cage speed > 0.5; slip_mae 0.867 pp > 0.3 (JPEG q30 noise; "
+          "the oracle reads 4.42 mrad)",
     7218: "refused: the chosen circle (84.2 px, the bright gaps between balls) is -0.31 ball diameters off the "
           "pitch circle (99.5 px); before the check a trace 17.1 mrad RMS off",
     7220: "refused: the chosen circle (161.3 px, the gaps between balls) is -0.33 ball diameters off the pitch "
           "circle (187.4 px); before the check refused later, 71 % of the ball positions lost",
-    7224: "angle_rms 0.724 mrad > 0.5; speed_rms 1.63 % of cage speed > 0.5; slip_mae 0.522 pp > 0.3",
-    7226: "angle_rms 0.614 mrad > 0.5",
-    7228: "angle_rms 0.735 mrad > 0.5",
+    7224: "angle_rms 0.69 mrad > 0.5; speed_rms 1.34 % of cage speed > 0.5; slip_mae 0.435 pp > 0.3 (two lobes in "
+          "one window)",
+    7226: "angle_rms 0.607 mrad > 0.5 (two lobes in one window)",
+    7228: "angle_rms 0.74 mrad > 0.5 (frame-to-frame scatter on a 16 px ball; the oracle passes)",
+    7304: "refused: found 7 balls moving together along one circle, but 16 are expected",
+    7317: "angle_rms 1.02 mrad > 0.5",
+    7329: "angle_rms 0.715 mrad > 0.5",
+    7334: "refused: found 11 balls moving together along one circle, but 17 are expected",
 }
 
 #: The same for the long variants (one cage revolution each), "" = passes: all 64 seeds measured with the tracker of
