@@ -469,8 +469,7 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
             before, warm = warm, _warm_state(current, sol, warm)
             sessions += isinstance(warm, ArkSession) and warm is not before
             ys.append(sol.y)
-            for key in totals:
-                totals[key] += getattr(sol, key)
+            totals = {key: n + getattr(sol, key) for key, n in totals.items()}
             wall += sol.wall_s
             bar.update(float(t[b] - t[a]))
             if not sol.success:
@@ -499,15 +498,14 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
                 else:
                     schedule.not_stiff(i)
             y0, log, t0 = sol.y[-1].copy(), sol.extra.get("log", log), float(t[b])
-    joined = _joined(t, ys, sol, method, probes, wall, log, totals)
-    joined.extra["ark4_sessions"] = sessions
-    return joined
+    return _joined(t, ys, sol, method, probes, wall, log, totals, sessions)
 
 
 def _joined(t: npt.NDArray[np.float64], ys: list[npt.NDArray[np.float64]], sol: Solution | None, method: str,
             probes: list[dict[str, Any]], wall: float, log: npt.NDArray[np.float64],
-            totals: dict[str, int]) -> Solution:
-    """The chunks' samples and statistics as one solution (NaN after a failure)."""
+            totals: dict[str, int], sessions: int) -> Solution:
+    """The chunks' samples and statistics as one solution (NaN after a failure), with the ark4 sessions the run
+    started."""
     y = np.concatenate(ys)
     if len(y) < len(t):
         y = np.vstack([y, np.full((len(t) - len(y), y.shape[1]), np.nan)])
@@ -515,4 +513,4 @@ def _joined(t: npt.NDArray[np.float64], ys: list[npt.NDArray[np.float64]], sol: 
     used = method if method != "auto" else ("auto: dp5" + "".join(f" -> {p['to']} at {p['time_s']:.4g} s"
                                                                   for p in probes if p["switch"]))
     return Solution(t=t, y=y, status=sol.status, message=sol.message, method=used, wall_s=wall,
-                    extra={"log": log, "switches": probes}, **totals)
+                    extra={"log": log, "switches": probes, "ark4_sessions": sessions}, **totals)

@@ -91,22 +91,8 @@ def ark_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_st
     the same steps as one call. With ``t_stop = t_out[-1]`` and a fresh ``state`` it is one solve."""  # noqa: D401
     f, ki, yt, ynew, f_end, e, g0, g1, work, cnt = _buffers(y0.shape[0])
     y = rows[0]  # the integrator's state lives in the session's rows
-    if state[_S_ACTIVE] > 0.0:
-        t, h, err_old, held, t_cross, sig = _resume(state, rows, f, ki)
-        k = _samples_held(t_out, out, state, rows)
-    else:
-        y[:] = y0
-        t = t0
-        state[_S_T0] = t0
-        model_rhs(model_id, t, y, p, log, f[0])
-        model_implicit(model_id, t, y, p, 0.0, ki[0], work)
-        cnt[_RHS] = 1
-        sig = model_signature(model_id, y, p) if h_onset > 0.0 else 0.0
-        h = h0
-        err_old = 1e-4
-        held = False  # the last trial step was rejected: the next accepted one may not grow (Hairer & Wanner, II.4)
-        t_cross = -np.inf  # a contact change located ahead (see _onset_retry): the step that crosses it is short
-        k = _samples_before(t_out, t, y, out)
+    t, h, err_old, held, t_cross, sig, k = _start(model_id, p, log, y0, t0, h0, h_onset, t_out, out, state, rows, f,
+                                                  ki, work, cnt)
     status = STATUS_OK
     t_last = t_out[t_out.shape[0] - 1]
     tiny = 1e-13 * max(abs(t_stop), t_stop - state[_S_T0])
@@ -163,13 +149,25 @@ SESSION_ROWS = 5
 
 
 @numba.njit(cache=True, inline="always")
-def _resume(state, rows, f, ki):  # pragma: no cover - compiled
-    """The loop's variables from a session: f(y) and f_I(y) into f[0] and ki[0]; (t, h, err_old, held, t_cross,
-    sig)."""
-    f[0, :] = rows[1]
-    ki[0, :] = rows[2]
-    return (state[_S_T], state[_S_H], state[_S_ERR_OLD], state[_S_HELD] > 0.0, state[_S_T_CROSS],
-            state[_S_SIG])
+def _start(model_id, p, log, y0, t0, h0, h_onset, t_out, out, state, rows, f, ki, work, cnt):  # pragma: no cover
+    """The loop's variables at the start of a call, with f(y) and f_I(y) in f[0] and ki[0] and the samples at or
+    before its time written: (t, h, the controller's last error, whether the last trial step was refused, so that
+    the next accepted one may not grow (Hairer & Wanner, II.4), a contact change located ahead (see
+    :func:`_onset_retry`; the step that crosses it is short), the contact signature, the next sample's index).
+    Resumed from the session when it holds one (``state[0] > 0``), else from ``(t0, y0)`` and ``h0``."""
+    if state[_S_ACTIVE] > 0.0:
+        f[0, :] = rows[1]
+        ki[0, :] = rows[2]
+        return (state[_S_T], state[_S_H], state[_S_ERR_OLD], state[_S_HELD] > 0.0, state[_S_T_CROSS],
+                state[_S_SIG], _samples_held(t_out, out, state, rows))
+    y = rows[0]
+    y[:] = y0
+    state[_S_T0] = t0
+    model_rhs(model_id, t0, y, p, log, f[0])
+    model_implicit(model_id, t0, y, p, 0.0, ki[0], work)
+    cnt[_RHS] = 1
+    sig = model_signature(model_id, y, p) if h_onset > 0.0 else 0.0
+    return t0, h0, 1e-4, False, -np.inf, sig, _samples_before(t_out, t0, y, out)
 
 
 @numba.njit(cache=True, inline="always")

@@ -73,12 +73,12 @@ def test_a_switch_that_stops_paying_is_undone(monkeypatch):
 def test_the_default_scene_switches_once_past_its_start_up():
     """The default lubricated scene over 50 ms (1 ms chunks): DP5 is not held by stability over the first two
     chunks, while the balls spread, so nothing is probed there; the first stiff chunk (ending at 3 ms) is
-    probed: ark4 costs 0.11 of DP5 there, below SWITCH_GAIN of the least CVODE could cost (its probe measured 0.30
-    before it was skipped there), and the run switches to ark4. A burst of contacts then makes its chunks 2.5 times dearer than DP5 on the
-    probed chunk, the run goes back to DP5 at 6 ms, and the next stiff chunk's probe (before ark4 was kept across
-    chunks: CVODE 0.52, ark4 0.19; now ark4 0.13 and CVODE skipped) switches to ark4 again at 9 ms for the rest of
-    the run (measured; the cost model is deterministic). With
-    CVODE as the only candidate the switches were the same, to CVODE (0.30, then 3.7 times dearer, then 0.52).
+    probed: ark4 costs 0.11 of DP5 there, below SWITCH_GAIN of the least CVODE could cost (its probe measured
+    0.30 before it was skipped there), and the run switches to ark4. A burst of contacts then makes its chunks
+    2.5 times dearer than DP5 on the probed chunk, the run goes back to DP5 at 6 ms, and the next stiff chunk's
+    probe (before ark4 was kept across chunks: CVODE 0.52, ark4 0.19; now ark4 0.13 and CVODE skipped) switches
+    to ark4 again at 9 ms for the rest of the run (measured; the cost model is deterministic). With CVODE as the
+    only candidate the switches were the same, to CVODE (0.30, then 3.7 times dearer, then 0.52).
     The pilot over the first 0.1 ms: CVODE's cold start costs DP5's rate there, and ark4 runs out of its step
     budget in the start-up."""
     sol = _run(500.0, duration=0.05).solution
