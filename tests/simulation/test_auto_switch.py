@@ -131,7 +131,7 @@ def test_an_unknown_method_or_a_bad_cap_is_refused_before_anything_runs():
 
 
 def test_ark4_is_left_once_the_runs_refusals_reach_the_hard_cases_bound():
-    """At the spatial level the run's refused steps, judged from simulation.auto_switch.ARK_JUDGE_STEPS (50) accepted
+    """At the spatial level (planar: 0.2) the run's refused steps, judged from simulation.auto_switch.ARK_JUDGE_STEPS (50) accepted
     steps on, may not reach ARK_REFUSAL_BOUND (0.1, the hard cases' bound on a run) of them while ark4 runs: a run that reaches it
     leaves ark4, to CVODE where the probe that chose ark4 found CVODE paying (below SWITCH_GAIN, 0.8, of DP5),
     else to DP5; the record carries the run's refused share."""
@@ -141,7 +141,10 @@ def test_ark4_is_left_once_the_runs_refusals_reach_the_hard_cases_bound():
     chosen = {"costs": {"CVODE": 0.3, "ark4": 0.1}}
     assert _leave_ark(60, 5, SPATIAL, chosen, 0.01) is None  # 8.3 %
     assert _leave_ark(49, 30, SPATIAL, chosen, 0.01) is None  # too few steps to judge
-    assert _leave_ark(60, 30, PLANAR, chosen, 0.01) is None  # no bound at the planar level
+    # the planar level's bound is its hard cases' 0.2; a probe that skipped CVODE (ark4 first) leaves to DP5
+    assert _leave_ark(60, 11, PLANAR, chosen, 0.01) is None
+    assert _leave_ark(60, 12, PLANAR, chosen, 0.01)["to"] == "CVODE"
+    assert _leave_ark(60, 12, PLANAR, {"costs": {"ark4": 0.1}, "skipped": {"CVODE": 0.25}}, 0.01)["to"] == "dp5"
     left = _leave_ark(60, 6, SPATIAL, chosen, 0.01)
     assert left["switch"] and left["to"] == "CVODE" and left["run_refused"] == pytest.approx(0.1)
     assert left["time_s"] == 0.01 and left["cost_ratio"] == pytest.approx(0.3)
