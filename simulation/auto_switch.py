@@ -46,6 +46,13 @@ stiff backend stops paying: a dry scene at the spatial level (allowed to switch 
 
 The stiff backend cannot take a step back; after a switch it is stopped ahead of predicted contact
 onsets instead (see :func:`cageless.simulation.solve.step_cvode`).
+
+Both stiff backends are kept across chunks (:class:`cageless.simulation.solve.CvodeSession`,
+:class:`cageless.simulation.solve.ArkSession`): ``ark4`` steps on towards the run's end and returns only where a
+chunk's samples are written, so a run on it takes the steps one solve takes. At the planar level
+(:data:`ARK_FIRST_MODELS`) ``ark4`` is probed before CVODE, and CVODE is not probed when ``ark4`` already costs below
+:data:`SWITCH_GAIN` of the least CVODE could cost on the chunk (its steps capped, one right-hand side each): the
+choice is then ``ark4`` whatever CVODE's probe would give, and the probe record says so (``skipped``).
 """
 
 from __future__ import annotations
@@ -61,11 +68,13 @@ from tqdm.auto import tqdm
 from cageless.simulation._cache import compile_notice
 from cageless.simulation.kernels import PLANAR, SPATIAL
 from cageless.simulation.problem import Problem
-from cageless.simulation.solve import CvodeSession, Solution, solve, step_cvode
+from cageless.simulation.integrators.dp5 import STATUS_MAX_STEPS, STATUS_OK
+from cageless.simulation.solve import ArkSession, CvodeSession, Solution, solve, step_ark, step_cvode
 
 __all__ = ["solve_chunks", "default_max_step", "CONTACT_MAX_STEP_S", "MAX_STEP_S", "RTOL_FACTOR", "STIFF_FRACTION",
            "RHS_COST_US", "STEP_COST_US", "SWITCH_GAIN", "STIFF_METHODS", "ARK_MODELS", "PROBE_CHUNKS",
-           "BACK_WINDOW", "SWITCH_WHEN_DRY", "PROBE_BACKOFF", "PILOT_FRACTION", "ARK_REFUSAL_BOUND", "ARK_JUDGE_STEPS"]
+           "BACK_WINDOW", "SWITCH_WHEN_DRY", "PROBE_BACKOFF", "PILOT_FRACTION", "ARK_REFUSAL_BOUND", "ARK_JUDGE_STEPS",
+           "ARK_FIRST_MODELS"]
 
 #: The progress bar shows simulated seconds without tqdm's rate, which for a simulation slower than real
 #: time reads as an inverted "s/s" figure; {n:.4g} also hides float noise of the summed step lengths.
@@ -90,12 +99,20 @@ ARK_MODELS: frozenset[int] = frozenset({PLANAR, SPATIAL})
 #: test_spatial.py). The run's, not ark4's own: ark4 refuses one step at most contact changes, and its steps are
 #: few (settled 5 ms windows at 3000 rpm: 17 of 174 planar, 21 of 146 spatial), so its own share sits near the
 #: bound without any trouble, while in the 1 mrad tilt's start-up it refused 680 of 1799 (the spins against the
-#: traction slope). A probe whose ark4 run would take the run's share (its steps and refusals added to the run's)
+#: traction slope). Since ark4 is kept across chunks (its steps no longer cut at every chunk's end, so fewer) the
+#: settled spatial 5 ms window from a DP5 chunk reaches the bound at 3 ms (18 refused, none at contact changes,
+#: 0.107 of the run's steps) and goes on on CVODE. A probe whose ark4 run would take the run's share (its steps and refusals added to the run's)
 #: to the bound does not choose ark4, and a run on ark4 that reaches it leaves ark4 (:func:`_leave_ark`).
-#: By model id; a model without an entry has no bound: at the planar level the guard moved the default 500 N scene
-#: off ark4 in its burst of contacts (dp5 -> ark4 at 3 ms -> CVODE at 5 ms -> dp5 at 8 ms -> ark4 at 10 ms, against
-#: dp5 -> ark4 at 3 ms -> dp5 at 6 ms -> ark4 at 9 ms), whose hard cases pass without it; not measured further.
-ARK_REFUSAL_BOUND: dict[int, float] = {SPATIAL: 0.1}
+#: By model id, each level's hard-case bound (planar 0.2, tests/validation/test_hard_cases.py). At the planar level
+#: 0.1 moved the default 500 N scene off ark4 in its burst of contacts (dp5 -> ark4 at 3 ms -> CVODE at 5 ms -> dp5
+#: at 8 ms -> ark4 at 10 ms, against dp5 -> ark4 at 3 ms -> dp5 at 6 ms -> ark4 at 9 ms), and none was needed while
+#: ark4 restarted at every chunk; kept across chunks, its fewer steps took the 10 N hard case to 633 refused of 3033.
+ARK_REFUSAL_BOUND: dict[int, float] = {SPATIAL: 0.1, PLANAR: 0.2}
+#: The models on which ``ark4`` is probed before CVODE and CVODE is skipped where it cannot be chosen (see
+#: :func:`_probe`). Not the spatial level: there a run that reaches :data:`ARK_REFUSAL_BOUND` leaves ark4 for CVODE
+#: where CVODE's probe found it paying, which needs that probe (the settled 500 N + 400 N window does, at 3 ms).
+#: At the planar level a run that leaves ark4 without CVODE's figure goes back to DP5 and probes again later.
+ARK_FIRST_MODELS: frozenset[int] = frozenset({PLANAR})
 #: Accepted steps of the run below which the share is not judged (one refusal in a few steps is not a trend).
 ARK_JUDGE_STEPS = 50
 #: Cost of one right-hand-side evaluation by model id (us), the compiled DP5 loop's own work included (its
@@ -200,6 +217,49 @@ def _ark_refusing(steps: int, refused: int, model_id: int) -> bool:
     return steps >= ARK_JUDGE_STEPS and refused >= ARK_REFUSAL_BOUND.get(model_id, np.inf) * steps
 
 
+class _ArkProbe:
+    """An ``ark4`` probe over one chunk that can be extended: run to a cost bar's step budget (:func:`_ark_budget`)
+    and, when a later bar is higher, resumed in its session (:class:`cageless.simulation.solve.ArkSession`) up to the
+    new budget, so that probing it before CVODE and again after costs what one probe at the higher bar costs."""
+
+    def __init__(self, part: Problem, t: npt.NDArray[np.float64], kw: dict[str, Any], dp5_cost: float,
+                 run_counts: tuple[int, int]) -> None:
+        self.part, self.t, self.settings = part, t, _settings("ark4", kw)
+        self.dp5_cost, self.run_counts = dp5_cost, run_counts
+        self.session: ArkSession | None = None
+        self.trials = self.steps = self.refused = self.rhs = 0
+        self.wall, self.done, self.failed = 0.0, False, False
+
+    def ratio(self, bar: float) -> float:
+        """ark4's modelled cost on the chunk over DP5's, probed with the step budget of ``bar`` (us); inf when it
+        runs out of that budget, fails, or would take the run's refused share to :data:`ARK_REFUSAL_BOUND`."""
+        budget = min(self.settings["max_steps"], _ark_budget(bar, self.part.model_id))
+        if not self.done and not self.failed and budget > self.trials:
+            sol = step_ark(self.part, self.t, self.settings["rtol"], self.settings["max_step"], budget - self.trials,
+                           self.settings["force_jump"], session=self.session, t_stop=float(self.t[-1]))
+            self.session = sol.extra["ark4"]
+            self.trials += sol.n_steps + sol.n_rejected
+            self.steps, self.refused = self.steps + sol.n_steps, self.refused + sol.n_rejected
+            self.rhs += sol.n_rhs
+            self.wall += sol.wall_s
+            self.done = sol.success
+            self.failed = not sol.success and sol.status != STATUS_MAX_STEPS  # out of its budget: may go on
+        if not self.done or _ark_refusing(self.run_counts[0] + self.steps, self.run_counts[1] + self.refused,
+                                          self.part.model_id):
+            return np.inf
+        cost = self.rhs * RHS_COST_US.get(self.part.model_id, 1.0) + self.trials * STEP_COST_US.get(
+            ("ark4", self.part.model_id), 30.0)
+        return cost / self.dp5_cost
+
+
+def _cvode_floor(part: Problem, t: npt.NDArray[np.float64], kw: dict[str, Any], dp5_cost: float) -> float:
+    """A lower bound of CVODE's modelled cost over DP5's on the chunk: its steps are at most its cap long, and each
+    takes at least one right-hand side (see :func:`_cost`)."""
+    steps = np.ceil((float(t[-1]) - part.t0) / _settings("CVODE", kw)["max_step"])
+    return float(steps * (RHS_COST_US.get(part.model_id, 1.0) + STEP_COST_US.get(("CVODE", part.model_id), 30.0))
+                 / dp5_cost)
+
+
 def _probe(part: Problem, t: npt.NDArray[np.float64], sol: Solution, time_s: float,
            kw: dict[str, Any], run_counts: tuple[int, int] = (0, 0)) -> dict[str, Any]:
     """Run each stiff backend (:data:`STIFF_METHODS`, in order) over the chunk ``sol`` covered and say whether
@@ -208,31 +268,39 @@ def _probe(part: Problem, t: npt.NDArray[np.float64], sol: Solution, time_s: flo
     on near ties (1800 rpm bunching: CVODE 0.48, ark4 0.45 of DP5) the run keeps CVODE, as before ark4 was a
     candidate. An ``ark4`` probe stops at the step budget of that bar (:func:`_ark_budget`) and then counts as
     inf, as does one that would take the run's refused share (``run_counts``: its accepted and refused steps so
-    far, the probe's added) to :data:`ARK_REFUSAL_BOUND`. The record names the choice (``to``), its cost ratio to
-    DP5 and every candidate's (``costs``), and ark4's refused share in the probe (``ark4_refused``)."""
+    far, the probe's added) to :data:`ARK_REFUSAL_BOUND`. On :data:`ARK_FIRST_MODELS`, ``ark4`` is probed first,
+    against :data:`SWITCH_GAIN` of CVODE's least possible cost (:func:`_cvode_floor`): below it, the rule above
+    chooses ark4 whatever CVODE's probe would give, so CVODE is not probed (``skipped`` records its bound); else
+    the probes run as above, ark4's resumed where the first stopped. The record names the choice (``to``), its
+    cost ratio to DP5 and every probed candidate's (``costs``), and ark4's refused share (``ark4_refused``)."""
     dp5_cost = max(_cost(sol, part.model_id), 1.0)
+    ark = (_ArkProbe(part, t, kw, dp5_cost, run_counts)
+           if "ark4" in STIFF_METHODS and part.model_id in ARK_MODELS else None)
     costs: dict[str, float] = {}
-    best, wall, refused = STIFF_METHODS[0], 0.0, None
-    for method in STIFF_METHODS:
-        if method == "ark4" and part.model_id not in ARK_MODELS:
+    skipped: dict[str, float] = {}
+    best, wall = STIFF_METHODS[0], 0.0
+    if ark is not None and "CVODE" in STIFF_METHODS and part.model_id in ARK_FIRST_MODELS:
+        floor = SWITCH_GAIN * min(_cvode_floor(part, t, kw, dp5_cost), 1.0)
+        first = ark.ratio(floor * dp5_cost)
+        if first < floor:
+            costs["ark4"], skipped["CVODE"], best = first, floor / SWITCH_GAIN, "ark4"
+    for method in STIFF_METHODS if not skipped else ():
+        if method == "ark4" and ark is None:
             continue
-        settings = _settings(method, kw)
         incumbent = costs.get(best, np.inf)  # what the method must beat: the choice so far if it pays, else DP5
         bar = SWITCH_GAIN * (incumbent if incumbent < SWITCH_GAIN else 1.0) * dp5_cost
         if method == "ark4":
-            settings["max_steps"] = min(settings["max_steps"], _ark_budget(bar, part.model_id))
-        trial = solve(part, t, method=method, **settings)
-        wall += trial.wall_s
-        costs[method] = _cost(trial, part.model_id) / dp5_cost if trial.success else np.inf
-        if method == "ark4":
-            refused = trial.n_rejected / max(trial.n_steps, 1)
-            if _ark_refusing(run_counts[0] + trial.n_steps, run_counts[1] + trial.n_rejected, part.model_id):
-                costs[method] = np.inf
+            costs[method] = ark.ratio(bar)
+        else:
+            trial = solve(part, t, method=method, **_settings(method, kw))
+            wall += trial.wall_s
+            costs[method] = _cost(trial, part.model_id) / dp5_cost if trial.success else np.inf
         if method != best and costs[method] * dp5_cost < bar:
             best = method
+    refused = ark.refused / max(ark.steps, 1) if ark is not None and ark.trials else None
     return {"time_s": time_s, "stiff_fraction": sol.n_stiff_steps / max(sol.n_steps, 1), "cost_ratio": costs[best],
-            "switch": bool(costs[best] < SWITCH_GAIN), "to": best, "costs": costs, "wall_s": wall,
-            "ark4_refused": refused}
+            "switch": bool(costs[best] < SWITCH_GAIN), "to": best, "costs": costs, "skipped": skipped,
+            "wall_s": wall + (ark.wall if ark is not None else 0.0), "ark4_refused": refused}
 
 
 def _pilot(pr: Problem, t_first: float, kw: dict[str, Any]) -> dict[str, Any] | None:
@@ -268,26 +336,49 @@ def _settings(method: str, kw: dict[str, Any]) -> dict[str, Any]:
             "rtol": kw["rtol"] * RTOL_FACTOR.get(method, 1.0)}
 
 
-def _step_chunk(part: Problem, t: npt.NDArray[np.float64], current: str, kw: dict[str, Any],
-                warm: CvodeSession | float | None) -> Solution:
-    """One chunk with the current method, warm from the chunk before when it ran the same method: CVODE keeps its
-    session (see simulation.solve.CvodeSession), the IMEX method starts at its last step length (from the
-    default first step, a tenth of a microsecond for 0.1 ms chunks, it took 1306 steps where one solve takes
-    752 over 5 ms settled at 3000 rpm, 500 N). DP5 starts afresh each chunk, as it always has."""
+Warm = CvodeSession | ArkSession | None
+
+
+def _step_chunk(part: Problem, t: npt.NDArray[np.float64], current: str, kw: dict[str, Any], warm: Warm,
+                t_stop: float) -> Solution:
+    """One chunk with the current method, warm from the chunk before when it ran the same method: CVODE and the
+    IMEX method keep their sessions (:class:`cageless.simulation.solve.CvodeSession`,
+    :class:`cageless.simulation.solve.ArkSession`; the latter steps on towards the run's end ``t_stop`` and only
+    returns where a chunk's samples are written). DP5 starts afresh each chunk, as it always has."""
     settings = _settings(current, kw)
     if current == "CVODE":
         return step_cvode(part, t, settings["rtol"], settings["max_step"], max_steps=settings["max_steps"],
                           session=warm if isinstance(warm, CvodeSession) else None)
-    if current == "ark4" and isinstance(warm, float):
-        settings["first_step"] = min(warm, settings["max_step"])
+    if current == "ark4":
+        return step_ark(part, t, settings["rtol"], settings["max_step"], settings["max_steps"], settings["force_jump"],
+                        session=warm if isinstance(warm, ArkSession) else None, t_stop=t_stop)
     return solve(part, t, method=current, **settings)
 
 
-def _warm_state(current: str, sol: Solution, before: CvodeSession | float | None) -> CvodeSession | float | None:
+def _warm_state(current: str, sol: Solution, before: Warm) -> Warm:
     """What the next chunk of the same method starts from (see :func:`_step_chunk`)."""
     if current == "CVODE":
         return sol.extra.get("cvode", before)
-    return float(sol.extra["last_h"]) if current == "ark4" and sol.extra.get("last_h", 0.0) > 0.0 else None
+    return sol.extra.get("ark4") if current == "ark4" else None
+
+
+def _chunk(pr: Problem, t: npt.NDArray[np.float64], current: str, kw: dict[str, Any], warm: Warm, t_stop: float,
+           left: ArkSession | None) -> tuple[Solution, Problem, npt.NDArray[np.float64], ArkSession | None]:
+    """One chunk from ``pr`` over the samples ``t``, where ``left`` is an ark4 session the run has just left: its
+    integrator is up to one step past the last sample written, so the chunk's samples up to there come from its
+    last step, and ``current`` goes on from its time, state and contact log. (The solution, the problem and the
+    samples ``current`` ran, the session still left when the whole chunk lay behind it.)"""
+    if left is None:
+        return _step_chunk(pr, t, current, kw, warm, t_stop), pr, t, None
+    behind = t[t <= left.t]
+    if len(behind) == len(t):
+        sol = Solution(t=t, y=left.samples(t), status=STATUS_OK, message="reached the end", method=current,
+                       extra={"log": left.log})
+        return sol, pr, t, left
+    part, rest = left.handover(pr), t[len(behind):]
+    sol = _step_chunk(part, rest, current, kw, warm, t_stop)
+    sol.t, sol.y = t, np.vstack([left.samples(behind), sol.y])
+    return sol, part, rest, None
 
 
 def _leave_ark(steps: int, refused: int, model_id: int, chosen_by: dict[str, Any],
@@ -369,7 +460,9 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
     y0, log, t0 = pr.y0.copy(), pr.log.copy(), float(t[0])
     auto = method == "auto"
     schedule, sol = _Schedule(), None
-    warm: CvodeSession | float | None = None
+    warm: Warm = None
+    left: ArkSession | None = None  # an ark4 session the run has left (see _chunk)
+    sessions = 0  # ark4 sessions started
     stiff_rates: list[float] = []  # cost per simulated second of each stiff chunk since the switch
     current, dp5_rate, wall, probes = _begin(pr, t, edges, method, progress, {
         "rtol": rtol, "max_step": max_step, "force_jump": force_jump, "max_steps": max_steps})
@@ -379,11 +472,11 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
             part = replace(pr, log=log, y0=y0, t0=t0)
             kw = {"rtol": rtol, "max_step": max_step, "force_jump": force_jump,
                   "max_steps": max(1, max_steps - totals["n_steps"] - totals["n_rejected"])}
-            sol = _step_chunk(part, t[a + 1:b + 1], current, kw, warm)
-            warm = _warm_state(current, sol, warm)
+            sol, part, t_part, left = _chunk(part, t[a + 1:b + 1], current, kw, warm, float(t[-1]), left)
+            before, warm = warm, _warm_state(current, sol, warm)
+            sessions += isinstance(warm, ArkSession) and warm is not before
             ys.append(sol.y)
-            for key in totals:
-                totals[key] += getattr(sol, key)
+            totals = {key: n + getattr(sol, key) for key, n in totals.items()}
             wall += sol.wall_s
             bar.update(float(t[b] - t[a]))
             if not sol.success:
@@ -396,12 +489,13 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
                 back = back or _go_back(stiff_rates, dp5_rate, float(t[b]))
                 if back is not None:
                     probes.append(back)
+                    left = warm if isinstance(warm, ArkSession) else None
                     current, stiff_rates, warm = back["to"], [], None
                     if current == "dp5":
                         schedule.wait_longer(i, for_good=True)
             elif auto and current == "dp5" and schedule.due(i):
                 if sol.n_stiff_steps >= STIFF_FRACTION * max(sol.n_steps, 1) and _may_switch(pr):
-                    probes.append(_probe(part, t[a + 1:b + 1], sol, float(t[b]), kw,  # the run as if ark4 ran the chunk
+                    probes.append(_probe(part, t_part, sol, float(t[b]), kw,  # the run as if ark4 ran the chunk
                                          (totals["n_steps"] - sol.n_steps, totals["n_rejected"] - sol.n_rejected)))
                     wall += probes[-1]["wall_s"]
                     if probes[-1]["switch"]:
@@ -411,13 +505,14 @@ def solve_chunks(pr: Problem, t: npt.NDArray[np.float64], rtol: float, method: s
                 else:
                     schedule.not_stiff(i)
             y0, log, t0 = sol.y[-1].copy(), sol.extra.get("log", log), float(t[b])
-    return _joined(t, ys, sol, method, probes, wall, log, totals)
+    return _joined(t, ys, sol, method, probes, wall, log, totals, sessions)
 
 
 def _joined(t: npt.NDArray[np.float64], ys: list[npt.NDArray[np.float64]], sol: Solution | None, method: str,
             probes: list[dict[str, Any]], wall: float, log: npt.NDArray[np.float64],
-            totals: dict[str, int]) -> Solution:
-    """The chunks' samples and statistics as one solution (NaN after a failure)."""
+            totals: dict[str, int], sessions: int) -> Solution:
+    """The chunks' samples and statistics as one solution (NaN after a failure), with the ark4 sessions the run
+    started."""
     y = np.concatenate(ys)
     if len(y) < len(t):
         y = np.vstack([y, np.full((len(t) - len(y), y.shape[1]), np.nan)])
@@ -425,4 +520,4 @@ def _joined(t: npt.NDArray[np.float64], ys: list[npt.NDArray[np.float64]], sol: 
     used = method if method != "auto" else ("auto: dp5" + "".join(f" -> {p['to']} at {p['time_s']:.4g} s"
                                                                   for p in probes if p["switch"]))
     return Solution(t=t, y=y, status=sol.status, message=sol.message, method=used, wall_s=wall,
-                    extra={"log": log, "switches": probes}, **totals)
+                    extra={"log": log, "switches": probes, "ark4_sessions": sessions}, **totals)

@@ -158,7 +158,7 @@ def accuracy_study(rpm: float = 3000.0, load_n: float = 500.0, window_s: float =
         slip_pp, pos_um = _errors(sol.y, ref.y, z, cage, radius)
         rows.append({"solver": f"{method} (compiled RHS)", "rtol": rtol, "max_step": cap, "ok": sol.success,
                      "wall_s_per_sim_s": wall / window_s, "slip_error_pp": slip_pp, "position_error_um": pos_um,
-                     "steps": sol.n_steps, "rhs_calls": sol.n_rhs, "variant": variant})
+                     "steps": sol.n_steps, "rhs_calls": sol.n_rhs, "variant": variant, "method": sol.method})
     tn = np.linspace(0.0, numpy_window_s, 6)
     sol_np, wall = _best_wall(lambda: _numpy_lsoda(pr, tn, 1e-6), repeats)
     y_np = sol_np.y
@@ -170,8 +170,8 @@ def accuracy_study(rpm: float = 3000.0, load_n: float = 500.0, window_s: float =
     auto = rows[0]["wall_s_per_sim_s"]
     for r in rows:
         r["label"] = f"{r['solver']}, cap {1e6 * r['max_step']:g} us" if r["max_step"] != 2e-6 else r["solver"]
-        if r.get("variant") == "default":
-            r["label"] = "auto (as simulate runs it)"
+        if r.get("variant") == "default":  # with the path the switch took, e.g. "dp5 -> ark4 at 0.0001 s"
+            r["label"] = f"auto (as simulate runs it: {r['method'].removeprefix('auto: ')})"
         elif r.get("variant"):
             r["label"] += f", {_VARIANT_LABELS[r['variant']]}"
         r["time_ratio"] = r["wall_s_per_sim_s"] / base

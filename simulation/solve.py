@@ -36,7 +36,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import Any, Protocol
 
 import numpy as np
@@ -44,11 +44,11 @@ import numpy.typing as npt
 from scipy.integrate import BDF, DOP853, LSODA, RK45, Radau
 
 from cageless.errors import ParameterError, suggest
-from cageless.simulation.integrators.ark import ark_integrate
+from cageless.simulation.integrators.ark import SESSION_ROWS, SESSION_SLOTS, ark_integrate
 # the CVODE backend and the solution type live in their own modules; re-exported here, where they always were
 from cageless.simulation.integrators.cvode import (JACOBIAN_DEFAULT, JACOBIANS, ONSET_APPROACH, CvodeSession,
                                                    _first_root, _onset_update, step_cvode)  # noqa: F401
-from cageless.simulation.integrators.dp5 import STATUS_OK, dp5_integrate
+from cageless.simulation.integrators.dp5 import STATUS_OK, _hermite, dp5_integrate
 from cageless.simulation.integrators.rosw import JAC_EVERY, LU_RATIO, rosw_integrate
 from cageless.simulation.jacobian import JacobianStructure
 from cageless.simulation.kernels import SPATIAL, implicit_speed_rows, model_post, model_rhs, ring_rows
@@ -56,8 +56,8 @@ from cageless.simulation.problem import Problem
 from cageless.simulation.solution import MESSAGES as _MESSAGES
 from cageless.simulation.solution import FloatArray, Solution
 
-__all__ = ["FORCE_JUMP", "Problem", "Solution", "Method", "METHODS", "CvodeSession", "solve", "step_scipy", "step_cvode",
-           "JACOBIANS", "JACOBIAN_DEFAULT", "ONSET_APPROACH"]
+__all__ = ["FORCE_JUMP", "Problem", "Solution", "Method", "METHODS", "CvodeSession", "ArkSession", "solve",
+           "step_scipy", "step_cvode", "step_ark", "JACOBIANS", "JACOBIAN_DEFAULT", "ONSET_APPROACH"]
 
 _SCIPY = {"RK45": RK45, "DOP853": DOP853, "LSODA": LSODA, "BDF": BDF, "Radau": Radau}
 #: scipy's methods that use a Jacobian; on the compiled path they get the structured one.
@@ -69,12 +69,13 @@ FORCE_JUMP = 0.5
 
 def _run_compiled(name: str, integrate: Callable[..., int], pr: Problem, t_eval: FloatArray, rtol: float,
                   atol: FloatArray, max_step: float, first_step: float | None, max_steps: int, force_jump: float,
-                  n_stats: int, *extra: Any) -> tuple[Solution, FloatArray]:
-    """Run a compiled integrator (the signature of dp5_integrate, then ``extra``); its solution and raw stats."""
+                  n_stats: int, *extra: Any, log: FloatArray | None = None) -> tuple[Solution, FloatArray]:
+    """Run a compiled integrator (the signature of dp5_integrate, then ``extra``); its solution and raw stats.
+    ``log``: the contact log to update in place (a session's); default a copy of the problem's."""
     out = np.full((len(t_eval), len(pr.y0)), np.nan)
     stats = np.zeros(n_stats)
     floor = np.zeros(len(pr.y0)) if pr.jump_floor is None else pr.jump_floor.astype(np.float64)
-    log = pr.log.copy()
+    log = pr.log.copy() if log is None else log
     h0 = first_step or min(max_step, 1e-3 * max(t_eval[-1] - pr.t0, 1e-12))
     t0 = time.perf_counter()
     status = integrate(pr.model_id, pr.params, log, pr.y0.astype(np.float64), float(pr.t0), t_eval, float(rtol),
@@ -161,15 +162,81 @@ def _ark_jump_floor(pr: Problem) -> Problem:
     return replace(pr, jump_floor=floor)
 
 
+@dataclass
+class ArkSession:
+    """``ark4`` kept between the output chunks of one run, as :class:`CvodeSession` keeps CVODE: the state, the
+    step the controller proposes, its error history, the contact signature and a contact change located ahead
+    (:func:`cageless.simulation.integrators.ark.ark_integrate`'s ``state`` and ``rows``), and the contact log.
+
+    Its steps are bounded by the run's end (``t_stop``), not by a chunk's last sample: a chunk returns after the
+    step that crosses its last sample, and the next chunk's first samples come from that step's interpolant, so
+    a run in chunks takes the same steps as one solve (bit for bit). Before this, every 0.1 ms chunk of ``auto``
+    restarted ark4 with a step clipped to the chunk's end, no error history and a fresh right-hand side: 202
+    steps where one solve takes 174 over 5 ms settled at 3000 rpm, 500 N (planar), and 4.33 CPU s per
+    simulated s against 2.58.
+    """
+
+    problem: Problem
+    atol: FloatArray
+    t_stop: float
+    state: FloatArray
+    rows: FloatArray
+    log: FloatArray
+    calls: int = 0
+
+    @classmethod
+    def start(cls, pr: Problem, t_stop: float) -> ArkSession:
+        """A session from ``pr``'s start that may step up to ``t_stop`` (s), the run's end."""
+        atol = pr.atol.astype(np.float64).copy()
+        atol[implicit_speed_rows(pr.model_id, pr.n_balls)] *= ARK_SPEED_ATOL_FACTOR
+        return cls(_ark_jump_floor(pr), atol, float(t_stop), np.zeros(SESSION_SLOTS),
+                   np.zeros((SESSION_ROWS, len(pr.y0))), pr.log.copy())
+
+    @property
+    def t(self) -> float:
+        """Where the integrator is (s): past the last sample written by up to one step."""
+        return float(self.state[1]) if self.state[0] > 0 else float(self.problem.t0)
+
+    def samples(self, t_eval: FloatArray) -> FloatArray:
+        """The states at ``t_eval`` (s, at or before :attr:`t`), from the last step's interpolant."""
+        out = np.empty((len(t_eval), self.rows.shape[1]))
+        for i, ts in enumerate(t_eval):
+            if self.state[8] > 0 and ts > self.state[7]:
+                _hermite(float(self.state[7]), float(self.state[8]), self.rows[3], self.rows[0], self.rows[4],
+                         self.rows[1], float(ts), out[i])
+            else:
+                out[i] = self.rows[0]
+        return out
+
+    def handover(self, pr: Problem) -> Problem:
+        """``pr`` from where the integrator is (its time, state and contact log), for another method to go on."""
+        return replace(pr, y0=self.rows[0].copy(), t0=self.t, log=self.log.copy())
+
+
+def step_ark(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float, max_steps: int = 50_000_000,
+             force_jump: float = FORCE_JUMP, first_step: float | None = None, session: ArkSession | None = None,
+             t_stop: float | None = None) -> Solution:
+    """``ark4`` over ``t_eval`` in a session (:class:`ArkSession`; a new one from ``pr``'s start, stepping up to
+    ``t_stop``, default the last sample), returned in ``extra["ark4"]`` for the next chunk. With a session,
+    ``pr``, ``first_step`` and ``t_stop`` are not used; without, the first step is by default 1e-3 of the span to
+    ``t_stop``, as one solve's over it."""
+    if session is None:
+        session = ArkSession.start(pr, float(t_eval[-1]) if t_stop is None else t_stop)
+        first_step = first_step or min(max_step, 1e-3 * max(session.t_stop - pr.t0, 1e-12))  # as one solve's
+    sol, _ = _run_compiled("ark4", ark_integrate, session.problem, t_eval, rtol, session.atol, max_step, first_step,
+                           max_steps, force_jump, 8, session.t_stop, session.state, session.rows, log=session.log)
+    session.calls += 1
+    sol.extra["ark4"] = session
+    return sol
+
+
 def _ark4(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float, first_step: float | None,
           max_steps: int, force_jump: float) -> Solution:
     """The compiled IMEX method (:mod:`cageless.simulation.integrators.ark`), with the implicit speeds' absolute
     tolerances scaled by :data:`ARK_SPEED_ATOL_FACTOR` and no force-jump test on the ring's rows
-    (:func:`_ark_jump_floor`)."""
-    atol = pr.atol.astype(np.float64).copy()
-    atol[implicit_speed_rows(pr.model_id, pr.n_balls)] *= ARK_SPEED_ATOL_FACTOR
-    sol, _ = _run_compiled("ark4", ark_integrate, _ark_jump_floor(pr), t_eval, rtol, atol, max_step, first_step,
-                           max_steps, force_jump, 8)
+    (:func:`_ark_jump_floor`), in one call."""
+    sol = step_ark(pr, t_eval, rtol, max_step, max_steps, force_jump, first_step)
+    del sol.extra["ark4"]
     return sol
 
 

@@ -33,8 +33,10 @@ length (:func:`_onset_retry`), where DP5 retries at the onset length and then st
 onset-length retries (3-5 refused steps per change at 3000 rpm, 500 N). The step controller is Hairer's PI
 controller (Solving ODEs I, sect. II.4) with the exponents of an order-3 error estimate: 1/4 - 0.75 beta
 and beta = 0.04, with no growth right after a rejected step (Hairer & Wanner's facmax = 1). The step after
-the end of a span starts from the controller's proposal, not from the step the span's end clipped, so that
-a run in chunks keeps its step.
+the end of a span starts from the controller's proposal, not from the step the span's end clipped. A run in
+chunks keeps the integrator in a session (``state`` and ``rows``, :class:`cageless.simulation.solve.ArkSession`):
+a call returns after the step that crosses its last sample, and the next call resumes there, writing its first
+samples from that step's interpolant, so that the chunks take the same steps as one call.
 """
 
 from __future__ import annotations
@@ -46,7 +48,7 @@ from cageless.simulation.integrators.dp5 import (STATUS_NONFINITE, STATUS_OK, _a
                                                  _hermite, _retry_step, _samples_before, _write_stats)
 from cageless.simulation.kernels import model_filter_error, model_gaps, model_implicit, model_rhs, model_signature
 
-__all__ = ["ark_integrate", "AE", "AI", "B", "B_HAT", "C", "GAMMA"]
+__all__ = ["ark_integrate", "SESSION_SLOTS", "SESSION_ROWS", "AE", "AI", "B", "B_HAT", "C", "GAMMA"]
 
 # Kennedy & Carpenter (2003), ARK4(3)6L[2]SA, tables as in SUNDIALS ARKODE (see the module docstring).
 GAMMA = 0.25
@@ -76,31 +78,30 @@ _STEPS, _REJ, _RHS = 0, 1, 2
 
 @numba.njit(cache=True)
 def ark_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_steps, out, stats, h_onset,
-                  jump_floor, force_jump):
+                  jump_floor, force_jump, t_stop, state, rows):
     """Integrate from ``t0`` and write ``y`` at each ``t_out[k]`` into ``out[k]``: the signature, controls,
     statistics and status codes of :func:`cageless.simulation.integrators.dp5.dp5_integrate` (no stiffness
-    counter: ``stats[7]`` stays 0)."""  # noqa: D401
-    y = y0.copy()
+    counter: ``stats[7]`` stays 0), with a session kept across calls.
+
+    Steps are bounded by ``t_stop`` (>= ``t_out[-1]``), not by the last sample: the call returns once every
+    sample is written, after the step that crosses the last one, and leaves the integrator where it is in
+    ``state`` (:data:`SESSION_SLOTS`) and ``rows`` ((5, n): y, f(y), f_I(y), and the last step's start and
+    its f, from which the next call's samples behind the integrator are interpolated). A call with
+    ``state[0] > 0`` resumes there (``y0``, ``t0`` and ``h0`` are then not used), so a run in many calls takes
+    the same steps as one call. With ``t_stop = t_out[-1]`` and a fresh ``state`` it is one solve."""  # noqa: D401
     f, ki, yt, ynew, f_end, e, g0, g1, work, cnt = _buffers(y0.shape[0])
-    t = t0
-    model_rhs(model_id, t, y, p, log, f[0])
-    model_implicit(model_id, t, y, p, 0.0, ki[0], work)
-    cnt[_RHS] = 1
-    sig = model_signature(model_id, y, p) if h_onset > 0.0 else 0.0
-    h = h0
-    err_old = 1e-4
-    held = False  # the last trial step was rejected: the next accepted one may not grow (Hairer & Wanner, II.4)
-    k = _samples_before(t_out, t, y, out)
+    y = rows[0]  # the integrator's state lives in the session's rows
+    t, h, err_old, held, t_cross, sig, k = _start(model_id, p, log, y0, t0, h0, h_onset, t_out, out, state, rows, f,
+                                                  ki, work, cnt)
     status = STATUS_OK
-    t_end = t_out[t_out.shape[0] - 1]
-    tiny = 1e-13 * max(abs(t_end), t_end - t0)
+    t_last = t_out[t_out.shape[0] - 1]
+    tiny = 1e-13 * max(abs(t_stop), t_stop - state[_S_T0])
     h_want = h  # the controller's proposal before the end of the span clipped it: where the next span starts
-    t_cross = -np.inf  # a contact change located ahead (see _onset_retry): the step that crosses it is short
     while k < t_out.shape[0]:
         h_want = h
         if t_cross > t:
             h = min(h, max(h_onset, t_cross - t + 0.5 * h_onset))
-        stop, h = _before_step(cnt, max_steps, t, t_end, h, h_max, tiny)
+        stop, h = _before_step(cnt, max_steps, t, t_stop, h, h_max, tiny)
         if stop >= 0:
             if stop == STATUS_OK:
                 out[k:, :] = y
@@ -127,11 +128,80 @@ def ark_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_st
         fac = max(1.0 if held else 0.1, min(5.0, err ** 0.22 / err_old ** 0.04 / 0.9))
         held = False
         err_old = max(err, 1e-4)
+        if t + h > t_last:  # the step that crosses the last sample: keep its start for the next call's samples
+            _hold_step(t, h, y, f[0], state, rows)
         k = _ark_accept(model_id, t, h, y, ynew, f, f_end, ki, work, p, log, t_out, out, k, cnt)
         t = t + h
         h = h / fac
     _write_stats(stats, cnt, max(h, h_want) if status == STATUS_OK else h)
+    _keep(state, rows, f, ki, t, h, err_old, held, t_cross, sig)
     return status
+
+
+# The session's scalar slots (``state`` of ark_integrate): whether it holds an integrator, its time, the next trial
+# step, the controller's last error, whether the last trial was refused, a contact change located ahead, the contact
+# signature, the start and length of the last step that crossed a call's last sample, and the first call's start.
+_S_ACTIVE, _S_T, _S_H, _S_ERR_OLD, _S_HELD, _S_T_CROSS, _S_SIG, _S_T_PREV, _S_H_PREV, _S_T0 = range(10)
+#: Length of the session's ``state`` array.
+SESSION_SLOTS = 10
+#: Rows of the session's ``rows`` array: y, f(y), f_I(y) at the integrator's time, the held step's start and its f.
+SESSION_ROWS = 5
+
+
+@numba.njit(cache=True, inline="always")
+def _start(model_id, p, log, y0, t0, h0, h_onset, t_out, out, state, rows, f, ki, work, cnt):  # pragma: no cover
+    """The loop's variables at the start of a call, with f(y) and f_I(y) in f[0] and ki[0] and the samples at or
+    before its time written: (t, h, the controller's last error, whether the last trial step was refused, so that
+    the next accepted one may not grow (Hairer & Wanner, II.4), a contact change located ahead (see
+    :func:`_onset_retry`; the step that crosses it is short), the contact signature, the next sample's index).
+    Resumed from the session when it holds one (``state[0] > 0``), else from ``(t0, y0)`` and ``h0``."""
+    if state[_S_ACTIVE] > 0.0:
+        f[0, :] = rows[1]
+        ki[0, :] = rows[2]
+        return (state[_S_T], state[_S_H], state[_S_ERR_OLD], state[_S_HELD] > 0.0, state[_S_T_CROSS],
+                state[_S_SIG], _samples_held(t_out, out, state, rows))
+    y = rows[0]
+    y[:] = y0
+    state[_S_T0] = t0
+    model_rhs(model_id, t0, y, p, log, f[0])
+    model_implicit(model_id, t0, y, p, 0.0, ki[0], work)
+    cnt[_RHS] = 1
+    sig = model_signature(model_id, y, p) if h_onset > 0.0 else 0.0
+    return t0, h0, 1e-4, False, -np.inf, sig, _samples_before(t_out, t0, y, out)
+
+
+@numba.njit(cache=True, inline="always")
+def _keep(state, rows, f, ki, t, h, err_old, held, t_cross, sig):  # pragma: no cover - compiled
+    """Store the loop's variables in the session (y is already in rows[0])."""
+    rows[1, :] = f[0]
+    rows[2, :] = ki[0]
+    state[_S_ACTIVE] = 1.0
+    state[_S_T], state[_S_H], state[_S_ERR_OLD] = t, h, err_old
+    state[_S_HELD] = 1.0 if held else 0.0
+    state[_S_T_CROSS], state[_S_SIG] = t_cross, sig
+
+
+@numba.njit(cache=True, inline="always")
+def _hold_step(t, h, y, f0, state, rows):  # pragma: no cover - compiled
+    """Keep the start (t, y, f(y)) and length of the step about to be accepted, for :func:`_samples_held`."""
+    rows[3, :] = y
+    rows[4, :] = f0
+    state[_S_T_PREV], state[_S_H_PREV] = t, h
+
+
+@numba.njit(cache=True, inline="always")
+def _samples_held(t_out, out, state, rows):  # pragma: no cover - compiled
+    """Write the samples at or before the session's time from the held step's cubic Hermite interpolant (the
+    values the one-call run writes when it accepts that step); the next sample index."""
+    k = 0
+    t, t_prev, h_prev = state[_S_T], state[_S_T_PREV], state[_S_H_PREV]
+    while k < t_out.shape[0] and t_out[k] <= t:
+        if h_prev > 0.0 and t_out[k] > t_prev:
+            _hermite(t_prev, h_prev, rows[3], rows[0], rows[4], rows[1], t_out[k], out[k])
+        else:
+            out[k, :] = rows[0]
+        k += 1
+    return k
 
 
 @numba.njit(cache=True, inline="always")
