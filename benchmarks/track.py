@@ -184,6 +184,12 @@ def _hash_cpu_ms(clip: Path, repeats: int) -> float:
     return 1e3 * best / n
 
 
+def _video_hash() -> str:
+    from cageless.provenance import VIDEO_HASH
+
+    return VIDEO_HASH
+
+
 def _version_s(src: Path, repeats: int) -> float:
     return min(_child(_CLI.format(src=str(src), argv=["--version"]))[0] for _ in range(repeats))
 
@@ -228,7 +234,7 @@ def speed_table(folder: Path, lengths: list[int], repeats: int, baseline: Path |
     tpy = _trackpy_fps(clips[max(clips)])  # the rendered clip has its truth; the cut ones do not
     return {"lengths": sorted(lengths), "rows": {k: {str(n): v for n, v in r.items()} for k, r in rows.items()},
             "version_s": version, "trackpy_fps": tpy, "trackpy_frames": 100, "from_disk": from_disk,
-            "hash_cpu_ms": _hash_cpu_ms(clips[max(clips)], repeats)}
+            "hash_cpu_ms": _hash_cpu_ms(clips[max(clips)], repeats), "hash_algorithm": _video_hash()}
 
 
 def format_speed(r: dict[str, Any]) -> str:
@@ -258,7 +264,7 @@ def format_speed(r: dict[str, Any]) -> str:
     lines.append("disk passes: bytes the cold run read from storage over the clip's size")
     lines.append("cageless --version: " + ", ".join(f"{t} {s:.3f} s" for t, s in r["version_s"].items()))
     if r.get("hash_cpu_ms"):
-        lines.append(f"hashing the clip (BLAKE3, uncached, from the page cache): {r['hash_cpu_ms']:.3f} ms of CPU a "
+        lines.append(f"hashing the clip ({r.get('hash_algorithm', 'BLAKE3')}, uncached, from the page cache): {r['hash_cpu_ms']:.3f} ms of CPU a "
                      f"frame, at most {1e3 / r['hash_cpu_ms']:.0f} frames/s on one core")
     if r["trackpy_fps"]:
         longest = str(r["lengths"][-1])

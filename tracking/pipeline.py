@@ -47,7 +47,7 @@ __all__ = ["TrackOptions", "TrackResult", "track_video"]
 
 log = logging.getLogger(__name__)
 
-#: How the input video is hashed for its provenance (BLAKE3), in a background thread while the frames
+#: How the input video is hashed for its provenance (XXH3-128), in a background thread while the frames
 #: are tracked.
 INPUT_HASH = VIDEO_HASH
 #: Shortest segment worth a thread, and the frames two segments share to match identities.
