@@ -249,12 +249,12 @@ def _setup(video: FrameSource, loc: BearingLocation, background: np.ndarray, bea
     # then keeps its ghost, which cuts the highlight into stripes (frame minus background).
     # Over the crop only: a per-pixel quantile, so the values of the full frames cropped (tested), on 41 % of the
     # pixels of the 1280 x 800 benchmark clip (0.20 -> 0.045 s of CPU there).
-    sel_bg = background_frame(_CropView(video, rows, cols), quantile=SELECT_QUANTILE)
+    sel_bg = background_frame(_CropView(video, rows, cols), quantile=SELECT_QUANTILE, workers=options.threads)
     sel = select_balls(frames, video.times, sel_bg, mask, z=z, ball_diameter_m=g.ball_diameter_m,
                        pitch_diameter_m=g.pitch_diameter_m, omega_i=conditions.speed_rad_s, centre0=centre0,
                        r_prior=r_prior, path=path, prior_known=known, k_sigma=k_sigma,
                        pixel_threshold=options.detector.weight_sigma * sigma,
-                       scale_stated=bool(conditions.px_per_mm))
+                       scale_stated=bool(conditions.px_per_mm), workers=options.threads)
     ring = sel.ring
     ball_px = 2 * g.ball_diameter_m / g.pitch_diameter_m * ring.radius  # now from the measured ball circle
     h, w = mask.shape
@@ -372,7 +372,7 @@ def track_video(
         if len(video) < options.window:
             raise TrackingError(path, f"has {len(video)} frames, fewer than the speed window of {options.window}: "
                                 "too short to give a speed.", "Record longer, or lower --window.")
-        background = background_frame(video)
+        background = background_frame(video, workers=options.threads)
         loc = _locate(video, background, bearing, path)
         try:
             loc, frames, setup, sel = _select(video, loc, background, bearing, options, conditions, path)
