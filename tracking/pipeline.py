@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import logging
 import math
+import sys
+import threading
 import warnings
 from collections import OrderedDict
 from concurrent.futures import ThreadPoolExecutor
@@ -344,6 +346,24 @@ def _refuse_with_qc(exc: SelectionError, path: Path, video: FrameSource, loc: Be
     raise exc
 
 
+def _import_late_modules() -> None:
+    """Import what only the last stages use (``scipy.signal``, for the speed), so that a cold process does it
+    beside the tracking rather than before it (see :func:`cageless.tracking.kinematics._savgol_filter`)."""
+    try:
+        import scipy.signal  # noqa: F401
+    except ImportError:  # reported where it is used
+        pass
+
+
+_LATE_IMPORTS: list[threading.Thread] = []
+
+
+def _start_late_imports() -> None:
+    if not _LATE_IMPORTS and "scipy.signal" not in sys.modules:
+        _LATE_IMPORTS.append(threading.Thread(target=_import_late_modules, name="cageless-imports", daemon=True))
+        _LATE_IMPORTS[0].start()
+
+
 def track_video(
     path: str | Path, conditions: OperatingConditions, bearing: Bearing, options: TrackOptions | None = None,
     out_dir: str | Path | None = None, progress: bool = True, config: dict[str, Any] | None = None,
@@ -357,6 +377,7 @@ def track_video(
     """
     options = options or TrackOptions()
     path = Path(path)
+    _start_late_imports()
     target = None if out_dir is None else Path(out_dir) / f"{_stem(path)}.trace.h5"
     if target is not None and is_foreign_file(target):
         raise TrackingError(path, f"{target} exists and is not a cageless trace; cageless does not overwrite files "
