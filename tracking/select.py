@@ -51,7 +51,7 @@ import pandas as pd
 
 from cageless.errors import TrackingError
 from cageless.tracking.candidates import (Tracklet, bin_mask, find_candidates, link_tracklets, refine_candidates,
-                                          response_map, response_noise)
+                                          response_map, response_noise, work_binning)
 from cageless.tracking.cyclic import cyclic_select
 from cageless.tracking.locate import fit_circle
 
@@ -220,13 +220,14 @@ def _burst_tracklets(frames: Callable[[int], np.ndarray], span: tuple[int, int],
                      ) -> tuple[list[Tracklet], float]:
     a, b = span
     shown = [frames(i) for i in range(a, b)]  # fetched here, in order; each frame's candidates on its own
+    binned = bin_mask(mask, work_binning(ctx.sigma_px))  # once for the burst's frames
     if noise is None:
-        resp, f = response_map(shown[0], background, ctx.sigma_px)
-        noise = response_noise(resp, bin_mask(mask, f))
+        resp, _ = response_map(shown[0], background, ctx.sigma_px)
+        noise = response_noise(resp, binned)
 
     def candidates(frame: np.ndarray) -> Any:
         c = find_candidates(frame, background, mask, ctx.sigma_px, EXTEND_SHARE * ctx.k_sigma, 12 * ctx.z + 32,
-                            noise)
+                            noise, binned)
         return refine_candidates(c, frame, background, mask, BLOB_RADIUS * ctx.ball_px, ctx.pixel_threshold,
                                  max(1.0, ctx.sigma_px))
     with ThreadPoolExecutor(max_workers=max(1, ctx.workers)) as pool:
