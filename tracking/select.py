@@ -215,14 +215,18 @@ def _speed_reason(ratio: float, omega: float, ctx: _Context) -> str:
     return ""
 
 
+#: Frames of a burst whose candidates are found together (on ``workers`` threads): as many as a memory-mapped
+#: source keeps mapped (tracking/pipeline.py), so that the pages of those before are dropped, not held.
+_FRAMES_AT_ONCE = 8
+
+
 def _burst_tracklets(frames: Callable[[int], np.ndarray], span: tuple[int, int], background: np.ndarray,
                      mask: np.ndarray, ctx: _Context, times: np.ndarray, noise: float | None
                      ) -> tuple[list[Tracklet], float]:
     a, b = span
-    shown = [frames(i) for i in range(a, b)]  # fetched here, in order; each frame's candidates on its own
     binned = bin_mask(mask, work_binning(ctx.sigma_px))  # once for the burst's frames
     if noise is None:
-        resp, _ = response_map(shown[0], background, ctx.sigma_px)
+        resp, _ = response_map(frames(a), background, ctx.sigma_px)
         noise = response_noise(resp, binned)
 
     def candidates(frame: np.ndarray) -> Any:
@@ -230,8 +234,10 @@ def _burst_tracklets(frames: Callable[[int], np.ndarray], span: tuple[int, int],
                             noise, binned)
         return refine_candidates(c, frame, background, mask, BLOB_RADIUS * ctx.ball_px, ctx.pixel_threshold,
                                  max(1.0, ctx.sigma_px))
+    cands = []
     with ThreadPoolExecutor(max_workers=max(1, ctx.workers)) as pool:
-        cands = list(pool.map(candidates, shown))
+        for k in range(a, b, _FRAMES_AT_ONCE):  # fetched in order, a few at a time: a memory map's pages are
+            cands += pool.map(candidates, [frames(i) for i in range(k, min(k + _FRAMES_AT_ONCE, b))])  # dropped
     dt = float(np.median(np.diff(times[a:b]))) if b - a > 1 else 1e-4
     r_max = ctx.r_prior + ctx.ball_px
     gate = max(3.0, 1.3 * ctx.omega_i * r_max * dt + 2.0)
