@@ -5,11 +5,13 @@ runs from a checkout, the resolved configuration, the input files with their
 hashes, and UTC start and end times.
 
 Each input's record names its hash algorithm by its key: ``{"name", "size_bytes",
-"sha256": hex}`` or ``{"name", "size_bytes", "blake3": hex}``. SHA-256 is the default;
-videos are hashed with BLAKE3 (the ``blake3`` package, 32-byte digests), which runs
-at about 3 GB/s on one core against SHA-256's 0.8 GB/s here, so that hashing a
-20 GB recording does not cap the tracking throughput. Records written before
-BLAKE3 was used say ``sha256`` and read as before.
+"sha256": hex}``, ``{"name", "size_bytes", "blake3": hex}`` or ``{"name", "size_bytes",
+"xxh3_128": hex}``. SHA-256 is the default. Videos are hashed with XXH3-128 (the
+``xxhash`` package; the digest ``xxh128sum`` prints), an identity check rather than a
+cryptographic one: 0.35 ms of CPU per 2 MB frame read from the page cache against BLAKE3's
+0.95 ms here (``benchmarks/input_hash.py``), so that hashing a recording does not cap the
+tracking throughput. Records written with SHA-256 or BLAKE3 (earlier versions) read as
+before, with the algorithm they name.
 """
 
 from __future__ import annotations
@@ -35,10 +37,10 @@ __all__ = ["InputFile", "Provenance", "sha256_file", "hash_file", "prefetch_hash
            "cache_dir", "code_digest"]
 
 _CHUNK = 1 << 20
-#: The hash algorithms an input can be recorded with.
-HASH_ALGORITHMS = ("sha256", "blake3")
-#: The algorithm videos are hashed with (a 20 GB recording: about 4 s of one core, against 26 s for SHA-256).
-VIDEO_HASH = "blake3"
+#: The hash algorithms an input can be recorded with (BLAKE3: videos hashed by earlier versions).
+HASH_ALGORITHMS = ("sha256", "blake3", "xxh3_128")
+#: The algorithm videos are hashed with: XXH3-128, the fastest of the three (see the module's docstring).
+VIDEO_HASH = "xxh3_128"
 _POOL = ThreadPoolExecutor(max_workers=2, thread_name_prefix="cageless-hash")
 
 
@@ -68,14 +70,16 @@ def sha256_file(path: str | Path, cache: bool = True) -> str:
 
 
 def hash_file(path: str | Path, algorithm: str = "sha256", cache: bool = True) -> str:
-    """Return the hex digest of a file with ``algorithm`` (``"sha256"`` or ``"blake3"``).
+    """Return the hex digest of a file with ``algorithm`` (one of :data:`HASH_ALGORITHMS`).
 
     For a folder (an image sequence) the hash covers the sorted file names and contents.
     With ``cache`` the result is remembered under :func:`cache_dir` (one folder per algorithm),
     keyed by the path, size, modification time and inode of every file, so an unchanged video
     is hashed once. The file is read in 1 MiB blocks into one reused buffer, so memory stays
-    flat; both hashers release the GIL, so hashing in a thread overlaps other work. Measured
-    here (CPU time, one core): SHA-256 about 1.3 s per GB, BLAKE3 about 0.2 s per GB.
+    flat; the hashers release the GIL, so hashing in a thread overlaps other work. Measured here
+    (CPU time, one core, a 2 MB frame from the page cache, read included): SHA-256 about 1.7 ms,
+    BLAKE3 about 0.95 ms, XXH3-128 about 0.35 ms (``benchmarks/input_hash.py``). Hashing from a memory
+    map instead cost as much or more (XXH3-128 0.43 ms) and was not kept.
 
     Raises
     ------
@@ -135,13 +139,20 @@ def _forget(key: tuple[str, str]) -> None:
         _INFLIGHT.pop(key, None)
 
 
-def _hash_uncached(path: Path, algorithm: str) -> str:
+def _new_digest(algorithm: str) -> Any:
+    if algorithm == "xxh3_128":
+        import xxhash
+
+        return xxhash.xxh3_128()
     if algorithm == "blake3":
         from blake3 import blake3
 
-        digest: Any = blake3()
-    else:
-        digest = hashlib.sha256()
+        return blake3()
+    return hashlib.sha256()
+
+
+def _hash_uncached(path: Path, algorithm: str) -> str:
+    digest = _new_digest(algorithm)
     buf = bytearray(_CHUNK)  # one buffer, refilled: the memory used does not grow with the file
     view = memoryview(buf)
     files = sorted(p for p in path.rglob("*") if p.is_file()) if path.is_dir() else [path]
@@ -150,7 +161,7 @@ def _hash_uncached(path: Path, algorithm: str) -> str:
             digest.update(str(p.relative_to(path)).encode())
         with open(p, "rb", buffering=0) as fh:
             while n := fh.readinto(buf):
-                digest.update(view[:n])  # both hashers release the GIL on large buffers
+                digest.update(view[:n])  # the hashers release the GIL on large buffers
     return str(digest.hexdigest())
 
 
@@ -261,7 +272,7 @@ class Provenance:
     ) -> Provenance:
         """Begin a record now, hashing the given input files with ``hash_algorithm``.
 
-        With ``background=True`` the hashing runs in a thread (hashlib and blake3 release the GIL),
+        With ``background=True`` the hashing runs in a thread (hashlib, blake3 and xxhash release the GIL),
         overlapping the caller's work; :meth:`finish` (or :attr:`inputs`) waits for it.
         """
         paths = list(inputs)

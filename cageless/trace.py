@@ -72,8 +72,8 @@ FloatArray = npt.NDArray[np.float64]
 class VideoInfo:
     """Root attributes that only video traces carry.
 
-    The input video's identity is ``input_hash`` (hex) by ``input_hash_algorithm`` (``"sha256"`` or
-    ``"blake3"``). ``input_sha256`` is kept for traces that name SHA-256: it equals ``input_hash``
+    The input video's identity is ``input_hash`` (hex) by ``input_hash_algorithm`` (``"sha256"``,
+    ``"blake3"`` or ``"xxh3_128"``; see :mod:`cageless.provenance`). ``input_sha256`` is kept for traces that name SHA-256: it equals ``input_hash``
     when the algorithm is SHA-256 and is empty otherwise (and then not written). A trace written
     before ``input_hash`` existed carries only ``input_sha256``; it reads as a SHA-256 hash.
     """

@@ -116,9 +116,14 @@ def blob_response(diff: np.ndarray, sigma_px: float) -> np.ndarray:
 _WORK_SIGMA = 1.5
 
 
+def work_binning(sigma_px: float) -> int:
+    """The binning factor :func:`response_map` works at for highlights of width ``sigma_px``."""
+    return max(1, int(sigma_px // _WORK_SIGMA))
+
+
 def response_map(frame: np.ndarray, background: np.ndarray, sigma_px: float) -> tuple[np.ndarray, int]:
     """Blob response of ``frame - background`` and the binning factor it was computed at."""
-    f = max(1, int(sigma_px // _WORK_SIGMA))
+    f = work_binning(sigma_px)
     diff = np.subtract(frame, background, dtype=np.float32)
     if f > 1:
         h, w = diff.shape
@@ -136,7 +141,8 @@ def bin_mask(mask: np.ndarray, f: int) -> np.ndarray:
 
 
 def find_candidates(frame: np.ndarray, background: np.ndarray, mask: np.ndarray, sigma_px: float,
-                    k_sigma: float = 5.0, max_n: int = 200, response_sigma: float | None = None) -> Candidates:
+                    k_sigma: float = 5.0, max_n: int = 200, response_sigma: float | None = None,
+                    binned_mask: np.ndarray | None = None) -> Candidates:
     """Blob candidates in ``frame`` inside ``mask`` (arrays cropped alike).
 
     Parameters
@@ -149,9 +155,12 @@ def find_candidates(frame: np.ndarray, background: np.ndarray, mask: np.ndarray,
         Keep at most this many, strongest first.
     response_sigma
         The response's noise level, if already known (else measured in ``mask``).
+    binned_mask
+        ``bin_mask(mask, f)`` at the response's binning ``f``, when the caller has it (a burst's frames share one
+        mask: binning it once per burst instead of once per frame).
     """
     resp, f = response_map(frame, background, sigma_px)
-    m = bin_mask(mask, f)
+    m = bin_mask(mask, f) if binned_mask is None else binned_mask
     if response_sigma is None:
         response_sigma = response_noise(resp, m)
     radius = max(1, int(round(1.5 * sigma_px / f)))

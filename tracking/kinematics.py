@@ -10,9 +10,10 @@ the median frame period, differentiated there and sampled back.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import numpy.typing as npt
-from scipy.signal import savgol_filter
 
 from cageless.errors import ParameterError
 
@@ -29,6 +30,15 @@ _BIWEIGHT_C = 6.0
 _SCALE_FLOOR_RAD = 1e-5
 
 _UNIFORM_TOL = 1e-3
+
+
+def _savgol_filter(*args: Any, **kwargs: Any) -> npt.NDArray[np.float64]:
+    """:func:`scipy.signal.savgol_filter`, imported on first use: ``scipy.signal`` takes 1.4-1.6 s of CPU to
+    import (it imports ``scipy.stats``), which a cold ``cageless track`` would otherwise spend before its first
+    frame; :func:`cageless.tracking.pipeline.track_video` imports it in a thread while the frames are tracked."""
+    from scipy.signal import savgol_filter
+
+    return savgol_filter(*args, **kwargs)  # type: ignore[no-any-return]
 
 
 def revolution_speed(time_s: npt.ArrayLike, angle: npt.ArrayLike, window: int = DEFAULT_WINDOW,
@@ -55,11 +65,11 @@ def revolution_speed(time_s: npt.ArrayLike, angle: npt.ArrayLike, window: int = 
     dt = np.diff(t)
     step = float(np.median(dt))
     if np.all(np.abs(dt - step) <= _UNIFORM_TOL * step):
-        return savgol_filter(a, window, polyorder, deriv=1, delta=step, axis=0, mode="interp")
+        return _savgol_filter(a, window, polyorder, deriv=1, delta=step, axis=0, mode="interp")
     grid = np.arange(t[0], t[-1] + 0.5 * step, step)
     flat = a.reshape(len(t), -1)
     resampled = np.column_stack([np.interp(grid, t, flat[:, j]) for j in range(flat.shape[1])])
-    d = savgol_filter(resampled, window, polyorder, deriv=1, delta=step, axis=0, mode="interp")
+    d = _savgol_filter(resampled, window, polyorder, deriv=1, delta=step, axis=0, mode="interp")
     back = np.column_stack([np.interp(t, grid, d[:, j]) for j in range(d.shape[1])])
     return back.reshape(a.shape)
 

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import logging
 import math
+import sys
+import threading
 import warnings
 from collections import OrderedDict
 from concurrent.futures import ThreadPoolExecutor
@@ -47,7 +49,7 @@ __all__ = ["TrackOptions", "TrackResult", "track_video"]
 
 log = logging.getLogger(__name__)
 
-#: How the input video is hashed for its provenance (BLAKE3), in a background thread while the frames
+#: How the input video is hashed for its provenance (XXH3-128), in a background thread while the frames
 #: are tracked.
 INPUT_HASH = VIDEO_HASH
 #: Shortest segment worth a thread, and the frames two segments share to match identities.
@@ -249,12 +251,12 @@ def _setup(video: FrameSource, loc: BearingLocation, background: np.ndarray, bea
     # then keeps its ghost, which cuts the highlight into stripes (frame minus background).
     # Over the crop only: a per-pixel quantile, so the values of the full frames cropped (tested), on 41 % of the
     # pixels of the 1280 x 800 benchmark clip (0.20 -> 0.045 s of CPU there).
-    sel_bg = background_frame(_CropView(video, rows, cols), quantile=SELECT_QUANTILE)
+    sel_bg = background_frame(_CropView(video, rows, cols), quantile=SELECT_QUANTILE, workers=options.threads)
     sel = select_balls(frames, video.times, sel_bg, mask, z=z, ball_diameter_m=g.ball_diameter_m,
                        pitch_diameter_m=g.pitch_diameter_m, omega_i=conditions.speed_rad_s, centre0=centre0,
                        r_prior=r_prior, path=path, prior_known=known, k_sigma=k_sigma,
                        pixel_threshold=options.detector.weight_sigma * sigma,
-                       scale_stated=bool(conditions.px_per_mm))
+                       scale_stated=bool(conditions.px_per_mm), workers=options.threads)
     ring = sel.ring
     ball_px = 2 * g.ball_diameter_m / g.pitch_diameter_m * ring.radius  # now from the measured ball circle
     h, w = mask.shape
@@ -344,6 +346,24 @@ def _refuse_with_qc(exc: SelectionError, path: Path, video: FrameSource, loc: Be
     raise exc
 
 
+def _import_late_modules() -> None:
+    """Import what only the last stages use (``scipy.signal``, for the speed), so that a cold process does it
+    beside the tracking rather than before it (see :func:`cageless.tracking.kinematics._savgol_filter`)."""
+    try:
+        import scipy.signal  # noqa: F401
+    except ImportError:  # reported where it is used
+        pass
+
+
+_LATE_IMPORTS: list[threading.Thread] = []
+
+
+def _start_late_imports() -> None:
+    if not _LATE_IMPORTS and "scipy.signal" not in sys.modules:
+        _LATE_IMPORTS.append(threading.Thread(target=_import_late_modules, name="cageless-imports", daemon=True))
+        _LATE_IMPORTS[0].start()
+
+
 def track_video(
     path: str | Path, conditions: OperatingConditions, bearing: Bearing, options: TrackOptions | None = None,
     out_dir: str | Path | None = None, progress: bool = True, config: dict[str, Any] | None = None,
@@ -357,6 +377,7 @@ def track_video(
     """
     options = options or TrackOptions()
     path = Path(path)
+    _start_late_imports()
     target = None if out_dir is None else Path(out_dir) / f"{_stem(path)}.trace.h5"
     if target is not None and is_foreign_file(target):
         raise TrackingError(path, f"{target} exists and is not a cageless trace; cageless does not overwrite files "
@@ -372,7 +393,7 @@ def track_video(
         if len(video) < options.window:
             raise TrackingError(path, f"has {len(video)} frames, fewer than the speed window of {options.window}: "
                                 "too short to give a speed.", "Record longer, or lower --window.")
-        background = background_frame(video)
+        background = background_frame(video, workers=options.threads)
         loc = _locate(video, background, bearing, path)
         try:
             loc, frames, setup, sel = _select(video, loc, background, bearing, options, conditions, path)

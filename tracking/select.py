@@ -41,6 +41,7 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -50,7 +51,7 @@ import pandas as pd
 
 from cageless.errors import TrackingError
 from cageless.tracking.candidates import (Tracklet, bin_mask, find_candidates, link_tracklets, refine_candidates,
-                                          response_map, response_noise)
+                                          response_map, response_noise, work_binning)
 from cageless.tracking.cyclic import cyclic_select
 from cageless.tracking.locate import fit_circle
 
@@ -155,6 +156,7 @@ class _Context:
     k_sigma: float
     prior_known: bool = True  # False: r_prior is only a scale guess; the circle is chosen by support
     pixel_threshold: float = 0.0  # centroid weight threshold (DN above the local background)
+    workers: int = 1  # threads finding the candidates of a burst's frames (OpenCV, numpy and numba release the GIL)
 
 
 def _burst_plan(n: int, times: np.ndarray, omega_c: float, n_bursts: int) -> list[tuple[int, int]]:
@@ -213,20 +215,29 @@ def _speed_reason(ratio: float, omega: float, ctx: _Context) -> str:
     return ""
 
 
+#: Frames of a burst whose candidates are found together (on ``workers`` threads): as many as a memory-mapped
+#: source keeps mapped (tracking/pipeline.py), so that the pages of those before are dropped, not held.
+_FRAMES_AT_ONCE = 8
+
+
 def _burst_tracklets(frames: Callable[[int], np.ndarray], span: tuple[int, int], background: np.ndarray,
                      mask: np.ndarray, ctx: _Context, times: np.ndarray, noise: float | None
                      ) -> tuple[list[Tracklet], float]:
     a, b = span
-    cands = []
-    for i in range(a, b):
-        frame = frames(i)
-        if noise is None:
-            resp, f = response_map(frame, background, ctx.sigma_px)
-            noise = response_noise(resp, bin_mask(mask, f))
+    binned = bin_mask(mask, work_binning(ctx.sigma_px))  # once for the burst's frames
+    if noise is None:
+        resp, _ = response_map(frames(a), background, ctx.sigma_px)
+        noise = response_noise(resp, binned)
+
+    def candidates(frame: np.ndarray) -> Any:
         c = find_candidates(frame, background, mask, ctx.sigma_px, EXTEND_SHARE * ctx.k_sigma, 12 * ctx.z + 32,
-                            noise)
-        cands.append(refine_candidates(c, frame, background, mask, BLOB_RADIUS * ctx.ball_px,
-                                       ctx.pixel_threshold, max(1.0, ctx.sigma_px)))
+                            noise, binned)
+        return refine_candidates(c, frame, background, mask, BLOB_RADIUS * ctx.ball_px, ctx.pixel_threshold,
+                                 max(1.0, ctx.sigma_px))
+    cands = []
+    with ThreadPoolExecutor(max_workers=max(1, ctx.workers)) as pool:
+        for k in range(a, b, _FRAMES_AT_ONCE):  # fetched in order, a few at a time: a memory map's pages are
+            cands += pool.map(candidates, [frames(i) for i in range(k, min(k + _FRAMES_AT_ONCE, b))])  # dropped
     dt = float(np.median(np.diff(times[a:b]))) if b - a > 1 else 1e-4
     r_max = ctx.r_prior + ctx.ball_px
     gate = max(3.0, 1.3 * ctx.omega_i * r_max * dt + 2.0)
@@ -435,13 +446,14 @@ def _table(feats: list[dict[str, float]], reasons: list[str], burst: np.ndarray,
 
 def _context(z: int, ball_diameter_m: float, pitch_diameter_m: float, omega_i: float,
              centre0: tuple[float, float], r_prior: float, k_sigma: float,
-             sigma_px: float | None = None, prior_known: bool = True, pixel_threshold: float = 0.0) -> _Context:
+             sigma_px: float | None = None, prior_known: bool = True, pixel_threshold: float = 0.0,
+             workers: int = 1) -> _Context:
     ratio = ball_diameter_m / pitch_diameter_m
     ball_px = 2.0 * ratio * r_prior
     return _Context(z=z, gap=MIN_SPACING * 2 * math.asin(min(ratio, 1.0)), omega_c=0.5 * omega_i * (1 - ratio),
                     omega_i=omega_i, ball_px=ball_px, r_prior=r_prior, centre0=centre0,
                     sigma_px=sigma_px or max(1.0, 0.05 * ball_px), k_sigma=k_sigma, prior_known=prior_known,
-                    pixel_threshold=pixel_threshold)
+                    pixel_threshold=pixel_threshold, workers=workers)
 
 
 def _collect_tracklets(frames: Callable[[int], np.ndarray], spans: list[tuple[int, int]], background: np.ndarray,
@@ -478,7 +490,7 @@ def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, backgro
                  mask: np.ndarray, *, z: int, ball_diameter_m: float, pitch_diameter_m: float, omega_i: float,
                  centre0: tuple[float, float], r_prior: float, path: object = "video", n_bursts: int = 6,
                  k_sigma: float = 4.0, prior_known: bool = True, pixel_threshold: float = 0.0,
-                 scale_stated: bool = False) -> Selection:
+                 scale_stated: bool = False, workers: int = 1) -> Selection:
     """Choose exactly ``z`` ball tracks from bursts spread over the clip (see the module docstring).
 
     Parameters
@@ -500,6 +512,8 @@ def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, backgro
     scale_stated
         True when ``r_prior`` is the pitch radius at a stated scale: the chosen circle must then lie within
         :data:`PRIOR_RADIUS_TOL` ball diameters of it (:func:`check_radius`).
+    workers
+        Threads that find the candidates of a burst's frames (the same candidates with any number).
 
     Raises
     ------
@@ -508,7 +522,7 @@ def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, backgro
         their circle is not the pitch circle.
     """
     ctx = _context(z, ball_diameter_m, pitch_diameter_m, omega_i, centre0, r_prior, k_sigma,
-                   prior_known=prior_known, pixel_threshold=pixel_threshold)
+                   prior_known=prior_known, pixel_threshold=pixel_threshold, workers=workers)
     spans = _burst_plan(len(times), times, ctx.omega_c, n_bursts)
     tracks, burst_arr, noise = _collect_tracklets(frames, spans, background, mask, ctx, times)
     feats = [_features(t, times, centre0) for t in tracks]

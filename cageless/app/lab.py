@@ -47,7 +47,7 @@ from cageless.kinematics import startup_duration, theoretical_cage_speed
 from cageless.outputs import clean_stale_parts, output_lock
 from cageless.parallel import job_pool
 from cageless.profiles import peak_estimator
-from cageless.provenance import code_digest, hash_file, sha256_file
+from cageless.provenance import VIDEO_HASH, code_digest, hash_file, sha256_file
 from cageless.trace import read_trace
 from cageless.validate import plausible_entry
 
@@ -404,7 +404,9 @@ def _track_all(pool: Any, entries: list[LabEntry], bearings: dict[Path, Bearing]
     jobs, keys, pending = [], [], []
     n_balls, cut = options.n_balls, {"allow_truncated": True} if options.allow_truncated else {}
     for e in entries:
-        key = cache.key("track", {"input": hash_file(e.video, "blake3"), "conditions": e.resolved.conditions.to_dict(),
+        # Keyed on the video's XXH3-128: entries an earlier version keyed on its BLAKE3 do not match (a miss).
+        key = cache.key("track", {"input": hash_file(e.video, VIDEO_HASH),
+                                  "conditions": e.resolved.conditions.to_dict(),
                                   "bearing": bearings[e.video].to_dict(), "n_balls": n_balls, **cut})
         hit = cache.hit(key)
         if hit:

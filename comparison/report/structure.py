@@ -11,6 +11,7 @@ from cageless import __version__
 from cageless.comparison.compare import SLIP_REFERENCES, ComparisonRow
 from cageless.comparison.metrics import SLIP_RATE_DEFINITION
 from cageless.profiles import PEAK_SMOOTHING_DEG
+from cageless.provenance import HASH_ALGORITHMS
 from cageless.comparison.report import figures
 from cageless.comparison.report.describe import ConditionDescription, tracking_verdict
 from cageless.comparison.table import number_cell, slip_reference_note, table_frame, to_html
@@ -104,7 +105,7 @@ def build_report(descriptions: Sequence[ConditionDescription], failed_rows: Sequ
                                                  f"{info['wall_s']:.1f} s"))
             repro.append((f"{d.label}: effects", "; ".join(_effects(info))))
         for item in d.video_provenance.get("inputs", []):
-            algorithm = next((a for a in ("blake3", "sha256") if a in item), "sha256")
+            algorithm = next((a for a in reversed(HASH_ALGORITHMS) if a in item), "sha256")
             repro.append((f"input {item.get('name')}", f"{algorithm} {item.get(algorithm)}"))
     return {
         "title": title,

@@ -89,6 +89,26 @@ def test_blake3_matches_the_reference_vectors(tmp_path):
         hash_file(p, "md5")
 
 
+#: XXH3-128 (seed 0) of b"": the length-0 entry of xxHash's tests/sanity_test_vectors.h (github.com/Cyan4973/xxHash);
+#: of b"abc": the value the xxhash-rust crate's tests and an independent Haxe port lock (found by searching their
+#: sources for the empty vector).
+XXH3_128_EMPTY = "99aa06d3014798d86001c324468d497f"
+XXH3_128_ABC = "06b05ab6733a618578af5f94892f3950"
+
+
+def test_xxh3_128_matches_the_reference_vectors(tmp_path):
+    from cageless.provenance import VIDEO_HASH, hash_file
+
+    assert VIDEO_HASH == "xxh3_128"
+    p = tmp_path / "abc.bin"
+    p.write_bytes(b"abc")
+    assert hash_file(p, "xxh3_128", cache=False) == XXH3_128_ABC
+    assert hash_file(p, "xxh3_128") == XXH3_128_ABC and hash_file(p, "xxh3_128") == XXH3_128_ABC  # cached
+    assert hash_file(p, "blake3") == BLAKE3_ABC  # a separate cache per algorithm
+    (tmp_path / "empty.bin").write_bytes(b"")
+    assert hash_file(tmp_path / "empty.bin", "xxh3_128", cache=False) == XXH3_128_EMPTY
+
+
 def test_provenance_names_the_hash_algorithm(tmp_path):
     from cageless.provenance import InputFile
 
@@ -100,6 +120,9 @@ def test_provenance_names_the_hash_algorithm(tmp_path):
     assert (back.algorithm, back.digest, back.sha256) == ("blake3", BLAKE3_ABC, None)
     old = InputFile.from_dict({"name": "x", "size_bytes": 3, "sha256": SHA256_ABC})
     assert (old.algorithm, old.sha256) == ("sha256", SHA256_ABC)
+    d = Provenance.start(inputs=[p], hash_algorithm="xxh3_128").finish().to_dict()
+    assert d["inputs"] == [{"name": str(p), "size_bytes": 3, "xxh3_128": XXH3_128_ABC}]
+    assert InputFile.from_dict(d["inputs"][0]).algorithm == "xxh3_128"
 
 
 def test_prefetched_hash_is_computed_once(tmp_path, monkeypatch):

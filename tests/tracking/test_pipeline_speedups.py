@@ -49,4 +49,6 @@ def test_background_frame_is_numpys_median_over_the_first_axis(tmp_path, n_frame
     with open_video(clip) as video:
         got = background_frame(video, quantile=quantile)
         ref = _background_plain(video, quantile=quantile)
+        threaded = background_frame(video, quantile=quantile, workers=2)  # bands of 32 rows on two threads
     assert got.tobytes() == ref.tobytes()
+    assert threaded.tobytes() == ref.tobytes()

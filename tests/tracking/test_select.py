@@ -27,7 +27,7 @@ from cageless.kinematics import theoretical_cage_speed
 from cageless.profiles import angle_profile
 from cageless.tracking.candidates import Candidates, link_tracklets
 from cageless.tracking.kinematics import DEFAULT_WINDOW, revolution_speed
-from cageless.tracking.pipeline import track_video
+from cageless.tracking.pipeline import TrackOptions, track_video
 from cageless.tracking.select import cyclic_select
 from cageless.tracking.synthetic.camera import Appearance, Camera
 from cageless.tracking.synthetic.clip import frames_for_revolutions, render_clip
@@ -119,6 +119,19 @@ def test_bright_ring_faces_give_exactly_the_bearings_balls(bright):
     assert "off the ball circle" in set(table.reason)  # the bright gaps at the band edges
     assert res.qc.selection["counts"] == [14] * len(res.qc.selection["counts"])
     assert (d / "out" / "qc" / "bright.selection.png").is_file()
+
+
+def test_the_selection_is_the_same_on_one_or_two_threads(bright):
+    """The candidates of a burst's frames found on two threads: the same choice, tracklets and table."""
+    from dataclasses import replace
+
+    d, clip = bright
+    one = track_video(clip["video"], OperatingConditions(3000, 500), B, TrackOptions(threads=1), progress=False)
+    two = track_video(clip["video"], OperatingConditions(3000, 500), B, TrackOptions(threads=2), progress=False)
+    assert one.qc.selection == two.qc.selection
+    assert one.table.equals(two.table)
+    assert np.array_equal(one.trace.angle, two.trace.angle)
+    assert replace(one.trace.video, input_hash="") == replace(two.trace.video, input_hash="")
 
 
 def test_wrong_speed_is_refused_without_a_trace(bright, capsys):

@@ -113,9 +113,9 @@ def test_cli_sample_lab_in_parallel(tmp_path, capsys):
         "clip_3000rpm.trace.h5", "n6000_Fr500_Fa0.trace.h5", "run_1800.trace.h5"]
     tr = read_trace(out / "run_1800.trace.h5")
     assert tr.video.camera_roll_rad == pytest.approx(np.radians(2.0))
-    assert tr.video.input_hash_algorithm == "blake3" and tr.video.input_sha256 == ""
-    assert tr.provenance["inputs"][0]["blake3"] == tr.video.input_hash
-    assert len(tr.video.input_hash) == 64
+    assert tr.video.input_hash_algorithm == "xxh3_128" and tr.video.input_sha256 == ""
+    assert tr.provenance["inputs"][0]["xxh3_128"] == tr.video.input_hash
+    assert len(tr.video.input_hash) == 32  # 128 bits
 
 
 def test_cli_speed_for_a_bare_video(tmp_path, capsys):
