@@ -111,6 +111,18 @@ class LabResult:
 
 # -- jobs (top-level so processes and Dask workers can run them) --------------------------------------
 
+def say_if_compiling(package: str) -> None:
+    """Tell the user, on stderr, when the next run of ``package`` (``"tracking"`` or ``"simulation"``) waits for its
+    one-off compile first (its progress bar then stands still for minutes)."""
+    if package == "tracking":
+        from cageless.tracking import compile_notice
+    else:
+        from cageless.simulation._cache import compile_notice
+    notice = compile_notice()
+    if notice:
+        tqdm.write(notice, file=sys.stderr)
+
+
 def _track_job(video: str, conditions: OperatingConditions, bearing: Bearing, out_dir: str,
                n_balls: int | None = None, allow_truncated: bool = False) -> tuple[str, str]:
     from cageless.tracking.pipeline import TrackOptions, track_video
@@ -417,11 +429,7 @@ def _track_all(pool: Any, entries: list[LabEntry], bearings: dict[Path, Bearing]
         keys.append(key)
         pending.append(e.video)
     if jobs and progress:
-        from cageless.tracking import compile_notice as tracking_compile_notice
-
-        notice = tracking_compile_notice()
-        if notice:
-            tqdm.write(notice, file=sys.stderr)
+        say_if_compiling("tracking")
     _collect(traces, pending, keys, _run_jobs(pool, jobs, "tracking", progress, [p.name for p in pending]), cache)
     return traces, len(entries) - len(jobs)
 
@@ -454,11 +462,7 @@ def _simulate_all(pool: Any, entries: list[LabEntry], traces: dict[Path, Any], b
         keys.append(key)
         pending.append(k)
     if jobs and progress:
-        from cageless.simulation._cache import compile_notice
-
-        notice = compile_notice()
-        if notice:
-            tqdm.write(notice, file=sys.stderr)
+        say_if_compiling("simulation")
     _collect(sims, pending, keys, _run_jobs(pool, jobs, "simulation", progress, [_sim_name(k) for k in pending]),
              cache)
     return sims, len(conditions) - len(jobs)

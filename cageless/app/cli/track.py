@@ -188,7 +188,10 @@ def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bear
                 print(failed_line(e.video, exc, shown=_shown(e.video)), file=sys.stderr)
                 failed += 1
     workers = max(1, min(args.workers, len(jobs)))
-    _say_if_compiling(bool(jobs) and not args.quiet)
+    if jobs and not args.quiet:
+        from cageless.app.lab import say_if_compiling
+
+        say_if_compiling("tracking")
     with tqdm(total=len(jobs), desc="videos", unit="video", disable=args.quiet or not jobs) as bar:
         results = _map(jobs, workers, bar)
         for (video, *_), (status, info) in zip(jobs, results, strict=True):
@@ -201,16 +204,6 @@ def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bear
                 tqdm.write(failed_line(video, info, shown=_shown(video)), file=sys.stderr)
                 failed += 1
     return 1 if failed else 0
-
-
-def _say_if_compiling(show: bool) -> None:
-    """Tell the user when the first video will wait for the tracker's one-off compile (the bar stands still)."""
-    if show:
-        from cageless.tracking import compile_notice
-
-        notice = compile_notice()
-        if notice:
-            tqdm.write(notice, file=sys.stderr)
 
 
 def _namer(inputs: list[str]) -> Callable[[Path], str]:
