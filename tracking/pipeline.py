@@ -41,7 +41,8 @@ from cageless.tracking.link import BallCountWarning, TrackSetup, track_frames
 from cageless.tracking.locate import BearingLocation, background_frame, locate_bearing
 from cageless.tracking.locate_motion import (DROPOUT_GAIN, frame_gains, holds_the_motion, locate_by_motion, motion_map,
                                              plausible_band)
-from cageless.tracking.qc import QCReport, build_qc, slip_warnings, write_qc, write_selection_qc
+from cageless.tracking.qc import (QCReport, build_qc, slip_warnings, write_qc, write_refusal_qc,
+                                  write_selection_qc)
 from cageless.tracking.select import SPEED_BAND, Selection, SelectionError, select_balls
 from cageless.tracking.position_bias import remove_place_bias
 
@@ -346,6 +347,15 @@ def _refuse_with_qc(exc: SelectionError, path: Path, video: FrameSource, loc: Be
     raise exc
 
 
+def _refuse_located(exc: TrackingError, path: Path, video: FrameSource, out_dir: str | Path | None) -> NoReturn:
+    """Re-raise a refusal to locate the bearing; with ``out_dir``, first write the first frame with the reason
+    (``qc/<stem>.refused.png``) and name that image in the message."""
+    if out_dir is None:
+        raise exc
+    png = write_refusal_qc(Path(out_dir) / "qc", _stem(path), video[0], exc.message)
+    raise TrackingError(path, f"{exc.message} No trace written; QC: {png}.", exc.hint) from None
+
+
 def _import_late_modules() -> None:
     """Import what only the last stages use (``scipy.signal``, for the speed), so that a cold process does it
     beside the tracking rather than before it (see :func:`cageless.tracking.kinematics._savgol_filter`)."""
@@ -394,7 +404,10 @@ def track_video(
             raise TrackingError(path, f"has {len(video)} frames, fewer than the speed window of {options.window}: "
                                 "too short to give a speed.", "Record longer, or lower --window.")
         background = background_frame(video, workers=options.threads)
-        loc = _locate(video, background, bearing, path)
+        try:
+            loc = _locate(video, background, bearing, path)
+        except TrackingError as exc:
+            _refuse_located(exc, path, video, out_dir)
         try:
             loc, frames, setup, sel = _select(video, loc, background, bearing, options, conditions, path)
         except SelectionError as exc:

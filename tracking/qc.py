@@ -31,7 +31,7 @@ from cageless.tracking.io import open_video
 from cageless.tracking.locate import BearingLocation
 
 __all__ = ["QC_LIMITS", "QCReport", "build_qc", "write_qc", "slip_warnings", "loaded_zone_speed_ratio",
-           "write_selection_qc", "REASON_COLOURS"]
+           "write_selection_qc", "write_refusal_qc", "REASON_COLOURS"]
 
 log = logging.getLogger(__name__)
 
@@ -247,11 +247,7 @@ def write_selection_qc(qc_dir: Path, stem: str, frame: np.ndarray | None, table:
     target = qc_dir / f"{stem}.selection.png"
     if frame is None:
         return target
-    lo, hi = np.percentile(frame, [1, 99.8])
-    img8 = np.clip((frame.astype(np.float32) - lo) * (255.0 / max(hi - lo, 1e-6)), 0, 255).astype(np.uint8)
-    scale = max(1, int(math.ceil(700 / max(frame.shape))))
-    img = cv2.resize(cv2.cvtColor(img8, cv2.COLOR_GRAY2BGR), None, fx=scale, fy=scale,
-                     interpolation=cv2.INTER_NEAREST)
+    img, scale = _frame_image(frame)
     if ring is not None:
         c = (int(round((ring.centre[0] + offset[0]) * scale)), int(round((ring.centre[1] + offset[1]) * scale)))
         cv2.circle(img, c, int(round(ring.radius * scale)), (0, 200, 255), 1, cv2.LINE_AA)
@@ -261,15 +257,45 @@ def write_selection_qc(qc_dir: Path, stem: str, frame: np.ndarray | None, table:
         p = (int(round(r.u_px * scale)), int(round(r.v_px * scale)))
         cv2.circle(img, p, 3 * scale if r.status == "selected" else 2 * scale, colour, 1, cv2.LINE_AA)
     counts = table.assign(key=np.where(table.status == "selected", "selected", table.reason)).key.value_counts()
-    y = 2
-    char_px = cv2.getTextSize("x", cv2.FONT_HERSHEY_SIMPLEX, 0.45, 1)[0][0]
-    for line in textwrap.wrap(title, width=max(20, (img.shape[1] - 12) // max(char_px, 1))):  # the whole title
-        y += 16
-        cv2.putText(img, line, (6, y), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (255, 255, 255), 1, cv2.LINE_AA)
+    y = _write_title(img, title)
     for reason, n in counts.items():
         y += 16
         cv2.putText(img, f"{reason}: {n}", (6, y), cv2.FONT_HERSHEY_SIMPLEX, 0.45,
                     REASON_COLOURS.get(str(reason), (255, 255, 255)), 1, cv2.LINE_AA)
+    return _write_png(target, img)
+
+
+def write_refusal_qc(qc_dir: Path, stem: str, frame: np.ndarray, title: str) -> Path:
+    """Write ``<stem>.refused.png``: the first frame (contrast-stretched) with the reason the video was refused
+    before any ball was looked for (no bearing in view, no ball band), so the user sees what the tracker saw.
+    Returns the PNG's path."""
+    qc_dir.mkdir(parents=True, exist_ok=True)
+    img, _ = _frame_image(frame)
+    _write_title(img, title)
+    return _write_png(qc_dir / f"{stem}.refused.png", img)
+
+
+def _frame_image(frame: np.ndarray) -> tuple[np.ndarray, int]:
+    """A frame as an 8-bit colour image stretched between its 1st and 99.8th percentiles, enlarged by a whole
+    factor to about 700 px; returns the image and the factor."""
+    lo, hi = np.percentile(frame, [1, 99.8])
+    img8 = np.clip((frame.astype(np.float32) - lo) * (255.0 / max(hi - lo, 1e-6)), 0, 255).astype(np.uint8)
+    scale = max(1, int(math.ceil(700 / max(frame.shape))))
+    return cv2.resize(cv2.cvtColor(img8, cv2.COLOR_GRAY2BGR), None, fx=scale, fy=scale,
+                      interpolation=cv2.INTER_NEAREST), scale
+
+
+def _write_title(img: np.ndarray, title: str) -> int:
+    """Write the whole of ``title`` in the image's top-left corner, wrapped; returns the last line's y."""
+    y = 2
+    char_px = cv2.getTextSize("x", cv2.FONT_HERSHEY_SIMPLEX, 0.45, 1)[0][0]
+    for line in textwrap.wrap(title, width=max(20, (img.shape[1] - 12) // max(char_px, 1))):
+        y += 16
+        cv2.putText(img, line, (6, y), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (255, 255, 255), 1, cv2.LINE_AA)
+    return y
+
+
+def _write_png(target: Path, img: np.ndarray) -> Path:
     with atomic_path(target) as tmp:
         _, buf = cv2.imencode(".png", img)
         tmp.write_bytes(buf.tobytes())

@@ -231,7 +231,10 @@ class _Cache:
 def _announce_failure(label: str, stage: str, message: str, progress: bool) -> None:
     """Say at once that one input failed, so a long run does not hide it until the end."""
     if progress:
-        tqdm.write(f"FAILED {label} ({stage}): {message.splitlines()[0] if message else ''}", file=sys.stderr)
+        from cageless.app.cli.common import failed_line
+
+        why = failed_line(label, message.splitlines()[0] if message else "")[len(f"FAILED {label}: "):]
+        tqdm.write(f"FAILED {label} ({stage}): {why}", file=sys.stderr)
 
 
 def _run_jobs(pool: Any, jobs: list[tuple[Callable[..., tuple[str, str]], tuple[Any, ...]]], desc: str,
@@ -350,7 +353,7 @@ def _run_lab(folder: str | Path, out: Path, options: LabOptions | None, bearing:
         skipped += n_skip
         timings["simulation"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    descriptions = _compare_all(good, traces, sims, bearings, bearing, options, failed)
+    descriptions = _compare_all(good, traces, sims, bearings, bearing, options, failed, progress)
     timings["comparison"] = time.perf_counter() - t0
     rows = [d.row for d in descriptions] + failed
     tables = write_tables(rows, out / "slip_table")
@@ -366,8 +369,10 @@ def _run_lab(folder: str | Path, out: Path, options: LabOptions | None, bearing:
 
 
 def _compare_all(good: list[LabEntry], traces: dict[Path, Any], sims: dict[SimKey, Any],
-                 bearings: dict[Path, Bearing], base: Bearing, options: LabOptions, failed: list[Any]) -> list[Any]:
-    """Compare each tracked video with its simulation; failures are appended to ``failed`` as rows."""
+                 bearings: dict[Path, Bearing], base: Bearing, options: LabOptions, failed: list[Any],
+                 progress: bool = False) -> list[Any]:
+    """Compare each tracked video with its simulation; failures are appended to ``failed`` as rows (and
+    announced at once when ``progress``, like the other stages' failures)."""
     from cageless.comparison.compare import compare
     from cageless.comparison.report import describe_condition
 
@@ -388,6 +393,7 @@ def _compare_all(good: list[LabEntry], traces: dict[Path, Any], sims: dict[SimKe
             descriptions.append(describe_condition(e.video.name, c, measured, simulated))
         except CagelessError as exc:
             failed.append(_failed_row(e.video.name, e.resolved.conditions, str(exc)))
+            _announce_failure(e.video.name, "comparison", str(exc), progress)
     return descriptions
 
 

@@ -63,6 +63,19 @@ def test_sample_lab_report_and_rerun(tmp_path, capsys):
     assert "3 jobs unchanged and skipped" in capsys.readouterr().out
 
 
+def test_with_progress_a_failure_is_said_once_as_it_happens_and_listed_at_the_end(tmp_path, capsys):
+    """Without -q the failure's reason is printed when it happens; the closing summary names the video only
+    (a new user's trial found every reason printed twice)."""
+    lab = tmp_path / "lab"
+    lab.mkdir()
+    (lab / "n3000_Fr500_Fa0.cine").write_bytes(b"not a cine file" * 100)
+    assert main(["report", str(lab), "-o", str(tmp_path / "out")]) == 1
+    err = capsys.readouterr().err
+    assert err.count("not a Phantom cine file") == 1, err
+    assert "FAILED n3000_Fr500_Fa0.cine (tracking): wrong magic bytes" in err, err  # named once, not by its path
+    assert "failed: n3000_Fr500_Fa0.cine (the reasons are above and in the report)" in err, err
+
+
 def test_a_bad_video_is_a_failed_row_and_the_rest_completes(tmp_path, capsys):
     lab = tmp_path / "lab"
     lab.mkdir()

@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 from pathlib import Path
 
+import cv2
 import numpy as np
 import pandas as pd
 import pytest
@@ -13,6 +14,7 @@ from cageless.bearing import default_bearing
 from cageless.app.cli import main
 from cageless.conditions import OperatingConditions
 from cageless.errors import TrackingError, VideoError
+from cageless.tracking.qc import _frame_image
 from cageless.trace import read_trace
 from cageless.tracking.io import write_cine
 from cageless.tracking.pipeline import track_video
@@ -36,9 +38,16 @@ def test_no_bearing_in_view(tmp_path):
     rng = np.random.default_rng(0)
     noise = rng.integers(0, 40, size=(30, 200, 320), dtype=np.uint8)
     video = write_cine(tmp_path / "empty_bench.cine", noise, fps=10000, fmt="8")
-    with pytest.raises(TrackingError, match="empty_bench.cine: .*no bearing in view"):
+    with pytest.raises(TrackingError, match="empty_bench.cine: .*no bearing in view") as err:
         track_video(video, COND, B, out_dir=tmp_path / "out", progress=False)
     assert not list((tmp_path).rglob("*.trace.h5"))
+    # the refusal shows what the tracker saw: the first frame with the reason, named in the message
+    png = tmp_path / "out" / "qc" / "empty_bench.refused.png"
+    assert f"No trace written; QC: {png}." in str(err.value)
+    image = cv2.imread(str(png))
+    assert image.shape[:2] == (200 * 3, 320 * 3)  # enlarged by the whole factor ceil(700 / 320) = 3
+    plain, _ = _frame_image(noise[0])
+    assert (image != plain)[:60].any() and not (image != plain)[120:].any()  # the reason at the top, on the frame
 
 
 @pytest.mark.parametrize(("level", "name"), [(0, "dark"), (255, "saturated")])

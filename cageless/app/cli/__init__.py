@@ -104,6 +104,25 @@ def _check_scheduler(args: argparse.Namespace) -> None:
                              "--scheduler to run on this machine.") from None
 
 
+def _parse(parser: ArgumentParser, argv: Sequence[str]) -> argparse.Namespace:
+    """Parse ``argv``; an unknown option is refused in the name of the subcommand it was given to, with
+    that subcommand's closest option as a hint (argparse itself names only the top-level program)."""
+    from cageless.errors import suggest
+
+    args, extra = parser.parse_known_args(argv)
+    if not extra:
+        return args
+    prog = parser.prog
+    options: list[str] = []
+    if args.command is not None:
+        sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices[args.command]
+        prog = sub.prog
+        options = [o for a in sub._actions for o in a.option_strings]
+    first = next((w.split("=", 1)[0] for w in extra if w.startswith("-")), "")
+    hint = suggest(first, options) if first else ""
+    raise UsageError(f"{prog}: unrecognized arguments: {' '.join(extra)}.{hint}\nRun '{prog} --help' for usage.")
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI in-process and return its exit code.
 
@@ -122,7 +141,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser(command or "")  # "" registers no subcommand in full
     try:
         config = apply_config_defaults(parser, command, config_path_of(argv)) if command else {}
-        args = parser.parse_args(argv)
+        args = _parse(parser, argv)
         if args.command is None:
             parser.print_help()
             return EXIT_USAGE

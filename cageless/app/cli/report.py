@@ -89,13 +89,18 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
                             "folders) with their conditions.")
     print(f"parameters: {note}" if note else f"parameters: set '{options.parameter_set}'")
     res = run_lab(args.lab, args.out, options, bearing_from_config(config), progress=not args.quiet)
+    failed = []
     for row in sorted(res.rows, key=lambda r: (r.status == "failed", r.speed_rpm, r.radial_load_n, r.label)):
         if row.status == "failed":
-            print(failed_line(row.label, row.message), file=sys.stderr)
+            failed.append(row.label)
+            if args.quiet:  # else each failure was printed with its reason as it happened
+                print(failed_line(row.label, row.message), file=sys.stderr)
         else:
             print(f"{row.label}: {row.speed_rpm:g} r/min, {row.radial_load_n:g} N: theoretical slip "
                   f"{row.theoretical_slip_pct:.2f} %, experimental {row.experimental_slip_pct:.2f} %, "
                   f"MAE {row.mae_pp:.2f} pp")
+    if failed and not args.quiet:
+        print(f"failed: {', '.join(failed)} (the reasons are above and in the report)", file=sys.stderr)
     timing = ", ".join(f"{k} {v:.1f} s" for k, v in res.timings.items())
     print(f"report -> {res.report}; table -> {res.table} ({timing}; {res.skipped} jobs unchanged and skipped)")
     return 1 if res.n_failed else 0
