@@ -8,6 +8,7 @@ from typing import Any
 
 from cageless.errors import CagelessError, ParameterError
 from cageless.kinematics import LOADED_ZONE_HALF_WIDTH_DEG, loaded_zone_speed, rereference_slip
+from cageless.profiles import peak_standard_error
 from cageless.trace import Trace
 from cageless.comparison.align import MismatchError, Profiles, check_compatible, profiles, simulation_settle_s
 from cageless.comparison.metrics import profile_errors, unloaded_peak
@@ -40,6 +41,10 @@ class ComparisonRow:
     status: str = "ok"
     message: str = ""
     slip_reference: str = "cage"
+    #: Standard errors (pp) of the two slip rates from the balls they were taken over
+    #: (:func:`cageless.profiles.peak_standard_error`); NaN when not known.
+    theoretical_slip_se_pp: float = float("nan")
+    experimental_slip_se_pp: float = float("nan")
 
     def to_dict(self) -> dict[str, Any]:
         """Plain values."""
@@ -94,7 +99,9 @@ def compare(measured: Trace, simulated: Trace, bin_deg: float = 1.0, settle_s: f
         theoretical_slip_pct=100 * unloaded_peak(ps.slip), experimental_slip_pct=100 * unloaded_peak(pm.slip),
         mae_pp=err.mae_pp, rmse_pp=err.rmse_pp, max_error_pp=err.max_pp, label=label,
         status="mismatch" if mismatches else "ok", message="; ".join(mismatches + ([note] if note else [])),
-        slip_reference=slip_reference)
+        slip_reference=slip_reference,
+        theoretical_slip_se_pp=100 * peak_standard_error(ps.slip_per_ball, bin_deg),
+        experimental_slip_se_pp=100 * peak_standard_error(pm.slip_per_ball, bin_deg))
     return Comparison(row=row, measured=pm, simulated=ps, mismatches=mismatches, settle_s=settle_s)
 
 

@@ -18,7 +18,7 @@ from cageless.comparison.compare import SLIP_REFERENCES, ComparisonRow
 from cageless.comparison.metrics import SLIP_RATE_DEFINITION
 
 __all__ = ["table_frame", "number_cell", "slip_reference_note", "to_csv", "to_markdown", "to_latex", "to_html", "write_tables",
-           "HEADERS"]
+           "HEADERS", "SE_COLUMNS", "SE_NOTE"]
 
 HEADERS = {
     "speed_rpm": "Speed (r/min)", "radial_load_n": "Radial load (N)", "axial_load_n": "Axial load (N)",
@@ -31,9 +31,17 @@ def table_frame(rows: Sequence[ComparisonRow]) -> pd.DataFrame:
     """The rows as a frame, sorted by speed then loads; ``label``, ``status``, ``message`` and
     ``slip_reference`` (a key of :data:`~cageless.comparison.compare.SLIP_REFERENCES`) kept."""
     frame = pd.DataFrame([r.to_dict() for r in rows],
-                         columns=[*HEADERS, "label", "status", "message", "slip_reference"])
+                         columns=[*HEADERS, "label", "status", "message", "slip_reference", *SE_COLUMNS.values()])
     return frame.sort_values(["speed_rpm", "radial_load_n", "axial_load_n", "label"], kind="stable").reset_index(
         drop=True)
+
+
+#: The standard error column of each slip-rate column (shown as "value ± se" in the readable tables).
+SE_COLUMNS = {"theoretical_slip_pct": "theoretical_slip_se_pp", "experimental_slip_pct": "experimental_slip_se_pp"}
+
+#: Printed under every table with standard errors.
+SE_NOTE = ("± is the slip rate's standard error from the balls it was taken over (a bootstrap over the balls): "
+           "how far other balls, or a longer clip, could move it. It holds no tracking or model error.")
 
 
 def _labelled(frame: pd.DataFrame) -> bool:
@@ -60,13 +68,22 @@ def _cells(frame: pd.DataFrame) -> list[list[str]]:
         if r["status"] == "failed":
             cells += ["failed"] + [""] * 4
         else:
-            cells += [number_cell(r[c], ".2f") for c in list(HEADERS)[3:]]
+            cells += [_with_se(r, c) for c in list(HEADERS)[3:]]
         out.append(cells)
     return out
 
 
+def _with_se(r: pd.Series, column: str) -> str:
+    """A value cell, with `` ± se`` after a slip rate whose standard error is known."""
+    cell = number_cell(r[column], ".2f")
+    se = r.get(SE_COLUMNS.get(column, ""), float("nan"))
+    return f"{cell} ± {se:.2f}" if cell and isinstance(se, float) and math.isfinite(se) else cell
+
+
 def _notes(frame: pd.DataFrame) -> list[str]:
     notes = [SLIP_RATE_DEFINITION, slip_reference_note(frame)]
+    if any(frame[c].notna().any() for c in SE_COLUMNS.values()):
+        notes.append(SE_NOTE)
     for _, r in frame.iterrows():
         if r["status"] != "ok":
             where = (f" ({number_cell(r['speed_rpm'], 'g')} r/min, {number_cell(r['radial_load_n'], 'g')} N)"
@@ -98,7 +115,8 @@ def to_markdown(frame: pd.DataFrame) -> str:
 
 
 def _tex(text: str) -> str:
-    for a, b in (("\\", r"\textbackslash{}"), ("%", r"\%"), ("&", r"\&"), ("_", r"\_"), ("#", r"\#")):
+    for a, b in (("\\", r"\textbackslash{}"), ("%", r"\%"), ("&", r"\&"), ("_", r"\_"), ("#", r"\#"),
+                 ("±", r"$\pm$")):
         text = text.replace(a, b)
     return text
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Mapping, Sequence
 from datetime import datetime, timezone
 from typing import Any
@@ -67,9 +68,15 @@ def _summary(d: ConditionDescription) -> dict[str, Any]:
     passed, reasons = tracking_verdict(d.qc)
     return {"title": d.label, "condition": f"{r.speed_rpm:g} r/min, {r.radial_load_n:g} N radial, "
                                            f"{r.axial_load_n:g} N axial",
-            "theoretical": f"{r.theoretical_slip_pct:.2f} %", "experimental": f"{r.experimental_slip_pct:.2f} %",
+            "theoretical": _slip_text(r.theoretical_slip_pct, r.theoretical_slip_se_pp),
+            "experimental": _slip_text(r.experimental_slip_pct, r.experimental_slip_se_pp),
             "mae": f"{r.mae_pp:.2f} pp", "qc_pass": passed, "qc_reasons": reasons,
             "svg": figures.slip_figure(d, size=(3.4, 2.0)) if d.comparison is not None else None}
+
+
+def _slip_text(value_pct: float, se_pp: float) -> str:
+    """``"6.52 ± 1.30 %"`` (the standard error from the balls), or ``"6.52 %"`` when it is not known."""
+    return f"{value_pct:.2f} ± {se_pp:.2f} %" if math.isfinite(se_pp) else f"{value_pct:.2f} %"
 
 
 def _qc(d: ConditionDescription) -> dict[str, Any]:

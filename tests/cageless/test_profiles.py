@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from cageless.errors import ParameterError
-from cageless.profiles import angle_profile
+from cageless.profiles import angle_profile, peak_standard_error
 
 
 def test_profile_by_hand():
@@ -79,3 +79,33 @@ def test_smoothing_skips_empty_bins_and_keeps_them_empty():
     assert np.isnan(unloaded_zone_peak(prof))  # no data in 0-180 deg
     with pytest.raises(ParameterError, match="sigma_deg"):
         smooth_profile(m, 10.0, sigma_deg=-1.0)
+
+
+def test_peak_standard_error_of_balls_offset_by_constants_is_the_standard_error_of_their_mean():
+    """Closed form: ball j's profile = base + c_j (every ball on every bin), so the peak of any draw's mean is
+    peak(base) + mean(c over the draw), and the bootstrap standard error of a mean of Z values is
+    std(c, ddof=0) / sqrt(Z) (Efron & Tibshirani 1993, eq. 6.8); 300 draws estimate it to about
+    1 / sqrt(2 x 300) = 4 %."""
+    bins = np.arange(360) + 0.5
+    base = 0.05 * np.exp(-0.5 * ((bins - 90.0) / 25.0) ** 2)
+    c = np.random.default_rng(3).normal(0.0, 0.01, 14)
+    per_ball = base[:, None] + c[None, :]
+    se = peak_standard_error(per_ball, 1.0)
+    assert se == pytest.approx(c.std() / np.sqrt(14), rel=0.12)
+    assert peak_standard_error(per_ball, 1.0) == se  # the fixed seed: the same trace gives the same figure
+    assert peak_standard_error(np.repeat(base[:, None], 14, axis=1), 1.0) == pytest.approx(0.0, abs=1e-12)
+    assert np.isnan(peak_standard_error(base[:, None], 1.0))  # one ball: no spread to draw from
+
+
+def test_peak_standard_error_grows_when_each_angle_is_seen_by_few_balls():
+    """A short clip: each ball covers its own 60 deg arc, so each bin holds two or three balls and the draws
+    leave some bins to one ball; the same balls seen all round give a smaller error."""
+    bins = np.arange(360) + 0.5
+    base = 0.05 * np.exp(-0.5 * ((bins - 90.0) / 25.0) ** 2)
+    c = np.random.default_rng(4).normal(0.0, 0.01, 14)
+    full = base[:, None] + c[None, :]
+    arcs = full.copy()
+    for j in range(14):
+        seen = ((bins - j * 360 / 14) % 360) < 60
+        arcs[~seen, j] = np.nan
+    assert peak_standard_error(arcs, 1.0) > 1.5 * peak_standard_error(full, 1.0)

@@ -104,7 +104,9 @@ def test_compare_row_and_table_formats(tmp_path):
     frame = table_frame([c.row, failed])
     assert list(frame.speed_rpm) == [1800, 3000]
     md = to_markdown(frame)
-    assert f"| 3000 | 500 | 0 | {4.0 * shrink:.2f} | {6.0 * shrink:.2f} |" in md
+    # every ball of these traces has the same profile: the balls' standard error of each peak is 0
+    assert f"| 3000 | 500 | 0 | {4.0 * shrink:.2f} ± 0.00 | {6.0 * shrink:.2f} ± 0.00 |" in md
+    assert "standard error from the balls" in md and r"$\pm$" in to_latex(frame)
     assert "run_1800" in md and "peak of the mean slip" in md
     assert r"\toprule" in to_latex(frame) and "<table" in to_html(frame) and "failed" in to_html(frame)
     assert "theoretical_slip_pct" in to_csv(frame).splitlines()[0]

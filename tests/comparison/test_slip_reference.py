@@ -124,4 +124,4 @@ def test_compare_cli_takes_the_reference(tmp_path, capsys):
 def _row(markdown: str) -> list[float]:
     line = markdown.splitlines()[2]
     assert markdown.startswith("| Video |")  # compare labels its row with the video trace's file name
-    return [float(c) for c in line.strip("|").split("|")[1:]]
+    return [float(c.split("±")[0]) for c in line.strip("|").split("|")[1:]]  # "5.54 ± 0.00": the value

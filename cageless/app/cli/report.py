@@ -97,8 +97,8 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
                 print(failed_line(row.label, row.message), file=sys.stderr)
         else:
             print(f"{row.label}: {row.speed_rpm:g} r/min, {row.radial_load_n:g} N: theoretical slip "
-                  f"{row.theoretical_slip_pct:.2f} %, experimental {row.experimental_slip_pct:.2f} %, "
-                  f"MAE {row.mae_pp:.2f} pp")
+                  f"{row.theoretical_slip_pct:.2f} ± {row.theoretical_slip_se_pp:.2f} %, experimental "
+                  f"{row.experimental_slip_pct:.2f} ± {row.experimental_slip_se_pp:.2f} %, MAE {row.mae_pp:.2f} pp")
     if failed and not args.quiet:
         print(f"failed: {', '.join(failed)} (the reasons are above and in the report)", file=sys.stderr)
     timing = ", ".join(f"{k} {v:.1f} s" for k, v in res.timings.items())
