@@ -51,6 +51,9 @@ QC_LIMITS = {
     "max_speed_mismatch": 0.07,
     "max_speed_shortfall": 0.03,
     "min_slip": -0.01,  # a ball cannot orbit faster than pure rolling allows by more than the noise
+    # The trace's self-assessed precision (tracking/precision.py) against issue 14's bars on the corpus.
+    "max_angle_rms_mrad": 0.5,
+    "max_speed_rms_pct": 0.5,
 }
 
 
@@ -73,6 +76,7 @@ class QCReport:
     overlays: list[str] = field(default_factory=list)
     selection: dict[str, Any] = field(default_factory=dict)
     place_bias: dict[str, Any] = field(default_factory=dict)
+    precision: dict[str, Any] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready summary."""
