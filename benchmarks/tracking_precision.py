@@ -1,7 +1,7 @@
 """The trace's self-assessed precision (tracking/precision.py) against the truth on the corpus.
 
     python benchmarks/tracking_precision.py [--cache DIR] [--sets HOLDOUT,FRESH,FRESH2,FRESH3] [--workers 1]
-                                            [--calibrate] [--json out.json]
+                                            [--calibrate] [--long] [--json out.json]
 
 Tracks every short clip of the chosen seed sets (rendered once into ``--cache``/ci, default
 ``/tmp/cageless-corpus``, and reused), scores the trace against the clip's truth
@@ -10,7 +10,8 @@ Tracks every short clip of the chosen seed sets (rendered once into ``--cache``/
 warning fired; then the correlation of estimate and truth (of their logarithms too) and the confusion
 counts of "the estimate is over the bar" against "the truth is over the bar", angle and speed.
 
-``--calibrate`` (TUNING only: the other sets are never used for tuning) also prints the medians of true
+``--long`` runs the long variants instead (one cage revolution each, in ``--cache``/long; TUNING and HOLDOUT
+have them; their videos are kept). ``--calibrate`` (TUNING only: the other sets are never used for tuning) also prints the medians of true
 over estimated noise that :data:`cageless.tracking.precision.ANGLE_GAIN` and ``SPEED_GAIN`` are set to
 (the gains in use are divided out first, so the medians are the gains a re-calibration would set).
 """
@@ -33,9 +34,9 @@ from cageless.tracking.synthetic.matrix import SETS
 from cageless.tracking.synthetic.score import BARS
 
 
-def _one(args: tuple[int, str]) -> dict[str, Any]:
+def _one(args: tuple[int, str, bool]) -> dict[str, Any]:
     """Track and score one clip; its precision record, score and warnings (or its error)."""
-    seed, folder = args
+    seed, folder, long = args
     logging.disable(logging.WARNING)
     warnings.simplefilter("ignore")
     from cageless.errors import CagelessError
@@ -43,7 +44,7 @@ def _one(args: tuple[int, str]) -> dict[str, Any]:
     from cageless.tracking.synthetic.corpus import render_clip
     from cageless.tracking.synthetic.score import score_trace
 
-    spec = render_clip(seed, folder)
+    spec = render_clip(seed, folder, long=long)
     try:
         res = track_video(spec.video, spec.conditions, spec.bearing, TrackOptions(threads=1), progress=False)
     except CagelessError as exc:
@@ -55,11 +56,11 @@ def _one(args: tuple[int, str]) -> dict[str, Any]:
 
 def _row(r: dict[str, Any]) -> str:
     if "error" in r:
-        return f"| {r['seed']} | refused: {r['error'][:90].replace('|', '/')} |" + " |" * 7
+        return f"| {r['seed']} | refused: {r['error'][:90].replace('|', '/')} |" + " |" * 8
     s, p = r["score"], r["precision"]
     return (f"| {r['seed']} | {s['angle_rms_mrad']:.3f} | {p['angle_rms_mrad']:.3f} | {s['speed_rms_pct']:.3f} | "
             f"{p['speed_rms_pct']:.3f} | {p['noise_mrad']:.3f} | {p['jump_share']:.4f} | "
-            f"{'yes' if r['warned'] else 'no'} | {'pass' if s['passed'] else 'FAIL'} |")
+            f"{'yes' if r['warned'] else 'no'} | {'pass' if s['passed'] else 'FAIL'} | {'; '.join(s['failures'])} |")
 
 
 def _confusion(true: np.ndarray, est: np.ndarray, bar: float) -> str:
@@ -71,7 +72,7 @@ def _confusion(true: np.ndarray, est: np.ndarray, bar: float) -> str:
 def summarise(name: str, results: list[dict[str, Any]]) -> str:
     """Markdown table of one set, the correlations and the confusion counts."""
     head = ["seed", "true angle mrad", "est. angle mrad", "true speed %", "est. speed %", "noise mrad",
-            "jump share", "QC warning", "bars"]
+            "jump share", "QC warning", "bars", "why"]
     lines = [f"### {name}", "", "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     lines += [_row(r) for r in results]
     ok = [r for r in results if "error" not in r and r["precision"]]
@@ -109,6 +110,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sets", default="HOLDOUT,FRESH,FRESH2,FRESH3")
     ap.add_argument("--workers", type=int, default=1)
     ap.add_argument("--calibrate", action="store_true", help="TUNING only: print the gains it gives")
+    ap.add_argument("--long", action="store_true", help="the long variants (TUNING and HOLDOUT only)")
     ap.add_argument("--json", type=Path)
     args = ap.parse_args(argv)
     names = ["TUNING"] if args.calibrate else args.sets.split(",")
@@ -116,9 +118,12 @@ def main(argv: list[str] | None = None) -> int:
     if unknown:
         print(f"--sets {args.sets}: unknown set {unknown[0]}; choose from {', '.join(SETS)}", file=sys.stderr)
         return 2
+    if args.long and set(names) - {"TUNING", "HOLDOUT"}:
+        print(f"--long: only TUNING and HOLDOUT have long variants, not {args.sets}", file=sys.stderr)
+        return 2
     out: dict[str, list[dict[str, Any]]] = {}
     for name in names:
-        jobs = [(int(s), str(args.cache / "ci")) for s in SETS[name]]
+        jobs = [(int(s), str(args.cache / ("long" if args.long else "ci")), args.long) for s in SETS[name]]
         if args.workers <= 1:
             results = [_one(j) for j in jobs]
         else:

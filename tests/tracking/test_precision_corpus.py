@@ -1,0 +1,54 @@
+"""The self-assessed precision on two CI corpus clips, through the trace file to the report's QC verdict.
+
+Seeds 1001 and 1002 are TUNING seeds of the CI block (tests/tracking/test_corpus_matrix.py), rendered once per
+session into ``$CAGELESS_CORPUS_CACHE/ci`` (default a pytest temporary folder). Measured values: commit 60a4470,
+``python benchmarks/tracking_precision.py --calibrate`` (2026-11-27) before the gains were set, times the gains
+(ANGLE_GAIN 1.11, SPEED_GAIN 0.93): 1001 estimates 0.049 x 1.11 = 0.0544 mrad and 0.0516 x 0.93 = 0.0480 %
+against true 0.0752 mrad and 0.0382 %; 1002 (white-noise dominated, 0.615 mrad per sample) estimates
+0.5857 x 1.11 = 0.650 mrad and 0.2707 x 0.93 = 0.252 % against true 0.391 mrad and 0.165 %: a false alarm of
+the angle warning (the estimate's gain is set for clips whose error is partly slow; white noise the track fit
+averages is over-estimated by about 1.6 times).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+from cageless.trace import read_trace
+from cageless.tracking.pipeline import track_video
+from cageless.tracking.synthetic.corpus import render_clip
+from cageless.tracking.synthetic.score import score_trace
+from comparison.report.describe import tracking_verdict
+
+#: seed: (estimated angle RMS mrad, estimated speed RMS %), measured as the module docstring says.
+MEASURED = {1001: (0.0544, 0.0480), 1002: (0.650, 0.252)}
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory) -> Path:
+    env = os.environ.get("CAGELESS_CORPUS_CACHE")
+    return Path(env) / "ci" if env else tmp_path_factory.mktemp("corpus-precision")
+
+
+@pytest.mark.parametrize("seed", sorted(MEASURED))
+def test_estimate_on_corpus_clip(seed, folder, tmp_path):
+    spec = render_clip(seed, folder)
+    res = track_video(spec.video, spec.conditions, spec.bearing, out_dir=tmp_path, progress=False)
+    trace = read_trace(res.path)
+    p = trace.qc["precision"]
+    angle, speed = MEASURED[seed]
+    assert p["angle_rms_mrad"] == pytest.approx(angle, rel=2e-3)
+    assert p["speed_rms_pct"] == pytest.approx(speed, rel=2e-3)
+    score = score_trace(trace, spec.truth, spec.bearing)
+    assert 0.5 < p["angle_rms_mrad"] / score.angle_rms_mrad < 2.0  # within a factor of two of the truth
+    assert 0.5 < p["speed_rms_pct"] / score.speed_rms_pct < 2.0
+    low = [w for w in trace.qc["warnings"] if w.startswith("low precision")]
+    passed, reasons = tracking_verdict(trace.qc)
+    if angle > 0.5:
+        assert len(low) == 1 and f"{p['angle_rms_mrad']:.2f} mrad RMS is worse than 0.5 mrad" in low[0]
+        assert not passed and any("low precision" in r for r in reasons)  # what `cageless report` shows
+    else:
+        assert not low
