@@ -75,7 +75,7 @@ def revolution_speed(time_s: npt.ArrayLike, angle: npt.ArrayLike, window: int = 
 
 
 def robust_track_fit(time_s: npt.ArrayLike, angle: npt.ArrayLike, valid: npt.ArrayLike, frames: int = 7,
-                     passes: int = 3) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_]]:
+                     passes: int = 3, exact: bool = True) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_]]:
     """Each ball's angle from a robust local quadratic over ``frames`` frames around each sample.
 
     Over a few frames a ball moves along its circle at nearly constant speed, so its angle is a
@@ -125,14 +125,14 @@ def robust_track_fit(time_s: npt.ArrayLike, angle: npt.ArrayLike, valid: npt.Arr
         base = ok[idx, j].astype(np.float64)
         w = base.copy()
         for _ in range(passes):
-            fit = _weighted_quadratic(design, y, w)
-            res = y - np.einsum("tkp,tp->tk", design, fit)
+            fit = _weighted_quadratic(design, y, w, exact)
+            res = y - (np.einsum("tkp,tp->tk", design, fit) if exact else (design @ fit[..., None])[..., 0])
             centre_res = res[np.arange(n), np.arange(n) - start]
             scale = 1.4826 * float(np.median(np.abs(centre_res[ok[:, j]]))) if ok[:, j].any() else 0.0
             scale = max(scale, _SCALE_FLOOR_RAD)
             u = res / (_BIWEIGHT_C * scale)
             w = base * np.where(np.abs(u) < 1.0, (1.0 - u * u) ** 2, 0.0)
-        fit = _weighted_quadratic(design, y, w)
+        fit = _weighted_quadratic(design, y, w, exact)
         good = (w > 0).sum(axis=1) >= 3
         out[good, j] = fit[good, 0]
         own = w[np.arange(n), np.arange(n) - start]
@@ -140,9 +140,14 @@ def robust_track_fit(time_s: npt.ArrayLike, angle: npt.ArrayLike, valid: npt.Arr
     return out, keep
 
 
-def _weighted_quadratic(design: np.ndarray, y: np.ndarray, w: np.ndarray) -> np.ndarray:
+def _weighted_quadratic(design: np.ndarray, y: np.ndarray, w: np.ndarray, exact: bool = True) -> np.ndarray:
     """Weighted least-squares quadratic coefficients for each row (a tiny ridge keeps a starved row solvable)."""
     dw = design * w[..., None]
-    lhs = np.einsum("tkp,tkq->tpq", dw, design) + 1e-9 * np.eye(3)
-    rhs = np.einsum("tkp,tk->tp", dw, y)
+    if exact:
+        lhs = np.einsum("tkp,tkq->tpq", dw, design) + 1e-9 * np.eye(3)
+        rhs = np.einsum("tkp,tk->tp", dw, y)
+    else:
+        dwt = dw.transpose(0, 2, 1)
+        lhs = dwt @ design + 1e-9 * np.eye(3)
+        rhs = (dwt @ y[..., None])[..., 0]
     return np.linalg.solve(lhs, rhs[..., None])[..., 0]

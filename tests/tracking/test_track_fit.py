@@ -55,3 +55,18 @@ def test_window_must_be_odd_and_at_least_five():
         robust_track_fit(t, truth, np.ones_like(truth, bool), frames=4)
     same, _ = robust_track_fit(t, truth, np.ones_like(truth, bool), frames=1)
     assert np.array_equal(same, truth)
+
+
+@pytest.mark.parametrize("frames", [7, 11, 21])
+def test_matrix_product_form_equals_the_exact_one_to_rounding(frames):
+    """``exact=False`` (matmul instead of einsum, for QC estimates) sums in another order: the same fit to
+    rounding of the angles' size (here up to 40 rad: 1e-13 rad), the same samples dropped."""
+    t, truth, rng = _clip(2000, z=4)
+    noisy = truth + rng.normal(0, 1e-4, truth.shape)
+    noisy[500, 2] += 5e-3
+    valid = np.ones_like(truth, bool)
+    valid[::37, 1] = False
+    exact, keep = robust_track_fit(t, noisy, valid, frames)
+    fast, keep_fast = robust_track_fit(t, noisy, valid, frames, exact=False)
+    assert np.max(np.abs(fast - exact)) < 1e-11
+    assert np.array_equal(keep, keep_fast) and not keep[500, 2]
