@@ -12,6 +12,7 @@ averages is over-estimated by about 1.6 times).
 
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
 
@@ -39,6 +40,7 @@ def test_estimate_on_corpus_clip(seed, folder, tmp_path):
     res = track_video(spec.video, spec.conditions, spec.bearing, out_dir=tmp_path, progress=False)
     trace = read_trace(res.path)
     p = trace.qc["precision"]
+    assert json.loads((tmp_path / "qc" / f"{spec.video.stem}.qc.json").read_text())["precision"] == p
     angle, speed = MEASURED[seed]
     assert p["angle_rms_mrad"] == pytest.approx(angle, rel=2e-3)
     assert p["speed_rms_pct"] == pytest.approx(speed, rel=2e-3)
