@@ -59,7 +59,7 @@ def main() -> None:
     ap.add_argument("--speed-rpm", type=float, default=3000.0)
     ap.add_argument("--copy", action="store_true", help="the per-frame loop on in-memory copies of its blocks")
     args = ap.parse_args()
-    for name in ("background_frame", "_locate", "_select", "_track_all", "_finish", "_precision", "noise_sigma",
+    for name in ("background_frame", "_locate", "_select", "_track_all", "_finish", "assess_table", "noise_sigma",
                  "static_defects", "static_pattern"):
         _wrap(pipeline, name)
     _wrap(select, "link_tracklets")

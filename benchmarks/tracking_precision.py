@@ -11,9 +11,10 @@ warning fired; then the correlation of estimate and truth (of their logarithms t
 counts of "the estimate is over the bar" against "the truth is over the bar", angle and speed.
 
 ``--long`` runs the long variants instead (one cage revolution each, in ``--cache``/long; TUNING and HOLDOUT
-have them; their videos are kept). ``--calibrate`` (TUNING only: the other sets are never used for tuning) also prints the medians of true
-over estimated noise that :data:`cageless.tracking.precision.ANGLE_GAIN` and ``SPEED_GAIN`` are set to
-(the gains in use are divided out first, so the medians are the gains a re-calibration would set).
+have them; their videos are kept). ``--calibrate`` (TUNING only: the other sets are never used for tuning)
+also prints the medians of the true error over the estimate with the gains in use divided out: what
+:data:`cageless.tracking.precision.ANGLE_GAIN` and ``SPEED_GAIN`` are set to (the gains a re-calibration would
+set).
 """
 
 from __future__ import annotations
@@ -84,7 +85,8 @@ def summarise(name: str, results: list[dict[str, Any]]) -> str:
             continue
         ratio = est / true
         out.append(f"{key}: correlation {np.corrcoef(true, est)[0, 1]:.3f} (of the logarithms "
-                   f"{np.corrcoef(np.log(true), np.log(est))[0, 1]:.3f}); estimate / truth median {np.median(ratio):.2f}, "
+                   f"{np.corrcoef(np.log(true), np.log(est))[0, 1]:.3f}); estimate / truth median "
+                   f"{np.median(ratio):.2f}, "
                    f"within a factor of 2 on {int(np.sum((ratio > 0.5) & (ratio < 2)))} of {len(ok)}; bar {bar}: "
                    + _confusion(true, est, bar))
     warned = np.array([r["warned"] for r in ok])
@@ -96,12 +98,12 @@ def summarise(name: str, results: list[dict[str, Any]]) -> str:
 
 
 def calibration(results: list[dict[str, Any]]) -> str:
-    """The medians of truth over noise-based estimate with the gains in use divided out."""
+    """The medians of the true error over the estimate with the gains in use divided out."""
     ok = [r for r in results if "error" not in r and r["precision"]]
     ga = [r["score"]["angle_rms_mrad"] / r["precision"]["angle_rms_mrad"] * r["precision"]["angle_gain"] for r in ok]
     gs = [r["score"]["speed_rms_pct"] / r["precision"]["speed_rms_pct"] * r["precision"]["speed_gain"] for r in ok]
     return (f"calibration on {len(ok)} traces: ANGLE_GAIN = {np.median(ga):.2f}, SPEED_GAIN = {np.median(gs):.2f} "
-            "(medians of truth over the noise-based estimate)")
+            "(medians of the true error over the estimate without gains)")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -34,7 +34,7 @@ from cageless.provenance import VIDEO_HASH, Provenance
 from cageless.trace import Trace, VideoInfo, write_trace
 from cageless.tracking.detect import (DetectorParams, detect_full, noise_sigma, spot_sigma, static_defects,
                                       static_pattern)
-from cageless.tracking.geometry import Orbit, fit_orbit, orbital_angles
+from cageless.tracking.geometry import fit_orbit, orbital_angles
 from cageless.tracking.io import CineReader, FrameSource, open_video
 from cageless.tracking.kinematics import DEFAULT_TRACK_FIT, DEFAULT_WINDOW, revolution_speed, robust_track_fit
 from cageless.tracking.link import BallCountWarning, TrackSetup, track_frames
@@ -45,7 +45,7 @@ from cageless.tracking.qc import (QC_LIMITS, QCReport, build_qc, slip_warnings, 
                                   write_selection_qc)
 from cageless.tracking.select import SPEED_BAND, Selection, SelectionError, select_balls
 from cageless.tracking.position_bias import remove_place_bias
-from cageless.tracking.precision import Precision, assess_precision, precision_warning
+from cageless.tracking.precision import assess_table, precision_warning
 
 __all__ = ["TrackOptions", "TrackResult", "track_video"]
 
@@ -549,16 +549,6 @@ def _selection_summary(sel: Selection, du: int, dv: int) -> dict[str, Any]:
             "rejected": {str(k): int(v) for k, v in reasons.items()}}
 
 
-def _precision(table: pd.DataFrame, order: np.ndarray, times: np.ndarray, angle: np.ndarray, valid: np.ndarray,
-               orbit: Orbit, omega_c: float, options: TrackOptions) -> Precision | None:
-    """The trace's self-assessed precision (:mod:`cageless.tracking.precision`) from the angles before the track
-    fit and the highlight positions in the trace's ball order."""
-    z = int(table.ball.max()) + 1
-    u_px, v_px = (table[c].to_numpy().reshape(-1, z)[:, order] for c in ("u_px", "v_px"))
-    return assess_precision(times, angle, valid, u_px, v_px, orbit.centre, orbit.radius, omega_c, options.window,
-                            options.polyorder, options.track_fit)
-
-
 def _finish(path: Path, video: FrameSource, table: pd.DataFrame, loc: BearingLocation,
             conditions: OperatingConditions, bearing: Bearing, options: TrackOptions, prov: Provenance,
             warned: list[str], selection: dict[str, Any] | None = None) -> tuple[Trace, QCReport]:
@@ -569,7 +559,8 @@ def _finish(path: Path, video: FrameSource, table: pd.DataFrame, loc: BearingLoc
     times = video.times
     angle, place = remove_place_bias(times, angle, valid, orbit.radius)
     omega_c = theoretical_cage_speed(g, conditions.speed_rad_s)
-    precision = _precision(table, order, times, angle, valid, orbit, omega_c, options)
+    precision = assess_table(table, order, times, angle, valid, orbit.centre, orbit.radius, omega_c, options.window,
+                             options.polyorder, options.track_fit)
     try:
         angle, valid = robust_track_fit(times, angle, valid, options.track_fit)
     except ParameterError as exc:

@@ -28,6 +28,8 @@ Public API::
     radial_scatter(u_px, v_px, valid, centre_px, radius_px) -> (T, Z) radial residual over the radius
     assess_precision(time_s, angle, valid, u_px, v_px, centre_px, radius_px, omega_c, window, polyorder,
                      track_fit) -> Precision | None
+    assess_table(table, order, time_s, angle, valid, centre_px, radius_px, omega_c, window, polyorder,
+                 track_fit) -> Precision | None   (positions from the tracker's table)
     precision_warning(p, bars) -> str | None
 """
 
@@ -39,11 +41,12 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
+import pandas as pd
 
 from cageless.tracking.kinematics import revolution_speed, robust_track_fit
 
 __all__ = ["NOISE_FRAMES", "ANGLE_GAIN", "SPEED_GAIN", "JUMP_SIGMA", "Precision", "angle_noise", "radial_scatter",
-           "assess_precision", "precision_warning", "savgol_slope_gain", "centre_leverage"]
+           "assess_precision", "assess_table", "precision_warning", "savgol_slope_gain", "centre_leverage"]
 
 #: Frames of the robust local quadratic that stands for each ball's motion (1.1 ms at 10 kfps).
 NOISE_FRAMES = 11
@@ -253,6 +256,18 @@ def assess_precision(time_s: npt.ArrayLike, angle: npt.ArrayLike, valid: npt.Arr
     return Precision(angle_rms_mrad=1e3 * ANGLE_GAIN * angle_rms, speed_rms_pct=100 * SPEED_GAIN * speed_rms / omega_c,
                      noise_mrad=1e3 * noise, radial_mrad=1e3 * float(np.nan_to_num(radial_angle)),
                      worst_ball_noise_mrad=1e3 * float(np.nanmax(sigma)), jump_share=float(np.mean(jumps)))
+
+
+def assess_table(table: pd.DataFrame, order: npt.ArrayLike, time_s: npt.ArrayLike, angle: npt.ArrayLike,
+                 valid: npt.ArrayLike, centre_px: tuple[float, float], radius_px: float, omega_c: float, window: int,
+                 polyorder: int = 2, track_fit: int = 7) -> Precision | None:
+    """:func:`assess_precision` with the highlight positions taken from the tracker's table (columns ``ball``,
+    ``u_px``, ``v_px``, frame-major) in the trace's ball order (``order[k]``: the table's ball that is ball k)."""
+    z = int(table.ball.max()) + 1
+    cols = np.asarray(order)
+    u_px, v_px = (table[c].to_numpy().reshape(-1, z)[:, cols] for c in ("u_px", "v_px"))
+    return assess_precision(time_s, angle, valid, u_px, v_px, centre_px, radius_px, omega_c, window, polyorder,
+                            track_fit)
 
 
 def precision_warning(p: Precision | None, bars: dict[str, Any]) -> str | None:

@@ -129,7 +129,8 @@ KNOWN_FAILURES: dict[int, str] = {
 #: re-measured (not the other 55): 1011 0.637 -> 0.701 mrad, 7009 0.604 -> 0.623, 7018 0.695 -> 0.641 (still failing);
 #: 1029 passes at 0.487 mrad, 7002 0.328, and 1009, 7011, 7024, 7025 pass. All 64 re-measured with the tracker of
 #: main 9422302 (with the backward pass started where the forward pass settled; run from branch trackprec, commits
-#: 60a4470 and 43c244c, whose precision estimate does not change the trace: benchmarks/tracking_precision.py --long,
+#: 60a4470 and 43c244c, b72f028 and 0e041df once rebased onto main 3da97eb, whose precision estimate does not
+#: change the trace: benchmarks/tracking_precision.py --long,
 #: 2026-11-27): the same 57 pass and the same 7 fail; 7026 1.18 -> 1.20 mrad, 7018 0.641 -> 0.640, 1011 speed
 #: 0.825 -> 0.824 %, the rest unchanged.
 _LONG_MEASURED: dict[int, str] = {

@@ -1,8 +1,9 @@
 """The self-assessed precision on two CI corpus clips, through the trace file to the report's QC verdict.
 
 Seeds 1001 and 1002 are TUNING seeds of the CI block (tests/tracking/test_corpus_matrix.py), rendered once per
-session into ``$CAGELESS_CORPUS_CACHE/ci`` (default a pytest temporary folder). Measured values: commit 60a4470,
-``python benchmarks/tracking_precision.py --calibrate`` (2026-11-27) before the gains were set, times the gains
+session into ``$CAGELESS_CORPUS_CACHE/ci`` (default a pytest temporary folder). Measured values: the tree of
+commit 60a4470 (the estimator on main 9422302; b72f028 once rebased onto 3da97eb),
+with the gains at 1, ``python benchmarks/tracking_precision.py --calibrate`` (2026-11-27), times the gains
 (ANGLE_GAIN 1.11, SPEED_GAIN 0.93): 1001 estimates 0.049 x 1.11 = 0.0544 mrad and 0.0516 x 0.93 = 0.0480 %
 against true 0.0752 mrad and 0.0382 %; 1002 (white-noise dominated, 0.615 mrad per sample) estimates
 0.5857 x 1.11 = 0.650 mrad and 0.2707 x 0.93 = 0.252 % against true 0.391 mrad and 0.165 %: a false alarm of
