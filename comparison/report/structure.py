@@ -91,8 +91,16 @@ def _qc(d: ConditionDescription) -> dict[str, Any]:
                   ("interpolated samples", f"{100 * qc.get('interpolated_share', 0):.2f} %"),
                   ("orbit fit residual", f"{qc.get('orbit_residual_px', float('nan')):.3f} px"),
                   ("scale", f"{qc.get('px_per_mm', float('nan')):.3f} px/mm"),
+                  ("estimated precision (from the trace alone)", _precision_text(qc.get("precision") or {})),
                   ("warnings", "; ".join(qc.get("warnings", [])) or "none")]
     return {"title": d.label, "facts": facts}
+
+
+def _precision_text(p: Mapping[str, Any]) -> str:
+    """The trace's self-assessed angle and speed precision, or "-" for a trace that does not carry one."""
+    if "angle_rms_mrad" not in p or "speed_rms_pct" not in p:
+        return "-"
+    return f"angle {p['angle_rms_mrad']:.2f} mrad RMS, speed {p['speed_rms_pct']:.2f} % of the cage speed RMS"
 
 
 def build_report(descriptions: Sequence[ConditionDescription], failed_rows: Sequence[ComparisonRow] = (),

@@ -24,6 +24,7 @@ from cageless.tracking.pipeline import track_video
 from cageless.tracking.synthetic.corpus import render_clip
 from cageless.tracking.synthetic.score import score_trace
 from comparison.report.describe import tracking_verdict
+from comparison.report.structure import _precision_text
 
 #: seed: (estimated angle RMS mrad, estimated speed RMS %), measured as the module docstring says.
 MEASURED = {1001: (0.0544, 0.0480), 1002: (0.650, 0.252)}
@@ -55,3 +56,7 @@ def test_estimate_on_corpus_clip(seed, folder, tmp_path):
         assert not passed and any("low precision" in r for r in reasons)  # what `cageless report` shows
     else:
         assert not low
+    # the report's QC facts give the numbers, not only the warning
+    assert _precision_text(trace.qc["precision"]) == (f"angle {angle:.2f} mrad RMS, speed {speed:.2f} % of the "
+                                                      "cage speed RMS")
+    assert _precision_text({}) == "-"  # a trace tracked before the estimate existed

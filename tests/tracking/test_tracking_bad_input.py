@@ -105,6 +105,8 @@ def test_cli_folder_one_bad_video_does_not_stop_the_rest(tmp_path, capsys):
     assert main(["track", str(lab), "-o", str(out), "-q", "--workers", "1"]) == 1
     cap = capsys.readouterr()
     assert "ok     n3000_Fr500.cine: 30 frames, 14 balls" in cap.out
+    precision = read_trace(out / "n3000_Fr500.trace.h5").qc["precision"]["angle_rms_mrad"]
+    assert f", angle precision {precision:.2f} mrad -> " in cap.out  # the trace's own estimate, on its line
     assert "FAILED n1800_Fr500.cine" in cap.err and "too short" in cap.err
     assert "FAILED" in cap.err and "mystery.cine: no operating conditions found" in cap.err
     assert "`--speed-rpm` gives its speed" in cap.err  # the missing-conditions line says how to give them here

@@ -140,7 +140,13 @@ def _track_one(job: tuple[Path, OperatingConditions, Bearing, Any, Path]) -> tup
     peak = unloaded_peak(angle_profile(tr.angle, tr.slip, 1.0, valid=tr.valid))
     return "ok", {"path": str(res.path), "frames": tr.n_samples, "balls": tr.n_balls,
                   "detected": float(np.mean(res.qc.detection_rate)), "warnings": res.qc.warnings,
-                  "peak_slip": peak}
+                  "peak_slip": peak, "precision_mrad": (res.qc.precision or {}).get("angle_rms_mrad")}
+
+
+def _precision(info: dict[str, Any]) -> str:
+    """``", angle precision 0.06 mrad"`` (the trace's self-assessed RMS angle error), or ``""`` without one."""
+    value = info.get("precision_mrad")
+    return f", angle precision {value:.2f} mrad" if value is not None else ""
 
 
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
@@ -199,7 +205,7 @@ def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bear
                 warn = f"; QC: {'; '.join(info['warnings'])}" if info["warnings"] else ""
                 tqdm.write(f"ok     {_shown(video)}: {info['frames']} frames, {info['balls']} balls, "
                            f"{100 * info['detected']:.1f}% detected, peak unloaded slip "
-                           f"{100 * info['peak_slip']:.2f}% -> {info['path']}{warn}")
+                           f"{100 * info['peak_slip']:.2f}%{_precision(info)} -> {info['path']}{warn}")
             else:
                 tqdm.write(failed_line(video, info, shown=_shown(video)), file=sys.stderr)
                 failed += 1
