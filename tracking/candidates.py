@@ -23,7 +23,6 @@ from dataclasses import dataclass, field
 import cv2
 import numpy as np
 import numpy.typing as npt
-from scipy.optimize import linear_sum_assignment
 
 __all__ = ["Candidates", "Tracklet", "blob_response", "response_map", "bin_mask", "find_candidates", "refine_candidates",
            "response_noise",
@@ -251,6 +250,8 @@ def link_tracklets(cands: list[Candidates], gate_px: float, max_misses: int = 2,
             per = np.array([fine if len(t.frames) >= 2 else gate_px for t in live])
             gate = (per * gap)[:, None]
             cost = np.where(d <= gate, d, 1e9)
+            from scipy.optimize import linear_sum_assignment  # on first use, see locate.fit_circle
+
             rows, cols = linear_sum_assignment(cost)
             ok = cost[rows, cols] < 1e9
             rows, cols = rows[ok], cols[ok]

@@ -20,7 +20,6 @@ from pathlib import Path
 import cv2
 import numpy as np
 import numpy.typing as npt
-from scipy import optimize
 
 from cageless.errors import TrackingError
 from cageless.tracking.io.base import FrameSource
@@ -136,6 +135,8 @@ def fit_circle(u: npt.ArrayLike, v: npt.ArrayLike) -> tuple[float, float, float,
 
     def resid(p: np.ndarray) -> np.ndarray:
         return np.hypot(u - p[0], v - p[1]) - p[2]
+
+    from scipy import optimize  # imported on first use (0.5-0.7 s of CPU): see pipeline._import_late_modules
 
     res = optimize.least_squares(resid, [cx, cy, r0], method="lm")
     cx, cy, r = res.x

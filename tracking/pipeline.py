@@ -55,13 +55,15 @@ log = logging.getLogger(__name__)
 #: are tracked.
 INPUT_HASH = VIDEO_HASH
 #: Shortest segment worth a thread, and the frames two segments share to match identities.
-_MIN_SEGMENT = 1024
+_MIN_SEGMENT = 500
 _OVERLAP = 8
 #: Quantile of the sampled frames that the ball selection subtracts (see :func:`_setup`).
 SELECT_QUANTILE = 0.25
 #: Frames served from a memory map between drops of their pages (fault-around maps whole frames:
 #: 8 full-size 16-bit frames are 16 MB).
 _DROP_EVERY = 8
+#: Single frames kept by a non-memory-mapped frame source between chunk reads (:class:`_CroppedFrames`).
+_SINGLE_FRAMES = 16
 #: Frames spread over the video whose minimum tells a static defect (bright in all of them) from a trace
 #: that passing highlights leave in the median background.
 _DEFECT_FRAMES = 16
@@ -88,7 +90,7 @@ class TrackOptions:
     qc_frames
         How many overlay images to write.
     threads
-        Segments tracked in parallel threads for long videos (each at least 1024 frames).
+        Segments tracked in parallel threads for videos of 1,000 frames or more (each at least 500 frames).
     allow_truncated
         Track the complete frames of a truncated ``.cine`` instead of refusing it.
     n_balls
@@ -126,14 +128,16 @@ class TrackResult:
 
 
 class _CroppedFrames:
-    """Random access to cropped frames ``offset + i``: zero-copy views of a memory-mapped cine, or whole
-    chunks read and the last two kept."""
+    """Random access to cropped frames ``offset + i``: zero-copy views of a memory-mapped cine; otherwise
+    :meth:`block` reads whole chunks and keeps the last two, and a single frame outside them is read alone
+    (the last :data:`_SINGLE_FRAMES` kept): the set-up's spread sample frames each cost a 64-frame chunk before."""
 
     def __init__(self, video: FrameSource, rows: slice, cols: slice, chunk: int, offset: int = 0,
                  stop: int | None = None) -> None:
         self.video, self.rows, self.cols, self.chunk, self.offset = video, rows, cols, chunk, offset
         self.stop = len(video) if stop is None else stop
         self._cache: OrderedDict[int, np.ndarray] = OrderedDict()
+        self._single: OrderedDict[int, np.ndarray] = OrderedDict()
         # Memory-mapped 8/16-bit cine: hand out views; the window kernel touches only the pages it needs.
         self.zero_copy = isinstance(video, CineReader) and not video._packed_bits
         self._stack = video.frame_stack() if self.zero_copy else None  # type: ignore[attr-defined]
@@ -150,7 +154,16 @@ class _CroppedFrames:
                 return self._stack[j, self.rows, self.cols]
             return self.video.frame_view(j)[self.rows, self.cols]
         k = i // self.chunk
-        return self._chunk(k)[i - k * self.chunk]
+        block = self._cache.get(k)
+        if block is not None:
+            return block[i - k * self.chunk]
+        frame = self._single.get(i)
+        if frame is None:
+            frame = self.video[self.offset + i][self.rows, self.cols]
+            self._single[i] = frame
+            if len(self._single) > _SINGLE_FRAMES:
+                self._single.popitem(last=False)
+        return frame
 
     @property
     def block_size(self) -> int:
@@ -358,9 +371,13 @@ def _refuse_located(exc: TrackingError, path: Path, video: FrameSource, out_dir:
 
 
 def _import_late_modules() -> None:
-    """Import what only the last stages use (``scipy.signal``, for the speed), so that a cold process does it
-    beside the tracking rather than before it (see :func:`cageless.tracking.kinematics._savgol_filter`)."""
+    """Import what later stages use, so that a cold process does it beside the first stages rather than before
+    them: ``scipy.optimize`` (the circle fits of the localisation and the selection's assignments, first needed
+    after the median background) and ``scipy.signal`` (the speed, see
+    :func:`cageless.tracking.kinematics._savgol_filter`). A stage that needs a module before it is in waits on
+    Python's import lock, so nothing is imported twice."""
     try:
+        import scipy.optimize  # noqa: F401
         import scipy.signal  # noqa: F401
     except ImportError:  # reported where it is used
         pass
@@ -370,7 +387,7 @@ _LATE_IMPORTS: list[threading.Thread] = []
 
 
 def _start_late_imports() -> None:
-    if not _LATE_IMPORTS and "scipy.signal" not in sys.modules:
+    if not _LATE_IMPORTS and not {"scipy.optimize", "scipy.signal"} <= sys.modules.keys():
         _LATE_IMPORTS.append(threading.Thread(target=_import_late_modules, name="cageless-imports", daemon=True))
         _LATE_IMPORTS[0].start()
 

@@ -85,3 +85,12 @@ def test_track_starts_hashing_before_the_heavy_imports(tmp_path):
     out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr[-2000:]
     assert json.loads(out.stdout.strip().splitlines()[-1]) == []
+
+
+def test_the_tracking_pipeline_leaves_the_later_scipy_modules_to_a_thread():
+    """``scipy.optimize`` and ``scipy.signal`` (0.5-0.7 and 0.35-0.42 s of CPU to import) are first needed after
+    the median background; importing the pipeline must not load them, so that a cold ``cageless track``
+    imports them on a thread beside its first stages (:func:`cageless.tracking.pipeline._import_late_modules`)."""
+    loaded = _modules_after("import cageless.tracking.pipeline")
+    assert "cageless.tracking.pipeline" in loaded
+    assert not {"scipy.optimize", "scipy.signal"} & loaded

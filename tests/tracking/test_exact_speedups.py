@@ -68,3 +68,22 @@ def test_prefix_argmax_matches_the_loop_with_ties_and_minus_infinity():
         x = rng.integers(-3, 4, n).astype(np.float64)  # many ties
         x[rng.random(n) < 0.3] = -np.inf
         assert np.array_equal(_prefix_argmax(x), _prefix_argmax_loop(x))
+
+
+@pytest.mark.parametrize("frames", [5, 7, 11])
+def test_track_fit_normal_equations_are_bit_identical_to_einsum(frames):
+    """The compiled normal equations of the robust track fit (tracking.kinematics._normal_equations) give the very
+    values of the two ``np.einsum`` calls they replace, zero weights, large and tiny values included."""
+    from cageless.tracking.kinematics import _normal_equations
+
+    rng = np.random.default_rng(frames)
+    t = 3000
+    x = np.arange(frames) - frames // 2 + rng.normal(0.0, 1e-3, (t, frames))
+    design = np.stack([np.ones_like(x), x, x * x], axis=-1)
+    w = rng.random((t, frames)) * np.exp(rng.normal(0.0, 3.0, (t, frames)))
+    w[rng.random((t, frames)) < 0.2] = 0.0
+    y = rng.normal(0.0, 1.0, (t, frames)) * 10.0 ** rng.integers(-6, 4, (t, 1)) + rng.uniform(-50, 50, (t, 1))
+    dw = design * w[..., None]
+    lhs, rhs = _normal_equations(design, w, y)
+    assert lhs.tobytes() == np.einsum("tkp,tkq->tpq", dw, design).tobytes()
+    assert rhs.tobytes() == np.einsum("tkp,tk->tp", dw, y).tobytes()

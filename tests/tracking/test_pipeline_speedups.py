@@ -52,3 +52,26 @@ def test_background_frame_is_numpys_median_over_the_first_axis(tmp_path, n_frame
         threaded = background_frame(video, quantile=quantile, workers=2)  # bands of 32 rows on two threads
     assert got.tobytes() == ref.tobytes()
     assert threaded.tobytes() == ref.tobytes()
+
+
+def test_a_single_frame_of_a_decoded_video_is_read_alone(tmp_path, monkeypatch):
+    """A frame asked for outside the chunks kept is read alone, not with its whole chunk (the set-up's spread
+    sample frames each cost a 64-frame chunk before), and cropped like the chunks."""
+    from cageless.tracking.io import write_ffv1
+    from cageless.tracking.pipeline import _CroppedFrames
+
+    rng = np.random.default_rng(3)
+    data = rng.integers(0, 256, size=(150, 20, 30), dtype=np.int64).astype(np.uint8)
+    path = write_ffv1(tmp_path / "x.avi", data, fps=1000)
+    with open_video(path) as video:
+        reads = []
+        inner = video._read
+        monkeypatch.setattr(video, "_read", lambda i: reads.append(i) or inner(i))
+        frames = _CroppedFrames(video, slice(2, 18), slice(3, 25), chunk=64)
+        for i in (10, 100, 149, 10):
+            np.testing.assert_array_equal(frames(i), data[i, 2:18, 3:25])
+        assert reads == [10, 100, 149]
+        np.testing.assert_array_equal(frames.block(64, 128), data[64:128, 2:18, 3:25])
+        reads.clear()
+        np.testing.assert_array_equal(frames(100), data[100, 2:18, 3:25])  # now from the chunk read for block
+        assert reads == []
