@@ -71,13 +71,13 @@ CANDIDATES = {
     "auto-planar-ark": ("auto, ark4 planar only (before it was probed at the spatial level)", "auto-planar-ark", 1e-6,
                         None),
     "dp5": ("dp5, rtol 1e-6, cap 2 us", "dp5", 1e-6, 2e-6),
-    "CVODE": ("CVODE throughout (rtol 3e-8, cap 5 us)", "CVODE", 1e-6, None),
+    "CVODE": ("CVODE throughout (rtol 1e-6, cap 5 us; auto runs it at 0.03 x rtol)", "CVODE", 1e-6, None),
     "rosw6": ("rosw, rtol 1e-6 (cap 10 us)", "rosw", 1e-6, None),
     "rosw7": ("rosw, rtol 1e-7 (cap 10 us)", "rosw", 1e-7, None),
     "rosw3e-7": ("rosw, rtol 3e-7 (cap 10 us)", "rosw", 3e-7, None),
     "rosw8": ("rosw, rtol 1e-8 (cap 10 us)", "rosw", 1e-8, None),
-    "ark4": ("ark4 (IMEX), rtol 1e-6 (cap 50 us)", "ark4", 1e-6, None),
-    "ark4-7": ("ark4 (IMEX), rtol 1e-7 (cap 50 us)", "ark4", 1e-7, None),
+    "ark4": ("ark4 (IMEX), rtol 1e-6 (error test at 0.2 x rtol, cap 50 us)", "ark4", 1e-6, None),
+    "ark4-7": ("ark4 (IMEX), rtol 1e-7 (error test at 0.2 x rtol, cap 50 us)", "ark4", 1e-7, None),
 }
 DEFAULT_CANDIDATES = "auto,dp5,rosw6,rosw7,rosw3e-7,rosw8"
 
