@@ -19,7 +19,7 @@ from collections import OrderedDict
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -41,8 +41,9 @@ from cageless.tracking.link import BallCountWarning, TrackSetup, track_frames
 from cageless.tracking.locate import BearingLocation, background_frame, locate_bearing
 from cageless.tracking.locate_motion import (DROPOUT_GAIN, frame_gains, holds_the_motion, locate_by_motion, motion_map,
                                              plausible_band)
-from cageless.tracking.qc import (QC_LIMITS, QCReport, build_qc, slip_warnings, write_qc, write_refusal_qc,
-                                  write_selection_qc)
+from cageless.tracking.qc import (QC_LIMITS, QCReport, build_qc, refuse_located, refuse_selection, slip_warnings,
+                                  write_qc, write_selection_qc)
+from cageless.tracking.qc import qc_stem as _stem
 from cageless.tracking.select import SPEED_BAND, Selection, SelectionError, select_balls
 from cageless.tracking.position_bias import remove_place_bias
 from cageless.tracking.precision import assess_table, precision_warning
@@ -347,29 +348,6 @@ def _select_in(video: FrameSource, loc: BearingLocation, background: np.ndarray,
     return loc, frames, setup, sel
 
 
-def _refuse_with_qc(exc: SelectionError, path: Path, video: FrameSource, loc: BearingLocation,
-                    out_dir: str | Path | None) -> NoReturn:
-    """Re-raise a failed ball selection; with ``out_dir``, first write its QC image of every candidate and the
-    reason it was rejected, and name that image in the message."""
-    rows, cols = loc.crop(video.frame_shape)
-    if out_dir is not None and exc.table is not None:
-        shown = exc.table.assign(u_px=exc.table.u_px + cols.start, v_px=exc.table.v_px + rows.start)
-        qc_png = write_selection_qc(Path(out_dir) / "qc", _stem(path), video[0], shown, exc.ring,
-                                    (cols.start, rows.start), exc.message)
-        raise SelectionError(path, f"{exc.message} No trace written; QC: {qc_png}.", exc.hint,
-                             exc.table, exc.found, exc.ring) from None
-    raise exc
-
-
-def _refuse_located(exc: TrackingError, path: Path, video: FrameSource, out_dir: str | Path | None) -> NoReturn:
-    """Re-raise a refusal to locate the bearing; with ``out_dir``, first write the first frame with the reason
-    (``qc/<stem>.refused.png``) and name that image in the message."""
-    if out_dir is None:
-        raise exc
-    png = write_refusal_qc(Path(out_dir) / "qc", _stem(path), video[0], exc.message)
-    raise TrackingError(path, f"{exc.message} No trace written; QC: {png}.", exc.hint) from None
-
-
 def _import_late_modules() -> None:
     """Import what later stages use, so that a cold process does it beside the first stages rather than before
     them: ``scipy.optimize`` (the circle fits of the localisation and the selection's assignments, first needed
@@ -425,11 +403,11 @@ def track_video(
         try:
             loc = _locate(video, background, bearing, path)
         except TrackingError as exc:
-            _refuse_located(exc, path, video, out_dir)
+            refuse_located(exc, path, video[0], out_dir)
         try:
             loc, frames, setup, sel = _select(video, loc, background, bearing, options, conditions, path)
         except SelectionError as exc:
-            _refuse_with_qc(exc, path, video, loc, out_dir)
+            refuse_selection(exc, path, video[0], loc.crop(video.frame_shape), out_dir)
         rows, cols = frames.rows, frames.cols
         with tqdm(total=len(video), desc=path.name, unit="frame", disable=not progress, leave=False) as bar:
             table = _track_all(path, fps, video, frames, times, setup, options, bar.update)
@@ -548,10 +526,6 @@ def _check_tracks(path: Path, times: np.ndarray, angle: np.ndarray, valid: np.nd
         k = int(bad[0])
         raise TrackingError(path, f"ball {k} moves at {ratio[k]:.2f} x the cage speed, outside the plausible "
                             f"{lo}-{hi}; no trace written.", "Check speed_rpm and the bearing description.")
-
-
-def _stem(path: Path) -> str:
-    return path.name if path.is_dir() else path.stem
 
 
 def _selection_summary(sel: Selection, du: int, dv: int) -> dict[str, Any]:

@@ -16,22 +16,24 @@ import math
 import textwrap
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 import cv2
 import numpy as np
 import pandas as pd
 
 from cageless.atomic import atomic_path, atomic_write_text
+from cageless.errors import TrackingError
 from cageless.kinematics import loaded_zone_speed
 from cageless.profiles import angle_profile
 from cageless.trace import Trace
 from cageless.tracking.geometry import Orbit
 from cageless.tracking.io import open_video
 from cageless.tracking.locate import BearingLocation
+from cageless.tracking.select import SelectionError
 
 __all__ = ["QC_LIMITS", "QCReport", "build_qc", "write_qc", "slip_warnings", "loaded_zone_speed_ratio",
-           "write_selection_qc", "write_refusal_qc", "REASON_COLOURS"]
+           "write_selection_qc", "write_refusal_qc", "refuse_selection", "refuse_located", "qc_stem", "REASON_COLOURS"]
 
 log = logging.getLogger(__name__)
 
@@ -304,3 +306,31 @@ def _write_png(target: Path, img: np.ndarray) -> Path:
         _, buf = cv2.imencode(".png", img)
         tmp.write_bytes(buf.tobytes())
     return target
+
+
+def qc_stem(path: Path) -> str:
+    """The name a video's outputs (trace, QC files) are written under: a folder's name, or a file's stem."""
+    return path.name if path.is_dir() else path.stem
+
+
+def refuse_selection(exc: SelectionError, path: Path, first_frame: np.ndarray, crop: tuple[slice, slice],
+                     out_dir: str | Path | None) -> NoReturn:
+    """Re-raise a failed ball selection; with ``out_dir``, first write its QC image of every candidate and the
+    reason it was rejected (candidates in the ``crop`` = (rows, cols) of the frame), and name it in the message."""
+    rows, cols = crop
+    if out_dir is not None and exc.table is not None:
+        shown = exc.table.assign(u_px=exc.table.u_px + cols.start, v_px=exc.table.v_px + rows.start)
+        png = write_selection_qc(Path(out_dir) / "qc", qc_stem(path), first_frame, shown, exc.ring,
+                                 (cols.start, rows.start), exc.message)
+        raise SelectionError(path, f"{exc.message} No trace written; QC: {png}.", exc.hint,
+                             exc.table, exc.found, exc.ring) from None
+    raise exc
+
+
+def refuse_located(exc: TrackingError, path: Path, first_frame: np.ndarray, out_dir: str | Path | None) -> NoReturn:
+    """Re-raise a refusal to locate the bearing; with ``out_dir``, first write the first frame with the reason
+    (``qc/<stem>.refused.png``) and name that image in the message."""
+    if out_dir is None:
+        raise exc
+    png = write_refusal_qc(Path(out_dir) / "qc", qc_stem(path), first_frame, exc.message)
+    raise TrackingError(path, f"{exc.message} No trace written; QC: {png}.", exc.hint) from None
