@@ -439,9 +439,11 @@ def _track_all(path: Path, fps: float | None, video: FrameSource, frames: _Cropp
     """Track every frame: in one pass, or in overlapping segments on ``options.threads`` threads."""
     n = len(times)
     k = max(1, min(options.threads, n // _MIN_SEGMENT))
-    if k == 1:
-        return track_frames(frames, times, setup, str(path), options.strict, update)[0]
     bounds = np.linspace(0, n, k + 1).astype(int)
+    if not video.seekable:
+        bounds = _bounds_at_anchors(bounds, [a.frame for a in setup.anchors])
+    if len(bounds) == 2:
+        return track_frames(frames, times, setup, str(path), options.strict, update)[0]
     spans = [(int(a), int(min(b + _OVERLAP, n))) for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
 
     def one(span: tuple[int, int]) -> pd.DataFrame:
@@ -458,6 +460,24 @@ def _track_all(path: Path, fps: float | None, video: FrameSource, frames: _Cropp
                     path.name, k)
         return track_frames(frames, times, setup, str(path), options.strict, update)[0]
     return joined
+
+
+def _bounds_at_anchors(bounds: np.ndarray, anchors: list[int]) -> np.ndarray:
+    """Segment bounds moved onto the selection's anchor frames, for a video that is read in order only.
+
+    A segment is tracked forward and backward from its first anchor; on a video where going back means
+    decoding again from the start (MKV/MP4), every chunk before that anchor cost a decode of all the frames
+    before it (a 1,009-frame MKV: 11,040 frame decodes for the whole track). Starting each segment at an
+    anchor leaves only :data:`~cageless.tracking.link.SETTLE_FRAMES` to track backwards. A bound with no
+    anchor within a quarter segment of it is dropped (its neighbours share the frames).
+    """
+    inner, out = bounds[1:-1], [int(bounds[0])]
+    reach = (bounds[-1] - bounds[0]) / (len(bounds) - 1) / 4
+    for b in inner:
+        near = [a for a in anchors if abs(a - b) <= reach and a > out[-1]]
+        if near:
+            out.append(min(near, key=lambda a: (abs(a - b), a)))
+    return np.array([*out, int(bounds[-1])])
 
 
 #: Largest distance (px) between one ball's positions in two segments on the frames both tracked.

@@ -158,3 +158,39 @@ def test_opencv_reader_decodes_a_reread_frame_once(tmp_path, suffix, monkeypatch
         decodes.clear()
         video[30]
         assert decodes == [30]
+
+
+def test_an_mkv_is_counted_once_and_read_in_order(tmp_path, monkeypatch):
+    """MKV/MP4 hold no exact frame count, so opening one decodes it all; the tracker's segments each open the
+    file again, and the same file is counted once. Going back in it means decoding again from the start, so
+    it says it is not seekable (AVI seeks exactly: it is)."""
+    import cv2
+
+    from cageless.tracking.io import opencv
+
+    data = frames(40, 16, 24, 8)
+    mkv = write_ffv1(tmp_path / "x.mkv", data, fps=1000)
+    grabs = []
+    real = cv2.VideoCapture
+
+    class Counting:
+        def __init__(self, *args):
+            self._cap = real(*args)
+
+        def grab(self):
+            grabs.append(1)
+            return self._cap.grab()
+
+        def __getattr__(self, name):
+            return getattr(self._cap, name)
+
+    monkeypatch.setattr(opencv.cv2, "VideoCapture", Counting)
+    monkeypatch.setattr(opencv, "_COUNTED", {})
+    with open_video(mkv) as video:
+        assert len(video) == 40 and not video.seekable
+    assert len(grabs) == 40  # frame 0 is decoded to read the size; 39 grabs count the rest, one finds the end
+    with open_video(mkv) as again:
+        assert len(again) == 40
+        np.testing.assert_array_equal(again[39], data[39])
+    assert len(grabs) == 40 + 38  # not counted again, and not opened again: frame 39 is 38 grabs from frame 1
+    assert open_video(write_ffv1(tmp_path / "x.avi", data, fps=1000)).seekable

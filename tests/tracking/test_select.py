@@ -180,3 +180,15 @@ def test_dark_ring_faces_are_located_by_motion(tmp_path):
     s = _score(res, clip["truth"], 3000)
     assert res.trace.n_balls == 14 and s["max_err_deg"] < 5
     assert s["angle_rms"] <= 0.5e-3 and s["speed_rms"] <= 0.005 and s["slip_mae_pp"] <= 0.3
+
+
+def test_segments_of_an_mkv_start_at_anchors():
+    """On a video read in order only, each later segment starts at one of the selection's anchor frames, so
+    that nothing before it is tracked backwards (the 1,009-frame MKV of ``cageless sample --revolutions 2``,
+    anchors every 197 frames: 11,040 frame decodes for its track before, 6,963 with the count kept, too)."""
+    from cageless.tracking.pipeline import _bounds_at_anchors
+
+    anchors = [0, 197, 394, 591, 788, 985]
+    assert _bounds_at_anchors(np.array([0, 504, 1009]), anchors).tolist() == [0, 591, 1009]
+    assert _bounds_at_anchors(np.array([0, 336, 672, 1009]), anchors).tolist() == [0, 394, 591, 1009]
+    assert _bounds_at_anchors(np.array([0, 504, 1009]), [0, 985]).tolist() == [0, 1009]  # none near: one pass

@@ -110,6 +110,9 @@ class FrameSource(abc.ABC):
 
     metadata: VideoMetadata
     _times: npt.NDArray[np.float64] | None
+    #: Whether reading frame ``i`` costs about the same wherever the last read ended. False where going back
+    #: means decoding again from the start (MKV/MP4 through OpenCV): readers then go through it in order.
+    seekable: bool = True
 
     def __init__(self, path: str | Path) -> None:
         self.path = Path(path)

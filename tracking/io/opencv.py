@@ -4,7 +4,8 @@ Frames come back as 8-bit luminance (the first channel of OpenCV's gray-as-BGR
 decode). Random access seeks by ``CAP_PROP_POS_FRAMES`` in AVI, where it is
 exact; in MKV/MP4 it moves forward by grabbing frames and re-opens the file to
 go back, which is always exact but slow, so read those sequentially
-(:meth:`~cageless.tracking.io.base.FrameSource.iter_chunks`). The last :data:`FRAME_CACHE` frames
+(:meth:`~cageless.tracking.io.base.FrameSource.iter_chunks`); their ``seekable`` is False, and their frame
+count (a whole decode) is kept per file for the process. The last :data:`FRAME_CACHE` frames
 decoded are kept, so the frames the tracker's set-up samples more than once are decoded once.
 
 Containers store their frame rate as a rational that may be rounded, so give
@@ -49,6 +50,9 @@ _AVI_MAX_FPS = 1000.0
 #: Decoded frames kept (8-bit: 32 MB at 1280 x 800). The tracker's set-up reads the same 25 spread frames for
 #: each of its two background frames and the motion map; without the cache a 200-frame AVI was decoded 944 times.
 FRAME_CACHE = 32
+#: Frame counts of the MKV/MP4 files opened in this process, by (path, size, modification time): counting
+#: decodes the whole file, whose header count is not exact.
+_COUNTED: dict[tuple[str, int, int], int] = {}
 
 
 class OpenCVReader(FrameSource):
@@ -72,6 +76,7 @@ class OpenCVReader(FrameSource):
         if not self.path.is_file():
             raise VideoError(self.path, "no such file.")
         self._decoded: OrderedDict[int, np.ndarray] = OrderedDict()
+        self.seekable = self.path.suffix.lower() in _EXACT_SEEK
         self._cap = self._open()
         first = self._decode(0)
         n = self._count_frames()
@@ -86,7 +91,8 @@ class OpenCVReader(FrameSource):
         self._apply_timing(fps, None)
         if self.metadata.time_source == "header frame rate":
             self.metadata.time_source = "container frame rate"
-        self._cap = self._open()
+        if self._next != 1:  # counted to the end: start again (a count kept from before leaves it at frame 1)
+            self._cap = self._open()
 
     def _open(self) -> cv2.VideoCapture:
         cap = cv2.VideoCapture(str(self.path), cv2.CAP_FFMPEG)
@@ -105,11 +111,17 @@ class OpenCVReader(FrameSource):
 
     def _count_frames(self) -> int:
         n = self._cap.get(cv2.CAP_PROP_FRAME_COUNT)
-        if self.path.suffix.lower() in _EXACT_SEEK and 0 < n < 1e9:
+        if self.seekable and 0 < n < 1e9:
             return int(n)
+        stat = self.path.stat()
+        key = (str(self.path.resolve()), stat.st_size, stat.st_mtime_ns)
+        if key in _COUNTED:  # the tracker's segments each open the file again
+            return _COUNTED[key]
         count = 1  # one frame was decoded already; count the rest without decoding
         while self._cap.grab():
             count += 1
+        _COUNTED[key] = count
+        self._next = count  # at the end: the next read opens the file again
         return count
 
     def _read(self, index: int) -> np.ndarray:
@@ -125,7 +137,7 @@ class OpenCVReader(FrameSource):
 
     def _seek_and_decode(self, index: int) -> np.ndarray:
         if index != self._next:
-            if self.path.suffix.lower() in _EXACT_SEEK:
+            if self.seekable:
                 self._cap.set(cv2.CAP_PROP_POS_FRAMES, index)
                 self._next = index
             else:
