@@ -89,7 +89,7 @@ def smooth_profile(mean: npt.ArrayLike, bin_deg: float,
                    sigma_deg: float = PEAK_SMOOTHING_DEG) -> npt.NDArray[np.float64]:
     """A full-circle profile smoothed by a periodic Gaussian of ``sigma_deg`` (deg).
 
-    Empty (NaN) bins are left out by normalised convolution (the smoothed values over the smoothed
+    ``mean`` holds the bins along its first axis (a 2-D array: one profile per column). Empty (NaN) bins are left out by normalised convolution (the smoothed values over the smoothed
     indicator of bins with data, :func:`scipy.ndimage.gaussian_filter1d` with ``mode="wrap"``) and stay
     NaN. ``sigma_deg`` = 0 returns the profile unchanged.
     """
@@ -102,8 +102,8 @@ def smooth_profile(mean: npt.ArrayLike, bin_deg: float,
         return m.copy()
     has = np.isfinite(m)
     sigma = sigma_deg / bin_deg
-    num = gaussian_filter1d(np.where(has, m, 0.0), sigma, mode="wrap")
-    den = gaussian_filter1d(has.astype(np.float64), sigma, mode="wrap")
+    num = gaussian_filter1d(np.where(has, m, 0.0), sigma, axis=0, mode="wrap")
+    den = gaussian_filter1d(has.astype(np.float64), sigma, axis=0, mode="wrap")
     with np.errstate(invalid="ignore", divide="ignore"):
         out = num / den
     out[~has] = np.nan
@@ -125,11 +125,18 @@ def unloaded_zone_peak(profile: pd.DataFrame, sigma_deg: float = PEAK_SMOOTHING_
 
 def peak_of_mean(mean: npt.ArrayLike, bin_deg: float, sigma_deg: float = PEAK_SMOOTHING_DEG) -> float:
     """:func:`unloaded_zone_peak` of a full-circle mean profile given as an array of ``bin_deg`` bins."""
-    smooth = smooth_profile(mean, bin_deg, sigma_deg)
-    centres = (np.arange(smooth.size) + 0.5) * bin_deg
+    return float(_peaks(np.asarray(mean, dtype=np.float64)[:, None], bin_deg, sigma_deg)[0])
+
+
+def _peaks(means: npt.NDArray[np.float64], bin_deg: float, sigma_deg: float) -> npt.NDArray[np.float64]:
+    """:func:`peak_of_mean` of each column of ``means`` (bins, profiles); NaN for a column without data in the
+    unloaded zone."""
+    smooth = smooth_profile(means, bin_deg, sigma_deg)
+    centres = (np.arange(smooth.shape[0]) + 0.5) * bin_deg
     lo, hi = UNLOADED_ZONE_DEG
     zone = smooth[(centres > lo) & (centres < hi)]
-    return float(np.nanmax(zone)) if np.isfinite(zone).any() else float("nan")
+    has = np.isfinite(zone).any(axis=0)
+    return np.where(has, np.max(np.where(np.isfinite(zone), zone, -np.inf), axis=0, initial=-np.inf), np.nan)
 
 
 def peak_standard_error(per_ball: npt.ArrayLike, bin_deg: float, sigma_deg: float = PEAK_SMOOTHING_DEG,
@@ -157,26 +164,33 @@ def peak_standard_error(per_ball: npt.ArrayLike, bin_deg: float, sigma_deg: floa
     float
         The standard error, NaN with fewer than two balls.
     """
-    import warnings
-
     from scipy.stats import bootstrap
 
     table = np.asarray(per_ball, dtype=np.float64)
     if table.ndim != 2 or table.shape[1] < 2:
         return float("nan")
+    seen = np.isfinite(table)
+    values = np.where(seen, table, 0.0)
 
-    def peak(balls: npt.NDArray[np.float64]) -> float:
-        with warnings.catch_warnings():  # a bin no drawn ball visited stays NaN
-            warnings.simplefilter("ignore", RuntimeWarning)
-            return peak_of_mean(np.nanmean(table[:, balls.astype(np.intp)], axis=1), bin_deg, sigma_deg)
+    def peaks(balls: npt.NDArray[np.float64], axis: int = -1) -> npt.NDArray[np.float64]:
+        draws = np.moveaxis(balls, axis, -1).astype(np.intp)  # (..., balls drawn)
+        flat = draws.reshape(-1, draws.shape[-1])
+        count = seen[:, flat].sum(axis=-1)  # (bins, draws): a bin no drawn ball visited stays NaN
+        with np.errstate(invalid="ignore", divide="ignore"):
+            means = values[:, flat].sum(axis=-1) / count
+        return _peaks(means, bin_deg, sigma_deg).reshape(draws.shape[:-1])
 
-    rng = np.random.default_rng(seed)
+    key = "rng" if "rng" in _parameters(bootstrap) else "random_state"  # scipy < 1.15
+    res = bootstrap((np.arange(table.shape[1], dtype=np.float64),), peaks, n_resamples=n_resamples,
+                    vectorized=True, method="percentile", **{key: np.random.default_rng(seed)})
+    return float(res.standard_error)
+
+
+def _parameters(func: object) -> set[str]:
+    """The names of ``func``'s parameters."""
     import inspect
 
-    key = "rng" if "rng" in inspect.signature(bootstrap).parameters else "random_state"  # scipy < 1.15
-    res = bootstrap((np.arange(table.shape[1], dtype=np.float64),), peak, n_resamples=n_resamples,
-                    vectorized=False, method="percentile", **{key: rng})
-    return float(res.standard_error)
+    return set(inspect.signature(func).parameters)  # type: ignore[arg-type]
 
 
 def peak_estimator(sigma_deg: float = PEAK_SMOOTHING_DEG) -> dict[str, object]:
