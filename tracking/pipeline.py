@@ -246,13 +246,14 @@ def _setup(video: FrameSource, loc: BearingLocation, background: np.ndarray, bea
     mask = loc.annulus_mask(video.frame_shape, margin)[rows, cols]
     bg = np.ascontiguousarray(background[rows, cols])
     picks = np.linspace(0, len(video) - 1, min(4, len(video))).astype(int)
+    spread_at = np.linspace(0, len(video) - 1, min(_DEFECT_FRAMES, len(video))).astype(int)
+    video.prefetch([*picks, *spread_at])  # one pass over an MKV/MP4 for both samples
     sample = np.stack([frames(int(i)) for i in picks])
     # Not over a lighting dropout: a dark frame's whole difference from the background is not noise (one dark
     # frame of the 4 made it 4x too large on the long clip of corpus seed 7021, and with it every threshold).
     steady = frame_gains(list(sample)) >= DROPOUT_GAIN
     sigma = noise_sigma(sample[steady] if steady.sum() >= 2 else sample, bg, mask)
-    spread = np.stack([frames(int(i)) for i in np.linspace(0, len(video) - 1, min(_DEFECT_FRAMES, len(video)))
-                       .astype(int)])
+    spread = np.stack([frames(int(i)) for i in spread_at])
     defects = static_defects(bg, sigma, frames=spread)
     static = static_pattern(bg, spread, mask, defects)
     mask = mask & ~defects

@@ -140,7 +140,7 @@ def test_opencv_reader_decodes_a_reread_frame_once(tmp_path, suffix, monkeypatch
     (a 200-frame corpus AVI was decoded 944 times in one ``cageless track`` before), and it reads the same."""
     from cageless.tracking.io import opencv
 
-    data = frames(80, 16, 24, 8)
+    data = frames(40 + opencv.FRAME_CACHE, 16, 24, 8)
     path = write_ffv1(tmp_path / f"x{suffix}", data, fps=1000)
     with open_video(path) as video:
         decodes = []
@@ -194,3 +194,22 @@ def test_an_mkv_is_counted_once_and_read_in_order(tmp_path, monkeypatch):
         np.testing.assert_array_equal(again[39], data[39])
     assert len(grabs) == 40 + 38  # not counted again, and not opened again: frame 39 is 38 grabs from frame 1
     assert open_video(write_ffv1(tmp_path / "x.avi", data, fps=1000)).seekable
+
+
+def test_prefetch_decodes_spread_frames_in_one_pass(tmp_path, monkeypatch):
+    """Spread frames asked for after a prefetch are decoded once, in order, in one pass over an MKV; an AVI
+    (seekable) ignores the hint and reads them when asked."""
+    data = frames(40, 16, 24, 8)
+    with open_video(write_ffv1(tmp_path / "x.mkv", data, fps=1000)) as video:
+        opened, decodes = [], []
+        for name, log in (("_open", opened), ("_seek_and_decode", decodes)):
+            inner = getattr(video, name)
+            monkeypatch.setattr(video, name, lambda *a, inner=inner, log=log: log.append(a) or inner(*a))
+        video.prefetch([30, 0, 13, 39, 13])
+        assert decodes == [(0,), (13,), (30,), (39,)] and not opened  # counted, then opened again at frame 0
+        for i in (39, 0, 30, 13):
+            np.testing.assert_array_equal(video[i], data[i])
+        assert len(decodes) == 4 and not opened
+    with open_video(write_ffv1(tmp_path / "x.avi", data, fps=1000)) as avi:
+        avi.prefetch([30, 0])
+        assert not avi._decoded

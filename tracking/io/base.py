@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import abc
 import logging
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -183,6 +183,10 @@ class FrameSource(abc.ABC):
         A view is read-only and valid while the source is open.
         """
         return self[index]
+
+    def prefetch(self, indices: Iterable[int]) -> None:  # noqa: B027 - optional hook
+        """Hint that frames ``indices`` will be read soon, in any order. A reader that is not
+        :attr:`seekable` decodes them in one pass and keeps them; the others read them when asked."""
 
     def close(self) -> None:  # noqa: B027 - optional hook
         """Release the file handle (readers that hold one override this)."""
