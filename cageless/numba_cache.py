@@ -20,7 +20,8 @@ cache files when asked.
 
 :func:`register` must run before the package's first kernel is decorated: each package calls it from its
 ``__init__``. The caches stay where numba puts them (``NUMBA_CACHE_DIR``, else ``__pycache__`` beside the
-sources, else numba's user-wide cache directory).
+sources, else numba's user-wide cache directory), except that an installed package's are never written beside
+its sources (:func:`installed`).
 """
 
 from __future__ import annotations
@@ -38,10 +39,14 @@ from typing import Any
 
 from numba.core import caching
 
-__all__ = ["SourcesLocator", "clear", "is_compiled", "kernel_sources", "register", "source_digest"]
+__all__ = ["SourcesLocator", "clear", "installed", "is_compiled", "kernel_sources", "register", "source_digest"]
 
-#: numba's cache implementation (renamed from ``_CacheImpl`` in numba 0.61).
+#: numba's cache implementation (renamed from ``_CacheImpl`` in numba 0.61), and its locator of caches in
+#: ``__pycache__`` beside the sources.
 _IMPL = getattr(caching, "CacheImpl", None) or getattr(caching, "_CacheImpl")
+_IN_TREE = getattr(caching, "InTreeCacheLocator", None) or getattr(caching, "_InTreeCacheLocator")
+#: Folders that hold installed distributions: no cache is written inside them (see :func:`installed`).
+_INSTALL_DIRS = {"site-packages", "dist-packages"}
 #: The registered package folders, each with the key of its run-time extensions (or None).
 _ROOTS: dict[Path, Callable[[], Hashable] | None] = {}
 
@@ -153,9 +158,13 @@ class SourcesLocator(caching._CacheLocator):
 
     @classmethod
     def base_locators(cls, py_func: Any, py_file: str) -> list[Any]:
-        """numba's own locators that accept ``py_file``, in its order of preference."""
+        """numba's own locators that accept ``py_file``, in its order of preference; for an installed
+        package (:func:`installed`) not the one beside the sources."""
         out = []
+        skip = _IN_TREE if installed(py_file) else None
         for other in _IMPL._locator_classes:
+            if other is skip:
+                continue
             if not (isinstance(other, type) and issubclass(other, SourcesLocator)):
                 loc = other.from_function(py_func, py_file)
                 if loc is not None:
@@ -170,6 +179,18 @@ class SourcesLocator(caching._CacheLocator):
             return None
         base = cls.base_locators(py_func, py_file)
         return cls(base[0], root) if base else None
+
+
+def installed(py_file: str | Path) -> bool:
+    """Whether ``py_file`` belongs to an installed (not editable) distribution, under ``site-packages``.
+
+    Its kernels are cached in numba's user-wide cache folder (``NUMBA_CACHE_DIR`` if set), not in
+    ``__pycache__`` beside it: pip does not remove files it did not install, so after ``pip uninstall`` the
+    cache files kept an empty ``cageless`` folder in ``site-packages``, which Python then imported as a
+    namespace package in place of a later editable install (``pip install .`` and then ``pip install -e .``
+    in the same environment: "cannot import name 'open_video' from 'cageless.tracking.io'").
+    """
+    return not _INSTALL_DIRS.isdisjoint(Path(py_file).parts)
 
 
 def register(root: str | Path, extra: Callable[[], Hashable] | None = None) -> None:
