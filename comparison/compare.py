@@ -13,7 +13,7 @@ from cageless.trace import Trace
 from cageless.comparison.align import MismatchError, Profiles, check_compatible, profiles, simulation_settle_s
 from cageless.comparison.metrics import profile_errors, unloaded_peak
 
-__all__ = ["ComparisonRow", "Comparison", "compare", "match_contact_angle", "slip_contact_angle", "SLIP_REFERENCES",
+__all__ = ["ComparisonRow", "Comparison", "compare", "tracking_verdict", "QC_FAILED", "match_contact_angle", "slip_contact_angle", "SLIP_REFERENCES",
            "refer_to_loaded_zone"]
 
 #: What a comparison's slip rates are referred to, by name (the table and the report print the text).
@@ -23,6 +23,10 @@ SLIP_REFERENCES = {
                     f"{LOADED_ZONE_HALF_WIDTH_DEG:g} deg of 270 deg), which removes a flat bias such as a "
                     "stated speed, scale or clearance slightly off"),
 }
+
+
+#: A row's status when its video failed the tracking QC (:func:`tracking_verdict`): the numbers stand, flagged.
+QC_FAILED = "tracking QC failed"
 
 
 @dataclass(frozen=True)
@@ -93,16 +97,46 @@ def compare(measured: Trace, simulated: Trace, bin_deg: float = 1.0, settle_s: f
         measured, note = match_contact_angle(measured, simulated)
     pm = profiles(measured, bin_deg)
     ps = profiles(simulated, bin_deg, settle_s=settle_s)
+    # A video's QC failures go with the row into every table (a trace without a QC record is not a video's)
+    qc_reasons = tracking_verdict(measured.qc)[1] if measured.qc else []
     err = profile_errors(pm.slip["mean"].to_numpy(), ps.slip["mean"].to_numpy())
     row = ComparisonRow(
         speed_rpm=measured.speed_rpm, radial_load_n=measured.radial_load_n, axial_load_n=measured.axial_load_n,
         theoretical_slip_pct=100 * unloaded_peak(ps.slip), experimental_slip_pct=100 * unloaded_peak(pm.slip),
         mae_pp=err.mae_pp, rmse_pp=err.rmse_pp, max_error_pp=err.max_pp, label=label,
-        status="mismatch" if mismatches else "ok", message="; ".join(mismatches + ([note] if note else [])),
+        status="mismatch" if mismatches else (QC_FAILED if qc_reasons else "ok"),
+        message="; ".join(mismatches + qc_reasons + ([note] if note else [])),
         slip_reference=slip_reference,
         theoretical_slip_se_pp=100 * peak_standard_error(ps.slip_per_ball, bin_deg),
         experimental_slip_se_pp=100 * peak_standard_error(pm.slip_per_ball, bin_deg))
     return Comparison(row=row, measured=pm, simulated=ps, mismatches=mismatches, settle_s=settle_s)
+
+
+def tracking_verdict(qc: dict[str, Any]) -> tuple[bool, list[str]]:
+    """Pass or fail a video's tracking QC.
+
+    The tracker judges its own QC against its limits (detection rate, interpolated share, orbit fit,
+    speed cross-check, negative slip) and records each breach as a warning; the verdict passes when every
+    ball was found and there is no such warning.
+
+    Parameters
+    ----------
+    qc
+        The QC record a video trace carries (``n_balls_found``, ``n_balls_expected``, ``warnings``).
+
+    Returns
+    -------
+    tuple of (bool, list of str)
+        Whether the QC passes, and a plain-language reason for each thing that fails it.
+    """
+    if not qc:
+        return False, ["no tracking QC record"]
+    reasons = []
+    found, expected = qc.get("n_balls_found"), qc.get("n_balls_expected")
+    if found != expected:
+        reasons.append(f"{found} balls found, {expected} expected")
+    reasons += [f"tracker warning: {w}" for w in qc.get("warnings", [])]
+    return not reasons, reasons
 
 
 def refer_to_loaded_zone(trace: Trace, settle_s: float = 0.0) -> tuple[Trace, str]:

@@ -137,7 +137,7 @@ def to_html(frame: pd.DataFrame) -> str:
     head = "".join(f"<th>{html.escape(h)}</th>" for h in _headers(frame))
     rows = []
     for (_, r), cells in zip(frame.iterrows(), _cells(frame), strict=True):
-        cls = "" if r["status"] == "ok" else f' class="{html.escape(r["status"])}"'
+        cls = "" if r["status"] == "ok" else f' class="{html.escape(r["status"].replace(" ", "-"))}"'
         rows.append(f"<tr{cls}>" + "".join(f"<td>{html.escape(c)}</td>" for c in cells) + "</tr>")
     notes = "".join(f"<p class='note'>{html.escape(n)}</p>" for n in _notes(frame))
     return f"<table class='slip'><thead><tr>{head}</tr></thead><tbody>{''.join(rows)}</tbody></table>{notes}"

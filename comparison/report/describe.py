@@ -11,10 +11,9 @@ import numpy.typing as npt
 import pandas as pd
 
 from cageless.trace import Trace
-from cageless.comparison.compare import Comparison, ComparisonRow
+from cageless.comparison.compare import Comparison, ComparisonRow, tracking_verdict
 
 __all__ = ["ConditionDescription", "describe_condition", "poincare_section", "tracking_verdict"]
-
 
 
 @dataclass
@@ -87,28 +86,3 @@ def contact_track(trace: Trace, settle_s: float, max_points: int = 4_000) -> dic
             "outer_angle": flat(c["outer_angle"]), "inner_point": flat(c["inner_point"])}
 
 
-def tracking_verdict(qc: dict[str, Any]) -> tuple[bool, list[str]]:
-    """Pass or fail a video's tracking QC.
-
-    The tracker judges its own QC against its limits (detection rate, interpolated share, orbit fit,
-    speed cross-check, negative slip) and records each breach as a warning; the verdict passes when every
-    ball was found and there is no such warning.
-
-    Parameters
-    ----------
-    qc
-        The QC record a video trace carries (``n_balls_found``, ``n_balls_expected``, ``warnings``).
-
-    Returns
-    -------
-    tuple of (bool, list of str)
-        Whether the QC passes, and a plain-language reason for each thing that fails it.
-    """
-    if not qc:
-        return False, ["no tracking QC record"]
-    reasons = []
-    found, expected = qc.get("n_balls_found"), qc.get("n_balls_expected")
-    if found != expected:
-        reasons.append(f"{found} balls found, {expected} expected")
-    reasons += [f"tracker warning: {w}" for w in qc.get("warnings", [])]
-    return not reasons, reasons

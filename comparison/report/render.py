@@ -21,7 +21,7 @@ _TEMPLATE = """<!DOCTYPE html>
 <style>
 body{font-family:system-ui,sans-serif;margin:2em auto;max-width:70em;color:#222;line-height:1.4}
 table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding:.2em .6em;text-align:right}
-th{background:#f3f3f3}tr.failed td{background:#fde8e8}tr.mismatch td{background:#fff4d6}
+th{background:#f3f3f3}tr.failed td{background:#fde8e8}tr.mismatch td,tr.tracking-QC-failed td{background:#fff4d6}
 .note{font-size:.85em;color:#555}.fig{display:inline-block;margin:.5em;vertical-align:top}
 .fig img{max-width:100%;height:auto}figcaption{font-size:.85em;color:#444}
 .cards{display:flex;flex-wrap:wrap;gap:.8em}.card{border:1px solid #ccc;border-radius:6px;padding:.6em;width:22em}

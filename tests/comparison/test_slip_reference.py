@@ -125,3 +125,27 @@ def _row(markdown: str) -> list[float]:
     line = markdown.splitlines()[2]
     assert markdown.startswith("| Video |")  # compare labels its row with the video trace's file name
     return [float(c.split("±")[0]) for c in line.strip("|").split("|")[1:]]  # "5.54 ± 0.00": the value
+
+
+def test_a_video_that_failed_its_tracking_qc_is_flagged_in_every_table():
+    """The report's card said "tracking QC: fail" while slip_table.csv said ok and the Markdown, LaTeX and HTML
+    tables showed nothing (found by a new user on a noisy clip). The row keeps its numbers and says why."""
+    from dataclasses import replace
+
+    from cageless.comparison.compare import QC_FAILED
+    from cageless.comparison.table import to_html
+
+    sim = orbit_trace("simulation", bump(0.06), omega=OMEGA)
+    video = orbit_trace("video", bump(0.06), omega=OMEGA)
+    z = video.angle.shape[1]
+    good = {"n_balls_found": z, "n_balls_expected": z, "warnings": []}
+    low = "low precision: estimated angle precision 2.48 mrad"
+    assert compare(replace(video, qc=good), sim, bin_deg=5.0, settle_s=0.0).row.status == "ok"
+    row = compare(replace(video, qc={**good, "warnings": [low]}), sim, bin_deg=5.0, settle_s=0.0, label="noisy").row
+    assert (row.status, row.message) == (QC_FAILED, f"tracker warning: {low}")
+    assert row.experimental_slip_pct == pytest.approx(compare(video, sim, bin_deg=5.0, settle_s=0.0).row
+                                                      .experimental_slip_pct)  # the numbers stand
+    frame = table_frame([row])
+    assert frame.loc[0, "status"] == QC_FAILED and low in to_csv(frame)
+    assert f"Note: noisy (3000 r/min, 500 N): {QC_FAILED}: tracker warning: {low}" in to_markdown(frame)
+    assert '<tr class="tracking-QC-failed">' in to_html(frame)

@@ -63,6 +63,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     from cageless.config import bearing_from_config
     from cageless.errors import CagelessError, UsageError
     from cageless.app.lab import LabOptions, run_lab
+    from cageless.comparison.compare import QC_FAILED
     from cageless.app.calibrate import describe_calibration
     from cageless.app.cli.common import failed_line, parameter_values
     from cageless.simulation.parameter_sets import DEFAULT_SET
@@ -98,7 +99,8 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
         else:
             print(f"{row.label}: {row.speed_rpm:g} r/min, {row.radial_load_n:g} N: theoretical slip "
                   f"{row.theoretical_slip_pct:.2f} ± {row.theoretical_slip_se_pp:.2f} %, experimental "
-                  f"{row.experimental_slip_pct:.2f} ± {row.experimental_slip_se_pp:.2f} %, MAE {row.mae_pp:.2f} pp")
+                  f"{row.experimental_slip_pct:.2f} ± {row.experimental_slip_se_pp:.2f} %, MAE {row.mae_pp:.2f} pp"
+                  + (f" ({row.status}: {row.message})" if row.status == QC_FAILED else ""))
     if failed and not args.quiet:
         print(f"failed: {', '.join(failed)} (the reasons are above and in the report)", file=sys.stderr)
     timing = ", ".join(f"{k} {v:.1f} s" for k, v in res.timings.items())
