@@ -130,6 +130,25 @@ def _best_wall(run: Any, repeats: int) -> tuple[Any, float]:
     return sol, best
 
 
+#: The plain-numpy baseline's row (:mod:`~cageless.simulation.models.planar_reference` has neither the rolling
+#: losses nor the regime traction).
+NUMPY_ROW = "LSODA (numpy RHS; rolling losses and film traction off in it and its reference)"
+#: The effects the plain-numpy right-hand side leaves out, with their flags.
+_NOT_IN_NUMPY = {"rolling_losses": "F_ROLL", "film_traction": "F_FTRAC"}
+
+
+def _numpy_physics(pr: Problem) -> Problem:
+    """``pr`` with the effects off that the plain-numpy right-hand side does not compute: measured against the
+    full model its error was those effects (1.45 pp of slip over 1 ms), not the integrator's. With them off the
+    two right-hand sides agree to 3e-6 relative at the settled state (up to 2,400 with them on)."""
+    from cageless.simulation.models.base import LAYOUT
+
+    params = pr.params.copy()
+    for flag in _NOT_IN_NUMPY.values():
+        params[LAYOUT.index(flag)] = 0.0
+    return replace(pr, params=params, effects=pr.effects - set(_NOT_IN_NUMPY))
+
+
 def _numpy_lsoda(pr: Problem, t: npt.NDArray[np.float64], rtol: float) -> Any:
     return step_scipy(pr, t, "LSODA", rtol, max_step=2e-6, fun=lambda tt, yy, log: reference_rhs(tt, yy, pr.params, log))
 
@@ -160,11 +179,12 @@ def accuracy_study(rpm: float = 3000.0, load_n: float = 500.0, window_s: float =
                      "wall_s_per_sim_s": wall / window_s, "slip_error_pp": slip_pp, "position_error_um": pos_um,
                      "steps": sol.n_steps, "rhs_calls": sol.n_rhs, "variant": variant, "method": sol.method})
     tn = np.linspace(0.0, numpy_window_s, 6)
-    sol_np, wall = _best_wall(lambda: _numpy_lsoda(pr, tn, 1e-6), repeats)
+    pr_np = _numpy_physics(pr)  # what the numpy RHS computes, for it and its reference
+    sol_np, wall = _best_wall(lambda: _numpy_lsoda(pr_np, tn, 1e-6), repeats)
     y_np = sol_np.y
-    ref_short = solve(pr, tn, rtol=1e-10, max_step=2.5e-7)
+    ref_short = solve(pr_np, tn, rtol=1e-10, max_step=2.5e-7)
     slip_pp, pos_um = _errors(y_np, ref_short.y, z, cage, radius)
-    rows.append({"solver": "LSODA (numpy RHS)", "rtol": 1e-6, "max_step": 2e-6, "ok": True,
+    rows.append({"solver": NUMPY_ROW, "rtol": 1e-6, "max_step": 2e-6, "ok": True,
                  "wall_s_per_sim_s": wall / numpy_window_s, "slip_error_pp": slip_pp, "position_error_um": pos_um, "steps": 0, "rhs_calls": 0})
     base = next(r for r in rows if r["solver"].startswith("dp5") and r["rtol"] == 1e-6)["wall_s_per_sim_s"]
     auto = rows[0]["wall_s_per_sim_s"]
