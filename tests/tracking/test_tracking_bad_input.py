@@ -145,3 +145,16 @@ def test_tracking_is_deterministic(tmp_path):
     for name in ("time", "angle", "speed", "slip", "valid"):
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
     assert a.video == b.video and a.config == b.config
+
+
+@pytest.mark.parametrize("command", ["track", "report"])
+def test_a_ball_count_that_cannot_fit_is_refused_before_any_work(tmp_path, capsys, command):
+    """--n-balls above what fits on the pitch circle was accepted on the command line (a new user's --n-balls 30)
+    while the same count in --config was refused. The default bearing: D = 9.525 mm on d_m = 46.01 mm, so
+    floor(pi / asin(D / d_m)) = 15 fit (the chord d_m sin(pi / Z) >= D)."""
+    video = Path(__file__).parents[2] / "sample_data" / "lab" / "n6000_Fr500_Fa0.cine"
+    assert main([command, str(video if command == "track" else video.parent), "-o", str(tmp_path / "out"),
+                 "--n-balls", "16"]) == 2
+    assert "--n-balls 16: at most 15 balls of 9.525 mm fit on the bearing's 46.01 mm pitch circle" in \
+        capsys.readouterr().err
+    assert not (tmp_path / "out").exists()

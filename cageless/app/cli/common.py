@@ -202,6 +202,28 @@ def _parameter_error_text(exc: Any, given: dict[str, Any], table: dict[str, Any]
     return f"{source}: {name}{shown}: {exc.rule}. {exc.hint}".rstrip()
 
 
+def check_n_balls(n_balls: int | None, config: dict[str, Any]) -> None:
+    """Refuse a ``--n-balls`` below 3 or above what fits on the configured bearing's pitch circle.
+
+    Raises
+    ------
+    UsageError
+        Naming the option, the limit and why.
+    """
+    if n_balls is None:
+        return
+    if n_balls < 3:
+        raise UsageError(f"--n-balls {n_balls}: must be a whole number >= 3.")
+    from cageless.config import bearing_from_config
+
+    g = bearing_from_config(config).geometry
+    if n_balls > g.max_ball_count:
+        raise UsageError(f"--n-balls {n_balls}: at most {g.max_ball_count} balls of {g.ball_diameter_m * 1e3:.4g} mm "
+                         f"fit on the bearing's {g.pitch_diameter_m * 1e3:.4g} mm pitch circle. Give the count the "
+                         "videos show, or describe their bearing (n_balls, ball_diameter_mm, pitch_diameter_mm in a "
+                         "sidecar or --config).")
+
+
 def failed_line(video: Path | str, why: object, shown: Path | str | None = None) -> str:
     """``FAILED <video>: <why>``, naming the video once even when the message starts with its path (or its
     file name); ``shown`` is how the video is named on the line (default: as given)."""

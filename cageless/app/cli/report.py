@@ -65,15 +65,14 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     from cageless.app.lab import LabOptions, run_lab
     from cageless.comparison.compare import QC_FAILED
     from cageless.app.calibrate import describe_calibration
-    from cageless.app.cli.common import failed_line, parameter_values
+    from cageless.app.cli.common import check_n_balls, failed_line, parameter_values
     from cageless.simulation.parameter_sets import DEFAULT_SET
 
     from cageless.app.lab import CACHE_NAME, REPORT_PRODUCTS
     from cageless.outputs import check_output_dir, check_products
     from cageless.validate import check_options
 
-    if args.n_balls is not None and args.n_balls < 3:
-        raise UsageError(f"--n-balls {args.n_balls}: must be a whole number >= 3.")
+    check_n_balls(args.n_balls, config)
     values = parameter_values(args, config)  # [parameters] of --config, then --set; before any work starts
     check_options(args, ("duration", "settle", "revolutions", "rtol", "workers"))
     check_output_dir(args.out, "-o")

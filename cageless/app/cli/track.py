@@ -14,7 +14,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from cageless.bearing import Bearing
-from cageless.app.cli.common import failed_line, finite_float
+from cageless.app.cli.common import check_n_balls, failed_line, finite_float
 from cageless.conditions import (
     IMAGE_SUFFIXES,
     LabEntry,
@@ -154,8 +154,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     if args.window < 3 or args.window % 2 == 0:
         raise UsageError(f"--window {args.window}: must be an odd number of frames >= 3.")
     _validate(args)
-    if args.n_balls is not None and args.n_balls < 3:
-        raise UsageError(f"--n-balls {args.n_balls}: must be a whole number >= 3.")
+    check_n_balls(args.n_balls, config)
     bearing = bearing_from_config(config)
     entries = [plausible_entry(e, args.force) for e in collect_inputs(args.inputs, args.speed_rpm)]
     _prefetch_first_hash(entries, args.workers)
