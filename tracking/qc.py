@@ -266,8 +266,7 @@ def write_selection_qc(qc_dir: Path, stem: str, frame: np.ndarray | None, table:
     y = _write_title(img, title)
     for reason, n in counts.items():
         y += 16
-        cv2.putText(img, f"{reason}: {n}", (6, y), cv2.FONT_HERSHEY_SIMPLEX, 0.45,
-                    REASON_COLOURS.get(str(reason), (255, 255, 255)), 1, cv2.LINE_AA)
+        _put_text(img, f"{reason}: {n}", y, REASON_COLOURS.get(str(reason), (255, 255, 255)))
     return _write_png(target, img)
 
 
@@ -297,8 +296,15 @@ def _write_title(img: np.ndarray, title: str) -> int:
     char_px = cv2.getTextSize("x", cv2.FONT_HERSHEY_SIMPLEX, 0.45, 1)[0][0]
     for line in textwrap.wrap(title, width=max(20, (img.shape[1] - 12) // max(char_px, 1))):
         y += 16
-        cv2.putText(img, line, (6, y), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (255, 255, 255), 1, cv2.LINE_AA)
+        _put_text(img, line, y)
     return y
+
+
+def _put_text(img: np.ndarray, text: str, y: int, colour: tuple[int, int, int] = (255, 255, 255)) -> None:
+    """``text`` at (6, y), outlined in black so that it reads on a bright frame as on a dark one (white text on
+    a near-white refused frame could not be read)."""
+    cv2.putText(img, text, (6, y), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (0, 0, 0), 3, cv2.LINE_AA)
+    cv2.putText(img, text, (6, y), cv2.FONT_HERSHEY_SIMPLEX, 0.45, colour, 1, cv2.LINE_AA)
 
 
 def _write_png(target: Path, img: np.ndarray) -> Path:
