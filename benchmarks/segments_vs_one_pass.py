@@ -3,7 +3,7 @@
     python benchmarks/segments_vs_one_pass.py [CLIP ...] [--long-seeds 7004 7011] [--corpus DIR]
 
 Tracks each clip with ``TrackOptions(threads=1)`` (one pass) and ``threads=2`` (overlapping segments of at
-least ``pipeline._MIN_SEGMENT`` frames, stitched), scores both against the clip's truth where it has the
+least ``segments.MIN_SEGMENT`` frames, stitched), scores both against the clip's truth where it has the
 corpus's truth columns (:func:`cageless.tracking.synthetic.score.score_trace`: found balls, identity swaps,
 angle RMS, speed RMS, slip-profile MAE) and prints the largest differences between the two traces.
 ``CLIP`` is a benchmark clip (``bench_*.cine`` of ``benchmarks/track.py``, 3000 rpm, the paper's bearing);
@@ -39,7 +39,8 @@ def _inputs(args: argparse.Namespace) -> list[tuple[Path, object, object, pd.Dat
 
 
 def main() -> None:
-    from cageless.tracking.pipeline import _MIN_SEGMENT, TrackOptions, track_video
+    from cageless.tracking.pipeline import TrackOptions, track_video
+    from cageless.tracking.segments import MIN_SEGMENT as _MIN_SEGMENT
     from cageless.tracking.synthetic.score import score_trace
 
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)

@@ -44,6 +44,7 @@ from cageless.tracking.locate_motion import (DROPOUT_GAIN, frame_gains, holds_th
 from cageless.tracking.qc import (QC_LIMITS, QCReport, build_qc, refuse_located, refuse_selection, slip_warnings,
                                   write_qc, write_selection_qc)
 from cageless.tracking.qc import qc_stem as _stem
+from cageless.tracking.segments import MIN_SEGMENT, OVERLAP, bounds_at_anchors, stitch
 from cageless.tracking.select import SPEED_BAND, Selection, SelectionError, select_balls
 from cageless.tracking.position_bias import remove_place_bias
 from cageless.tracking.precision import assess_table, precision_warning
@@ -55,9 +56,6 @@ log = logging.getLogger(__name__)
 #: How the input video is hashed for its provenance (XXH3-128), in a background thread while the frames
 #: are tracked.
 INPUT_HASH = VIDEO_HASH
-#: Shortest segment worth a thread, and the frames two segments share to match identities.
-_MIN_SEGMENT = 500
-_OVERLAP = 8
 #: Quantile of the sampled frames that the ball selection subtracts (see :func:`_setup`).
 SELECT_QUANTILE = 0.25
 #: Frames served from a memory map between drops of their pages (fault-around maps whole frames:
@@ -439,13 +437,13 @@ def _track_all(path: Path, fps: float | None, video: FrameSource, frames: _Cropp
                setup: TrackSetup, options: TrackOptions, update: Any) -> pd.DataFrame:
     """Track every frame: in one pass, or in overlapping segments on ``options.threads`` threads."""
     n = len(times)
-    k = max(1, min(options.threads, n // _MIN_SEGMENT))
+    k = max(1, min(options.threads, n // MIN_SEGMENT))
     bounds = np.linspace(0, n, k + 1).astype(int)
     if not video.seekable:
-        bounds = _bounds_at_anchors(bounds, [a.frame for a in setup.anchors])
+        bounds = bounds_at_anchors(bounds, [a.frame for a in setup.anchors])
     if len(bounds) == 2:
         return track_frames(frames, times, setup, str(path), options.strict, update)[0]
-    spans = [(int(a), int(min(b + _OVERLAP, n))) for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+    spans = [(int(a), int(min(b + OVERLAP, n))) for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
 
     def one(span: tuple[int, int]) -> pd.DataFrame:
         a, b = span
@@ -455,76 +453,12 @@ def _track_all(path: Path, fps: float | None, video: FrameSource, frames: _Cropp
 
     with ThreadPoolExecutor(max_workers=k) as pool:
         parts = list(pool.map(one, spans))
-    joined = _stitch(parts, spans, times)
+    joined = stitch(parts, spans, times)
     if joined is None:  # the segments' ball identities could not be matched: the one-pass result is the answer
         log.warning("%s: the %d segments' ball identities did not match on their overlaps; tracking in one pass",
                     path.name, k)
         return track_frames(frames, times, setup, str(path), options.strict, update)[0]
     return joined
-
-
-def _bounds_at_anchors(bounds: np.ndarray, anchors: list[int]) -> np.ndarray:
-    """Segment bounds moved onto the selection's anchor frames, for a video that is read in order only.
-
-    A segment is tracked forward and backward from its first anchor; on a video where going back means
-    decoding again from the start (MKV/MP4), every chunk before that anchor cost a decode of all the frames
-    before it (a 1,009-frame MKV: 11,040 frame decodes for the whole track). Starting each segment at an
-    anchor leaves only :data:`~cageless.tracking.link.SETTLE_FRAMES` to track backwards. A bound with no
-    anchor within a quarter segment of it is dropped (its neighbours share the frames).
-    """
-    inner, out = bounds[1:-1], [int(bounds[0])]
-    reach = (bounds[-1] - bounds[0]) / (len(bounds) - 1) / 4
-    for b in inner:
-        near = [a for a in anchors if abs(a - b) <= reach and a > out[-1]]
-        if near:
-            out.append(min(near, key=lambda a: (abs(a - b), a)))
-    return np.array([*out, int(bounds[-1])])
-
-
-#: Largest distance (px) between one ball's positions in two segments on the frames both tracked.
-STITCH_GATE_PX = 2.0
-
-
-def _match_segments(prev_u: np.ndarray, prev_v: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray | None:
-    """This segment's column for each previous ball, by a minimum-cost assignment of the median distances on
-    the overlap frames; ``None`` when a ball both segments saw there is matched further than the gate."""
-    from scipy.optimize import linear_sum_assignment
-
-    with warnings.catch_warnings():  # a ball missed on every overlap frame by one segment: an all-NaN median
-        warnings.simplefilter("ignore", RuntimeWarning)
-        d = np.nanmedian(np.hypot(prev_u[:, :, None] - u[:, None, :], prev_v[:, :, None] - v[:, None, :]), axis=0)
-    seen = np.isfinite(d)
-    rows, cols = linear_sum_assignment(np.where(seen, d, 1e6))  # unseen pairs only take what is left over
-    if np.any(seen[rows, cols] & (d[rows, cols] > STITCH_GATE_PX)):
-        return None
-    mapping = np.empty_like(cols)
-    mapping[rows] = cols
-    return mapping
-
-
-def _stitch(parts: list[pd.DataFrame], spans: list[tuple[int, int]], times: np.ndarray) -> pd.DataFrame | None:
-    """Join segment tables, renaming each segment's balls to the first segment's by position on the overlap;
-    ``None`` when the segments disagree (ball counts, or a ball's position on the overlap)."""
-    z = int(parts[0].ball.max()) + 1
-    grids = []
-    for part in parts:
-        if int(part.ball.max()) + 1 != z:
-            return None
-        grids.append({c: part[c].to_numpy().reshape(-1, z) for c in ("u_px", "v_px", "mass")})
-    out = {c: grids[0][c] for c in ("u_px", "v_px", "mass")}
-    for (a, _), g in zip(spans[1:], grids[1:], strict=True):
-        prev_u, prev_v = out["u_px"][a:], out["v_px"][a:]
-        mapping = _match_segments(prev_u, prev_v, g["u_px"][: len(prev_u)], g["v_px"][: len(prev_v)])
-        if mapping is None:
-            return None
-        for c in out:
-            out[c] = np.concatenate([out[c][:a], g[c][:, mapping]])
-    n = len(times)
-    return pd.DataFrame({
-        "frame": np.repeat(np.arange(n), z), "time_s": np.repeat(times, z), "ball": np.tile(np.arange(z), n),
-        "u_px": out["u_px"].ravel(), "v_px": out["v_px"].ravel(), "mass": out["mass"].ravel(),
-        "detected": np.isfinite(out["u_px"]).ravel(),
-    })
 
 
 #: Largest share of interpolated (missed) samples a trace may have.
@@ -594,6 +528,8 @@ def _finish(path: Path, video: FrameSource, table: pd.DataFrame, loc: BearingLoc
         log.warning("%s: %s", path.name, low)
         qc.warnings.append(low)
     meta = video.metadata
+    # a cut-off file tracked with allow_truncated: only its complete frames are in the trace
+    qc.warnings.extend(n for n in meta.notes if n.startswith("truncated file"))
     fps = meta.extra.get("fps_override") or meta.timestamp_fps or meta.header_fps or float("nan")
     trace = Trace(
         source="video", time=times, angle=angle, speed=speed, slip=slip, valid=valid,

@@ -186,7 +186,7 @@ def test_segments_of_an_mkv_start_at_anchors():
     """On a video read in order only, each later segment starts at one of the selection's anchor frames, so
     that nothing before it is tracked backwards (the 1,009-frame MKV of ``cageless sample --revolutions 2``,
     anchors every 197 frames: 11,040 frame decodes for its track before, 6,963 with the count kept, too)."""
-    from cageless.tracking.pipeline import _bounds_at_anchors
+    from cageless.tracking.segments import bounds_at_anchors as _bounds_at_anchors
 
     anchors = [0, 197, 394, 591, 788, 985]
     assert _bounds_at_anchors(np.array([0, 504, 1009]), anchors).tolist() == [0, 591, 1009]

@@ -1,11 +1,11 @@
-"""Joining the segments that long videos are tracked in on parallel threads (tracking.pipeline._stitch)."""
+"""Joining the segments that long videos are tracked in on parallel threads (tracking.segments.stitch)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pandas as pd
 
-from cageless.tracking.pipeline import _OVERLAP, _stitch
+from cageless.tracking.segments import OVERLAP as _OVERLAP, stitch as _stitch
 
 
 def _part(u: np.ndarray, v: np.ndarray, order: np.ndarray, offset: int) -> pd.DataFrame:

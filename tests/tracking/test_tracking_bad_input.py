@@ -17,7 +17,7 @@ from cageless.errors import TrackingError, VideoError
 from cageless.tracking.qc import _frame_image
 from cageless.trace import read_trace
 from cageless.tracking.io import write_cine
-from cageless.tracking.pipeline import track_video
+from cageless.tracking.pipeline import TrackOptions, track_video
 from cageless.tracking.synthetic.camera import Appearance, Camera
 from cageless.tracking.synthetic.clip import render_clip
 from cageless.tracking.synthetic.motion import KinematicLaw
@@ -158,3 +158,15 @@ def test_a_ball_count_that_cannot_fit_is_refused_before_any_work(tmp_path, capsy
     assert "--n-balls 16: at most 15 balls of 9.525 mm fit on the bearing's 46.01 mm pitch circle" in \
         capsys.readouterr().err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_truncated_cine_tracked_anyway_says_so_in_its_qc(tmp_path):
+    """--allow-truncated tracks the complete frames of a cut-off cine; its QC said "warnings": [] and the report
+    "warnings none" (new user). The sample's 84-frame 6000 rpm cine cut 1,000 bytes short: 83 complete frames."""
+    video = Path(__file__).parents[2] / "sample_data" / "lab" / "n6000_Fr500_Fa0.cine"
+    cut = tmp_path / "n6000_Fr500_Fa0.cine"
+    cut.write_bytes(video.read_bytes()[:-1000])
+    res = track_video(cut, OperatingConditions(6000, 500), default_bearing(), out_dir=tmp_path / "out", progress=False,
+                      options=dataclasses.replace(TrackOptions(), allow_truncated=True))
+    assert res.trace.n_samples == 83
+    assert "truncated file: 83 of 84 frames are complete" in res.qc.warnings
