@@ -149,11 +149,13 @@ def run_sweep(vary: Mapping[str, Sequence[float]], seeds: int, speed_rpm: float,
 
 
 def summarise(runs: pd.DataFrame, names: Sequence[str]) -> pd.DataFrame:
-    """Mean, seed spread (std) and count of the peak slip per grid point."""
+    """Mean, seed spread (population std over the seeds; NaN from one run, which shows no spread) and count
+    of the peak slip per grid point."""
     ok = runs[runs.status == "ok"]
     g = ok.groupby(list(names), sort=True)["peak_slip_pct"]
-    return pd.DataFrame({"peak_slip_mean_pct": g.mean(), "peak_slip_std_pct": g.std(ddof=0),
-                         "runs": g.count()}).reset_index()
+    count = g.count()
+    return pd.DataFrame({"peak_slip_mean_pct": g.mean(), "peak_slip_std_pct": g.std(ddof=0).where(count > 1),
+                         "runs": count}).reset_index()
 
 
 def plot_sweep(summary: pd.DataFrame, names: Sequence[str], path: str | Path) -> None:
@@ -173,7 +175,7 @@ def plot_sweep(summary: pd.DataFrame, names: Sequence[str], path: str | Path) ->
                 label = ", ".join(f"{o}={v:g}" for o, v in zip(others, np.atleast_1d(key), strict=False)) or None
                 ax.errorbar(part[name], part.peak_slip_mean_pct, yerr=part.peak_slip_std_pct, marker="o",
                             capsize=2, label=label)
-            ax.set(xlabel=name, ylabel="peak slip, unloaded zone (%)")
+            ax.set(xlabel=name, ylabel="peak slip, unloaded zone (%)\nmean, bars: spread over seeds")
             if others:
                 ax.legend(fontsize=6)
             ax.grid(True, alpha=0.3)

@@ -42,3 +42,14 @@ def test_sweep_on_a_local_cluster_matches_the_local_run():
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cl:
         remote = run_sweep(vary, scheduler=cl.scheduler_address, **kw)
     pd.testing.assert_frame_equal(local.drop(columns="wall_s"), remote.drop(columns="wall_s"))
+
+
+def test_one_run_per_point_shows_no_spread():
+    """A grid point with one run has no seed spread: NaN (a blank cell), not 0 (new user, --seeds 1); two runs
+    give the population standard deviation, |9 - 11| / 2 = 1."""
+    from cageless.simulation.sweep import summarise
+
+    runs = pd.DataFrame({"x": [1.0, 2.0, 2.0], "peak_slip_pct": [5.0, 9.0, 11.0], "status": ["ok"] * 3})
+    s = summarise(runs, ["x"])
+    assert s.peak_slip_std_pct.isna().tolist() == [True, False] and s.peak_slip_std_pct.iloc[1] == 1.0
+    assert s.runs.tolist() == [1, 2] and s.peak_slip_mean_pct.tolist() == [5.0, 10.0]
