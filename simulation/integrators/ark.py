@@ -46,7 +46,8 @@ import numpy as np
 
 from cageless.simulation.integrators.dp5 import (STATUS_NONFINITE, STATUS_OK, _accept, _before_step, _controls,
                                                  _hermite, _retry_step, _samples_before, _write_stats)
-from cageless.simulation.kernels import model_filter_error, model_gaps, model_implicit, model_rhs, model_signature
+from cageless.simulation.kernels import (model_filter_error, model_gaps, model_implicit, model_rhs, model_signature,
+                                        model_stage)
 
 __all__ = ["ark_integrate", "SESSION_SLOTS", "SESSION_ROWS", "AE", "AI", "B", "B_HAT", "C", "GAMMA"]
 
@@ -251,8 +252,7 @@ def _ark_stages(model_id, t, h, y, p, log, f, ki, yt, ynew, work):  # pragma: no
             for j in range(i):
                 acc += AE[i, j] * (f[j, q] - ki[j, q]) + AI[i, j] * ki[j, q]
             yt[q] = y[q] + h * acc
-        model_implicit(model_id, t + C[i] * h, yt, p, h * GAMMA, ki[i], work)
-        model_rhs(model_id, t + C[i] * h, yt, p, log, f[i])
+        model_stage(model_id, t + C[i] * h, yt, p, log, h * GAMMA, ki[i], f[i], work)
     for q in range(n):
         acc = 0.0
         for j in range(6):
