@@ -34,12 +34,12 @@ import numba
 import numpy as np
 
 from cageless.simulation.forces import FASTMATH
-from cageless.simulation.models.base import LAYOUT, P_F_FILM, P_F_ROLL, P_H0
+from cageless.simulation.models.base import LAYOUT, P_F_FILM, P_H0
 from cageless.simulation.models.contact_laws import tangential
 from cageless.simulation.physics.viscosity import ROELANDS_LN_POLE, ROELANDS_P0_PA
 
 __all__ = ["race_regime", "regime_force", "race_tangential", "strip_tangential", "regime_slots",
-           "oil_viscosity", "race_tangential_array", "film_logs", "race_regime_logs", "race_tangential_logs"]
+           "oil_viscosity", "race_tangential_array"]
 
 (P_F_FTRAC, P_SIGMA, P_LSS, P_MU_B, P_V_REG_B, P_U_MIN, P_LAM_B, P_LAM_F, P_ETA_T, P_ROE_LN, P_ROE_Z,
  P_LHC_I, P_LHM_I, P_AB_I, P_LHC_O, P_LHM_O, P_AB_O) = LAYOUT.slots(
@@ -48,29 +48,9 @@ __all__ = ["race_regime", "regime_force", "race_tangential", "strip_tangential",
 
 
 @numba.njit(cache=True, fastmath=FASTMATH, inline="always")
-def film_logs(u_r, q, p):  # pragma: no cover - compiled
-    """(ln u_r, ln q) of a race contact with entraining speed ``u_r`` > 0 and load ``q`` > 0 when the ``ehl_film``
-    effect is on, else (0, 0): the two logarithms the Hamrock-Dowson films of both the regime traction
-    (:func:`race_regime_logs`) and the rolling losses (:func:`cageless.simulation.models.rolling.race_rolling_logs`)
-    take, computed once per contact instead of once per law (the same values, so the same forces bit for bit)."""
-    if p[P_F_FILM] > 0.5 and u_r > 0.0 and q > 0.0 and (p[P_F_FTRAC] > 0.5 or p[P_F_ROLL] > 0.5):
-        return math.log(u_r), math.log(q)
-    return 0.0, 0.0
-
-
-@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
 def race_regime(u_r, q, inner, p):  # pragma: no cover - compiled
     """(w, u_L) at a race contact: the full film's share w in [0, 1] and its limiting sliding speed (m/s);
     (-1, 0) when the ``film_traction`` effect is off (the traction curve applies)."""
-    if p[P_F_FTRAC] < 0.5:
-        return -1.0, 0.0
-    lu, lq = film_logs(u_r, q, p)
-    return race_regime_logs(u_r, q, lu, lq, inner, p)
-
-
-@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
-def race_regime_logs(u_r, q, lu, lq, inner, p):  # pragma: no cover - compiled
-    """:func:`race_regime` with ``(lu, lq)`` = :func:`film_logs` (u_r, q, p) given."""
     if p[P_F_FTRAC] < 0.5:
         return -1.0, 0.0
     if q <= 0.0:
@@ -82,6 +62,7 @@ def race_regime_logs(u_r, q, lu, lq, inner, p):  # pragma: no cover - compiled
     if p[P_F_FILM] > 0.5:
         if u_r <= 0.0:
             return 0.0, 1.0  # no entrainment, no film: boundary friction
+        lu, lq = math.log(u_r), math.log(q)
         h_c = math.exp(lhc + 0.67 * lu - 0.067 * lq)
         h_m = math.exp(lhm + 0.68 * lu - 0.073 * lq)
     else:
@@ -114,15 +95,6 @@ def race_tangential(u_s, u_r, q, inner, p):  # pragma: no cover - compiled
     """Signed tangential force (N) at a race contact: the regime law when ``film_traction`` is on, else the
     models' :func:`~cageless.simulation.models.contact_laws.tangential` (traction curve or dry friction)."""
     w, u_l = race_regime(u_r, q, inner, p)
-    if w < 0.0:
-        return tangential(u_s, u_r, q, p)
-    return regime_force(u_s, q, w, u_l, p)
-
-
-@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
-def race_tangential_logs(u_s, u_r, q, lu, lq, inner, p):  # pragma: no cover - compiled
-    """:func:`race_tangential` with ``(lu, lq)`` = :func:`film_logs` (u_r, q, p) given."""
-    w, u_l = race_regime_logs(u_r, q, lu, lq, inner, p)
     if w < 0.0:
         return tangential(u_s, u_r, q, p)
     return regime_force(u_s, q, w, u_l, p)

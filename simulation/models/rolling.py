@@ -30,7 +30,7 @@ from cageless.simulation.forces import FASTMATH
 from cageless.simulation.models.base import (P_D, P_ETA0, P_F_FILM, P_LT_FILM_I, P_LT_FILM_O, P_LT_FIX_I, P_LT_FIX_O,
                                              P_RC_I, P_RC_O, P_RH_I, P_RH_O)
 
-__all__ = ["race_rolling", "race_rolling_logs", "spatial_rolling", "rolling_slots"]
+__all__ = ["race_rolling", "spatial_rolling", "rolling_slots"]
 
 
 @numba.njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -45,23 +45,13 @@ def race_rolling(u_e, q, inner, p):  # pragma: no cover - compiled
     """
     if q <= 0.0 or u_e == 0.0:
         return 0.0, 0.0
-    lu, lq = (math.log(abs(u_e)), math.log(q)) if p[P_F_FILM] > 0.5 else (0.0, 0.0)
-    return race_rolling_logs(u_e, q, lu, lq, inner, p)
-
-
-@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
-def race_rolling_logs(u_e, q, lu, lq, inner, p):  # pragma: no cover - compiled
-    """:func:`race_rolling` with ln |u_e| and ln q given (``lu``, ``lq``; used only with the ``ehl_film`` effect on),
-    as :func:`cageless.simulation.models.regime.film_logs` computes them once for both laws of a contact."""
-    if q <= 0.0 or u_e == 0.0:
-        return 0.0, 0.0
     if inner:
         rc, rh, lt_film, lt_fix = p[P_RC_I], p[P_RH_I], p[P_LT_FILM_I], p[P_LT_FIX_I]
     else:
         rc, rh, lt_film, lt_fix = p[P_RC_O], p[P_RH_O], p[P_LT_FILM_O], p[P_LT_FIX_O]
     au = abs(u_e)
     if p[P_F_FILM] > 0.5:
-        ln_t = lt_film - 0.5 * (0.67 * lu - 0.067 * lq)
+        ln_t = lt_film - 0.5 * (0.67 * math.log(au) - 0.067 * math.log(q))
     else:
         ln_t = lt_fix
     fbar = max(28.59 * ln_t - 10.10, 36.57 * ln_t - 22.85, 0.0)  # chiu_coefficient
