@@ -20,8 +20,9 @@ RADAU5; ``model_filter_error``): unfiltered, the stiff normal modes that the L-s
 the estimate (a loaded ball's radial speed in every accepted step) and hold the step near 9 us.
 
 A stage is Y_i = Z_i + h/4 f_I(Y_i) with the explicit predictor
-Z_i = y + h sum_{j<i} (aE_ij f_E(Y_j) + aI_ij f_I(Y_j)); the model solves it (``model_implicit``), and
-f_E(Y_i) = f(Y_i) - f_I(Y_i). So a step costs five right-hand sides and five per-ball solves, plus the
+Z_i = y + h sum_{j<i} (aE_ij f_E(Y_j) + aI_ij f_I(Y_j)); the model solves it and evaluates f there in one call
+(``model_stage``: ``model_implicit``, then ``model_rhs``, the planar model's angles' cos and sin computed once for
+both), and f_E(Y_i) = f(Y_i) - f_I(Y_i). So a step costs five right-hand sides and five per-ball solves, plus the
 right-hand side at its end (the next step's first stage, the dense output and the force-jump test).
 
 Around the step everything is DP5's (:mod:`cageless.simulation.integrators.dp5`, reused, not changed): the
