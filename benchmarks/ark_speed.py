@@ -94,7 +94,8 @@ def speed_only(states: dict[str, str], window: float, repeats: int, keys: list[s
             for key in keys:
                 cpu, wall = time.process_time(), time.perf_counter()
                 sols[key] = _run(pr, t, *CANDIDATES[key][1:])
-                best[key] = [min(best[key][0], time.perf_counter() - wall), min(best[key][1], time.process_time() - cpu)]
+                elapsed = (time.perf_counter() - wall, time.process_time() - cpu)
+                best[key] = [min(best[key][0], elapsed[0]), min(best[key][1], elapsed[1])]
         for key in keys:
             tracemalloc.start()
             _run(pr, t, *CANDIDATES[key][1:])
@@ -118,8 +119,8 @@ def _child(exe: str, args: argparse.Namespace, states: dict[str, str]) -> list[d
 
 def _peer_table(runs: dict[str, list[list[dict[str, Any]]]]) -> str:
     """Each (case, candidate)'s best wall and CPU time per simulated second on both trees, with their ratios."""
-    lines = ["| case | solver | wall this / peer | ratio | CPU this / peer | ratio | steps this / peer | RHS this / peer |"
-             " peak MiB this / peer |", "|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| case | solver | wall this / peer | ratio | CPU this / peer | ratio | steps this / peer | "
+             "RHS this / peer | peak MiB this / peer |", "|---|---|---|---|---|---|---|---|---|"]
     first = runs["this"][0]
     for i, row in enumerate(first):
         a = [r[i] for r in runs["this"]]
@@ -147,8 +148,8 @@ def _speed_main(args: argparse.Namespace) -> None:
             text = "\n".join(f"| {r['case']} | {r['solver']} ({r['method']}) | {r['wall_s_per_sim_s']:.2f} | "
                              f"{r['cpu_s_per_sim_s']:.2f} | {r['steps']} | {r['rhs_calls']} | "
                              f"{r['peak_traced_mib']:.1f} |" for r in rows)
-            print("| case | solver | wall s / sim s | CPU s / sim s | steps | RHS | peak MiB |\n|---|---|---|---|---|---|---|\n"
-                  + text)
+            head = "| case | solver | wall s / sim s | CPU s / sim s | steps | RHS | peak MiB |\n" + "|---" * 7 + "|\n"
+            print(head + text)
             result: Any = rows
         else:
             runs: dict[str, list[list[dict[str, Any]]]] = {"this": [], "peer": []}
