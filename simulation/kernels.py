@@ -13,7 +13,7 @@ from cageless.simulation.models import (implicit_normal, implicit_normal_spatial
                                         two_balls)
 
 __all__ = ["PLANAR", "SPATIAL", "TWO_BALLS", "OSCILLATOR", "RICCATI", "DAMPED", "model_rhs", "model_post",
-           "model_signature", "model_ring_share", "model_gaps", "model_implicit", "model_filter_error",
+           "model_signature", "model_ring_share", "model_gaps", "model_implicit", "model_stage", "model_filter_error",
            "implicit_speed_rows", "ring_rows"]
 
 PLANAR, TWO_BALLS, SPATIAL = planar.MODEL_ID, two_balls.MODEL_ID, spatial.MODEL_ID
@@ -92,6 +92,18 @@ def model_implicit(model_id, t, y, p, hg, k_i, work):  # pragma: no cover - comp
     else:
         for i in range(k_i.shape[0]):
             k_i[i] = 0.0
+
+
+@numba.njit(cache=True)
+def model_stage(model_id, t, y, p, log, hg, k_i, dydt, work):  # pragma: no cover - compiled
+    """One stage of the IMEX method: :func:`model_implicit` with ``hg`` (y solved in place, f_I(y) into ``k_i``),
+    then :func:`model_rhs` at the solved y into ``dydt``; the planar model computes its angles' cos and sin once
+    for both (:func:`cageless.simulation.models.implicit_normal.planar_stage`), the others call the two."""
+    if model_id == PLANAR:
+        implicit_normal.planar_stage(t, y, p, log, hg, k_i, dydt)
+    else:
+        model_implicit(model_id, t, y, p, hg, k_i, work)
+        model_rhs(model_id, t, y, p, log, dydt)
 
 
 def implicit_speed_rows(model_id: int, n_balls: int) -> list[int]:

@@ -20,8 +20,9 @@ RADAU5; ``model_filter_error``): unfiltered, the stiff normal modes that the L-s
 the estimate (a loaded ball's radial speed in every accepted step) and hold the step near 9 us.
 
 A stage is Y_i = Z_i + h/4 f_I(Y_i) with the explicit predictor
-Z_i = y + h sum_{j<i} (aE_ij f_E(Y_j) + aI_ij f_I(Y_j)); the model solves it (``model_implicit``), and
-f_E(Y_i) = f(Y_i) - f_I(Y_i). So a step costs five right-hand sides and five per-ball solves, plus the
+Z_i = y + h sum_{j<i} (aE_ij f_E(Y_j) + aI_ij f_I(Y_j)); the model solves it and evaluates f there in one call
+(``model_stage``: ``model_implicit``, then ``model_rhs``, the planar model's angles' cos and sin computed once for
+both), and f_E(Y_i) = f(Y_i) - f_I(Y_i). So a step costs five right-hand sides and five per-ball solves, plus the
 right-hand side at its end (the next step's first stage, the dense output and the force-jump test).
 
 Around the step everything is DP5's (:mod:`cageless.simulation.integrators.dp5`, reused, not changed): the
@@ -46,7 +47,8 @@ import numpy as np
 
 from cageless.simulation.integrators.dp5 import (STATUS_NONFINITE, STATUS_OK, _accept, _before_step, _controls,
                                                  _hermite, _retry_step, _samples_before, _write_stats)
-from cageless.simulation.kernels import model_filter_error, model_gaps, model_implicit, model_rhs, model_signature
+from cageless.simulation.kernels import (model_filter_error, model_gaps, model_implicit, model_rhs, model_signature,
+                                        model_stage)
 
 __all__ = ["ark_integrate", "SESSION_SLOTS", "SESSION_ROWS", "AE", "AI", "B", "B_HAT", "C", "GAMMA"]
 
@@ -251,8 +253,7 @@ def _ark_stages(model_id, t, h, y, p, log, f, ki, yt, ynew, work):  # pragma: no
             for j in range(i):
                 acc += AE[i, j] * (f[j, q] - ki[j, q]) + AI[i, j] * ki[j, q]
             yt[q] = y[q] + h * acc
-        model_implicit(model_id, t + C[i] * h, yt, p, h * GAMMA, ki[i], work)
-        model_rhs(model_id, t + C[i] * h, yt, p, log, f[i])
+        model_stage(model_id, t + C[i] * h, yt, p, log, h * GAMMA, ki[i], f[i], work)
     for q in range(n):
         acc = 0.0
         for j in range(6):

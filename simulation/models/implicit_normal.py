@@ -33,8 +33,9 @@ import numba
 import numpy as np
 
 from cageless.simulation.models import base as B
+from cageless.simulation.models.planar import planar_rhs_trig
 
-__all__ = ["planar_implicit_normal", "planar_filter_error", "converged", "TOL_V", "MAX_NEWTON"]
+__all__ = ["planar_implicit_normal", "planar_stage", "planar_filter_error", "converged", "TOL_V", "MAX_NEWTON"]
 
 #: Newton's tolerance on the distance of r' and r theta' from the solution (m/s): 1e-4 of the radial speeds'
 #: absolute tolerance.
@@ -128,23 +129,47 @@ def planar_implicit_normal(y, p, hg, k_i):  # pragma: no cover - compiled
     for i in range(k_i.shape[0]):
         k_i[i] = 0.0
     z = int(p[B.P_Z])
-    m = p[B.P_M]
     ring = (y[5 * z], y[5 * z + 1], y[5 * z + 2], y[5 * z + 3])
-    race = p[B.P_F_RACE] > 0.5
     for j in range(z):
-        c, s = math.cos(y[z + j]), math.sin(y[z + j])
-        r, rd, thd = y[j], y[2 * z + j], y[3 * z + j]
-        if hg > 0.0:
-            if race:
-                r, rd, thd = _ball_stage(r, rd, thd, c, s, ring, p, hg)
-            else:
-                r = r + hg * rd
-            y[j], y[2 * z + j], y[3 * z + j] = r, rd, thd
-        k_i[j] = rd
+        _ball_implicit(y, p, hg, k_i, j, z, math.cos(y[z + j]), math.sin(y[z + j]), ring)
+
+
+@numba.njit(cache=True, inline="always")
+def _ball_implicit(y, p, hg, k_i, j, z, c, s, ring):  # pragma: no cover - compiled
+    """Ball j's share of :func:`planar_implicit_normal` (c, s: the cos and sin of its angle)."""
+    m = p[B.P_M]
+    race = p[B.P_F_RACE] > 0.5
+    r, rd, thd = y[j], y[2 * z + j], y[3 * z + j]
+    if hg > 0.0:
         if race:
-            fr, ft, _, _, _, _ = _forces(r, rd, thd, c, s, ring, p, 0.0)
-            k_i[2 * z + j] = fr / m
-            k_i[3 * z + j] = ft / (m * r)
+            r, rd, thd = _ball_stage(r, rd, thd, c, s, ring, p, hg)
+        else:
+            r = r + hg * rd
+        y[j], y[2 * z + j], y[3 * z + j] = r, rd, thd
+    k_i[j] = rd
+    if race:
+        fr, ft, _, _, _, _ = _forces(r, rd, thd, c, s, ring, p, 0.0)
+        k_i[2 * z + j] = fr / m
+        k_i[3 * z + j] = ft / (m * r)
+
+
+@numba.njit(cache=True)
+def planar_stage(t, y, p, log, hg, k_i, dydt):  # pragma: no cover - compiled
+    """One IMEX stage of the planar model: the stage equation solved in place on ``y`` and f_I into ``k_i``
+    (:func:`planar_implicit_normal`), then the whole right-hand side at the solved ``y`` into ``dydt``. The
+    implicit solve leaves the balls' angles alone, so the cos and sin of each are computed once, into the log's
+    scratch, for both (the same values the two computed apart: the same stage, bit for bit, for 14 fewer sine and
+    cosine pairs)."""
+    for i in range(k_i.shape[0]):
+        k_i[i] = 0.0
+    z = int(p[B.P_Z])
+    trig = log.shape[0] - 2 * z
+    ring = (y[5 * z], y[5 * z + 1], y[5 * z + 2], y[5 * z + 3])
+    for j in range(z):
+        log[trig + j] = np.cos(y[z + j])
+        log[trig + z + j] = np.sin(y[z + j])
+        _ball_implicit(y, p, hg, k_i, j, z, log[trig + j], log[trig + z + j], ring)
+    planar_rhs_trig(t, y, p, log, dydt, True)
 
 
 @numba.njit(cache=True, inline="always")

@@ -248,6 +248,14 @@ def _pair_forces(y, p, log, j, k, z, cj, sj, ck, sk, obs):  # pragma: no cover -
 
 @numba.njit(cache=True, fastmath=FASTMATH)
 def planar_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
+    """dy/dt at (t, y) into ``dydt``; the cos and sin of every ball's angle go to the log's scratch."""
+    planar_rhs_trig(t, y, p, log, dydt, False)
+
+
+@numba.njit(cache=True, fastmath=FASTMATH)
+def planar_rhs_trig(t, y, p, log, dydt, trig_ready):  # pragma: no cover - compiled
+    """:func:`planar_rhs`; with ``trig_ready`` the cos and sin of the balls' angles at ``y`` are already in the
+    log's scratch (:func:`cageless.simulation.models.implicit_normal.planar_stage` puts them there)."""
     z = int(p[P_Z])
     m, m_ring, g = p[P_M], p[P_MR], p[P_G]
     grav_on = p[P_F_GRAV] > 0.5
@@ -257,8 +265,9 @@ def planar_rhs(t, y, p, log, dydt):  # pragma: no cover - compiled
     fy_ring, fz_ring = 0.0, -p[P_FR] - (m_ring * g if grav_on else 0.0)
     trig = log.shape[0] - 2 * z  # scratch: cos and sin of every ball's angle, computed once per call
     for j in range(z):
-        log[trig + j] = np.cos(y[z + j])
-        log[trig + z + j] = np.sin(y[z + j])
+        if not trig_ready:
+            log[trig + j] = np.cos(y[z + j])
+            log[trig + z + j] = np.sin(y[z + j])
         dydt[j] = y[2 * z + j]
         dydt[z + j] = y[3 * z + j]
         dydt[2 * z + j] = 0.0  # force accumulators (Cartesian y, z) held in the acceleration slots for now
