@@ -211,16 +211,20 @@ class _CropView:
         return self.video.frame_view(i)[self.rows, self.cols]
 
 
-def _locate(video: FrameSource, background: np.ndarray, bearing: Bearing, path: Path) -> BearingLocation:
+def _locate(video: FrameSource, background: np.ndarray, bearing: Bearing, path: Path,
+            px_per_mm: float | None = None) -> BearingLocation:
     """The bearing and its ball band from brightness; from motion when that fails, gives a band that
-    does not fit a ball, or a band where little moves (dark ring faces, balls over bright faces)."""
+    does not fit a ball, a band where little moves (dark ring faces, balls over bright faces), or (at a stated
+    ``px_per_mm``) a band that does not hold the pitch circle (corpus seed 7304: a contour centre 0.58 balls off)."""
     g = bearing.geometry
     ratio = g.ball_diameter_m / (0.5 * g.pitch_diameter_m)
+    pitch_px = 0.5 * g.pitch_diameter_m * 1e3 * px_per_mm if px_per_mm else None
     err: TrackingError | None = None
     spread = motion_map(video)
     try:
         loc = locate_bearing(background, path)
-        if plausible_band(loc, ratio) and holds_the_motion(spread, loc):
+        if (plausible_band(loc, ratio) and holds_the_motion(spread, loc)
+                and (pitch_px is None or loc.band_inner <= pitch_px <= loc.band_outer)):
             return loc
     except TrackingError as exc:
         if "no contrast" in exc.message:
@@ -400,7 +404,7 @@ def track_video(
                                 "too short to give a speed.", "Record longer, or lower --window.")
         background = background_frame(video, workers=options.threads)
         try:
-            loc = _locate(video, background, bearing, path)
+            loc = _locate(video, background, bearing, path, conditions.px_per_mm)
         except TrackingError as exc:
             refuse_located(exc, path, video[0], out_dir)
         try:

@@ -23,7 +23,8 @@ The stage runs once per video on a few bursts of consecutive frames spread over 
    tracked balls' mean speeds are checked against :data:`SPEED_BAND` after tracking;
 3. one common circle by RANSAC over the moving tracklets (Fischler & Bolles 1981), the hypotheses
    with a full complement of balls ranked by their distance from the expected radius (the middle of
-   the ball band, or d_m/2 times px/mm when the scale is given); of circles of about that radius (two
+   the ball band, or d_m/2 times px/mm when the scale is given, and then only circles within
+   :data:`PRIOR_RADIUS_TOL` ball diameters of it are hypotheses); of circles of about that radius (two
    lights give two), the brighter light's;
 4. per burst, an exact-Z choice with every cyclic neighbour at least :data:`MIN_SPACING` contact
    spacings apart that maximises the total tracklet weight: a dynamic programme over the cyclic
@@ -83,7 +84,10 @@ EXTEND_SHARE = 0.6
 #: diameters. The bright wedges between neighbouring balls travel like balls, Z on one circle, but about a third
 #: of a ball off the pitch circle (FRESH2 seed 7218: 0.31 D inside; its dim, doubled highlights gave fewer
 #: tracklets, 17.1 mrad RMS); the highlights' circle is the pitch circle shifted (<= 0.017 D off on TUNING).
-#: A stated scale off by a fraction e moves it by e d_m / (2 D) ball diameters (7 % at d_m = 4 D).
+#: A stated scale off by a fraction e moves it by e d_m / (2 D) ball diameters (7 % at d_m = 4 D). With a stated
+#: scale only circles within it are RANSAC hypotheses (the wedges' circle, fuller, had won on fullness), so the
+#: highlights' circle is chosen when it is there (7218: 7 of 12 balls in the band between the lands, 12 of 12 in
+#: the band of whole balls) and :func:`check_radius` guards the refit.
 PRIOR_RADIUS_TOL = 0.15
 #: Window radius of the blob centroid that places each candidate, in ball diameters: a highlight (even
 #: saturated, elongated or two lights' run together) is a small part of its ball (the per-frame tracker
@@ -157,6 +161,7 @@ class _Context:
     prior_known: bool = True  # False: r_prior is only a scale guess; the circle is chosen by support
     pixel_threshold: float = 0.0  # centroid weight threshold (DN above the local background)
     workers: int = 1  # threads finding the candidates of a burst's frames (OpenCV, numpy and numba release the GIL)
+    radius_tol_px: float = math.inf  # a stated scale: the ball circle lies within this of r_prior (px)
 
 
 def _burst_plan(n: int, times: np.ndarray, omega_c: float, n_bursts: int) -> list[tuple[int, int]]:
@@ -351,13 +356,14 @@ def _table(feats: list[dict[str, float]], reasons: list[str], burst: np.ndarray,
 def _context(z: int, ball_diameter_m: float, pitch_diameter_m: float, omega_i: float,
              centre0: tuple[float, float], r_prior: float, k_sigma: float,
              sigma_px: float | None = None, prior_known: bool = True, pixel_threshold: float = 0.0,
-             workers: int = 1) -> _Context:
+             workers: int = 1, scale_stated: bool = False) -> _Context:
     ratio = ball_diameter_m / pitch_diameter_m
     ball_px = 2.0 * ratio * r_prior
     return _Context(z=z, gap=MIN_SPACING * 2 * math.asin(min(ratio, 1.0)), omega_c=0.5 * omega_i * (1 - ratio),
                     omega_i=omega_i, ball_px=ball_px, r_prior=r_prior, centre0=centre0,
                     sigma_px=sigma_px or max(1.0, 0.05 * ball_px), k_sigma=k_sigma, prior_known=prior_known,
-                    pixel_threshold=pixel_threshold, workers=workers)
+                    pixel_threshold=pixel_threshold, workers=workers,
+                    radius_tol_px=PRIOR_RADIUS_TOL * ball_px if scale_stated else math.inf)
 
 
 def _collect_tracklets(frames: Callable[[int], np.ndarray], spans: list[tuple[int, int]], background: np.ndarray,
@@ -426,7 +432,8 @@ def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, backgro
         their circle is not the pitch circle.
     """
     ctx = _context(z, ball_diameter_m, pitch_diameter_m, omega_i, centre0, r_prior, k_sigma,
-                   prior_known=prior_known, pixel_threshold=pixel_threshold, workers=workers)
+                   prior_known=prior_known, pixel_threshold=pixel_threshold, workers=workers,
+                   scale_stated=scale_stated)
     spans = _burst_plan(len(times), times, ctx.omega_c, n_bursts)
     tracks, burst_arr, noise = _collect_tracklets(frames, spans, background, mask, ctx, times)
     feats = [_features(t, times, centre0) for t in tracks]
@@ -440,8 +447,10 @@ def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, backgro
     if circle is None:
         table = _table(feats, reasons, burst_arr, ctx, direction)
         raise SelectionError(path, f"no {z} highlights moving together along one circle near the cage speed were "
-                             "found (0 balls found).", "Check the lighting, the speed_rpm and the bearing "
-                             "description; the QC image shows every candidate and why it was rejected.",
+                             "found (0 balls found).", "Check the lighting, the speed_rpm, px_per_mm (when stated, "
+                             f"only circles within {PRIOR_RADIUS_TOL} ball diameters of its pitch circle are tried) "
+                             "and the bearing description; the QC image shows every candidate and why it was "
+                             "rejected.",
                              table=table, found=0)
     feats = [_features(t, times, (circle[0], circle[1])) for t in tracks]
     anchors, counts = _choose_bursts(tracks, feats, reasons, burst_arr, spans, times, circle, tol, ctx)
@@ -475,7 +484,8 @@ def _check_count(path: object, z: int, found: int, n_good: int, n_spans: int, ta
         raise SelectionError(path, f"found {found} balls moving together along one circle, but {z} are expected (the "
                              "bearing's ball count, or --n-balls).",
                              f"Check the stated speed (speed_rpm: balls far from the expected cage speed are "
-                             f"rejected) and the bearing's ball count; if the video really shows {found} balls, "
+                             f"rejected), px_per_mm (when stated, the balls are looked for near its pitch circle) "
+                             f"and the bearing's ball count; if the video really shows {found} balls, "
                              f"state it with --n-balls {found}. The QC image shows what was found.", table=table,
                              found=found, ring=ring)
     if n_good < 0.5 * n_spans:

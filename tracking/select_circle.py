@@ -38,7 +38,7 @@ def _ransac_circle(pts: np.ndarray, burst: np.ndarray, weight: np.ndarray, ctx: 
         cx, cy, r = c
         if math.hypot(cx - ctx.centre0[0], cy - ctx.centre0[1]) > 0.5 * ctx.ball_px:
             continue
-        if not 0.6 * ctx.r_prior <= r <= 1.4 * ctx.r_prior:
+        if not 0.6 * ctx.r_prior <= r <= 1.4 * ctx.r_prior or abs(r - ctx.r_prior) > ctx.radius_tol_px:
             continue
         res = np.abs(np.hypot(pts[:, 0] - cx, pts[:, 1] - cy) - r)
         inl = res <= tol

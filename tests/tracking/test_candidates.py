@@ -104,6 +104,33 @@ def test_of_two_circles_of_one_radius_the_fuller_is_chosen():
     assert (cx, cy, rr) == pytest.approx((195.0, 200.0, r), abs=1e-6)
 
 
+@pytest.mark.parametrize("stated", [False, True])
+def test_a_stated_scale_keeps_the_circle_on_the_pitch_circle(stated):
+    """The look of corpus FRESH2 seed 7218: the 12 bright wedges between the balls travel a circle 0.31 ball
+    diameters inside the pitch circle and are found in every burst, the dim highlights on the pitch circle only
+    7 of 12 a burst. By fullness the wedges' circle wins; with the scale stated, only circles within
+    PRIOR_RADIUS_TOL ball diameters of the pitch circle are hypotheses, and the highlights' circle is chosen."""
+    from cageless.tracking.select import PRIOR_RADIUS_TOL, _context
+
+    z, r, ball = 12, 99.5, 49.4
+    ctx = _context(z, ball / 2e3, r / 1e3, 250.0, (300.0, 240.0), r, 4.0, scale_stated=stated)
+    assert ctx.ball_px == pytest.approx(ball)
+    assert ctx.radius_tol_px == (pytest.approx(PRIOR_RADIUS_TOL * ball) if stated else math.inf)
+    pts, burst = [], []
+    for b in range(5):
+        th = 2 * math.pi * np.arange(z) / z + 0.1 * b
+        wedge = th + math.pi / z
+        pts += list(zip(300.0 + (r - 0.31 * ball) * np.cos(wedge), 240.0 + (r - 0.31 * ball) * np.sin(wedge),
+                        strict=True))
+        seen = th[:7]  # the highlights: 7 of 12 found
+        pts += list(zip(305.0 + r * np.cos(seen), 238.0 + r * np.sin(seen), strict=True))
+        burst += [b] * (z + seen.size)
+    pts_a = np.array(pts)
+    circle = _ransac_circle(pts_a, np.array(burst), np.ones(len(pts_a)), ctx, tol=2.5)
+    expected = (305.0, 238.0, r) if stated else (300.0, 240.0, r - 0.31 * ball)
+    assert circle == pytest.approx(expected, abs=1e-6)
+
+
 def test_a_dropped_frame_does_not_break_a_tracklet():
     """Frame times 0, 1, 2, 4, 5, ... (one frame dropped): the ball moves 6 px between the third and fourth
     entries. Predicted per second, that is the expected step; counted per frame it would be 3 px off, out of

@@ -21,7 +21,7 @@ from cageless.units import rpm_to_rad_s
 from cageless.tracking.io import open_video
 from cageless.tracking.synthetic.appearance import draw_params
 from cageless.tracking.synthetic.corpus import clip_truth, render_clip, simulate_motion
-from cageless.tracking.synthetic.matrix import FRESH, FRESH2, FRESH3, HOLDOUT, SETS, TUNING, coverage
+from cageless.tracking.synthetic.matrix import FRESH, FRESH2, FRESH3, FRESH4, HOLDOUT, SETS, TUNING, coverage
 from cageless.tracking.synthetic.scene3d import FrameState, SceneRenderer
 from cageless.tracking.synthetic.score import BARS, ideal_trace, score_trace, truth_arrays
 
@@ -142,6 +142,7 @@ def test_sets_are_disjoint():
     assert not (set(TUNING) | set(HOLDOUT)) & set(FRESH)
     assert not (set(TUNING) | set(HOLDOUT) | set(FRESH)) & set(FRESH2)
     assert not (set(TUNING) | set(HOLDOUT) | set(FRESH) | set(FRESH2)) & set(FRESH3)
+    assert not (set(TUNING) | set(HOLDOUT) | set(FRESH) | set(FRESH2) | set(FRESH3)) & set(FRESH4)
 
 
 def test_each_set_is_whole_blocks():
@@ -217,9 +218,9 @@ def test_noise_and_extra_balls_fail_the_bars(clip):
 
 def test_a_perfect_detector_meets_the_bars_on_every_clip():
     """Fairness of the corpus: true highlight positions, one circle fit and the tracker's speed filter pass
-    every bar with room to spare on all 160 clips (lens distortion is limited for this)."""
+    every bar with room to spare on all 192 clips (lens distortion is limited for this)."""
     worst = 0.0
-    for seed in (*TUNING, *HOLDOUT, *FRESH, *FRESH2, *FRESH3):
+    for seed in (*TUNING, *HOLDOUT, *FRESH, *FRESH2, *FRESH3, *FRESH4):
         p, truth, _ = clip_truth(seed)
         s = score_trace(ideal_trace(p, truth), truth, p.bearing)
         assert s.passed, (seed, s.failures)

@@ -1,4 +1,4 @@
-"""The corpus test matrix: five named seed sets and their factor coverage.
+"""The corpus test matrix: six named seed sets and their factor coverage.
 
 ``TUNING``
     32 seeds (four blocks of 8) that a tracker may be tuned on.
@@ -18,6 +18,11 @@
     32 further seeds (four more blocks), added before the held-out verification and the fixes of
     issue 14's second robustness round, once ``FRESH2``'s failing clips had been diagnosed (so it was no
     longer unseen). The same rule: never tune on them; score them once, after a change is final.
+``FRESH4``
+    32 further seeds (four more blocks), added and scored once with the tracker of main 8c12d80 before issue
+    14's third robustness round (the selection refusals of ``FRESH2`` and ``FRESH3``), whose failures had all been
+    looked at. The same rule: never tune on them, never look at their individual failures while changing the
+    tracker; score them once, after a change is final.
 
 Each block of 8 consecutive seeds is a Latin hypercube over every factor
 (:mod:`cageless.tracking.synthetic.appearance`), so each set reaches both ends of every
@@ -33,7 +38,7 @@ from typing import Any
 
 from cageless.tracking.synthetic.appearance import CONTAINERS, RESOLUTIONS, ClipParams, draw_params
 
-__all__ = ["TUNING", "HOLDOUT", "FRESH", "FRESH2", "FRESH3", "SETS", "CHECKS", "coverage", "format_coverage"]
+__all__ = ["TUNING", "HOLDOUT", "FRESH", "FRESH2", "FRESH3", "FRESH4", "SETS", "CHECKS", "coverage", "format_coverage"]
 
 TUNING: tuple[int, ...] = tuple(range(1000, 1032))
 HOLDOUT: tuple[int, ...] = tuple(range(7000, 7032))
@@ -43,8 +48,10 @@ FRESH: tuple[int, ...] = tuple(range(7104, 7136))
 FRESH2: tuple[int, ...] = tuple(range(7200, 7232))
 #: The same (7304, not 7300: 7300 is not a multiple of 8).
 FRESH3: tuple[int, ...] = tuple(range(7304, 7336))
+#: The same.
+FRESH4: tuple[int, ...] = tuple(range(7400, 7432))
 SETS: dict[str, tuple[int, ...]] = {"TUNING": TUNING, "HOLDOUT": HOLDOUT, "FRESH": FRESH, "FRESH2": FRESH2,
-                                    "FRESH3": FRESH3}
+                                    "FRESH3": FRESH3, "FRESH4": FRESH4}
 
 
 def _close(a: float, b: float) -> bool:

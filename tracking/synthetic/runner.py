@@ -2,8 +2,8 @@
 
 Public API::
 
-    run_seed(seed: int, folder: Path, long: bool = False) -> ClipResult
-    run_seeds(seeds, folder, workers=2, long=False, progress=True) -> list[ClipResult]
+    run_seed(seed: int, folder: Path, long: bool = False, keep=True, oracle=True) -> ClipResult
+    run_seeds(seeds, folder, workers=2, long=False, progress=True, keep=True, oracle=True) -> list[ClipResult]
 
 Each clip is rendered into ``folder`` (or reused), tracked by
 :func:`cageless.tracking.pipeline.track_video` with the clip's bearing and conditions, and
@@ -55,26 +55,27 @@ class ClipResult:
     warnings: list[str] = field(default_factory=list)
 
 
-def run_seed(seed: int, folder: str | Path, long: bool = False, keep: bool = True) -> ClipResult:
+def run_seed(seed: int, folder: str | Path, long: bool = False, keep: bool = True, oracle: bool = True) -> ClipResult:
     """Render (or reuse) the clip of ``seed`` in ``folder``, track it and score the trace.
 
     With ``keep=False`` the video is deleted afterwards (a long 16-bit clip is up to 3.5 GB); the truth stays.
+    With ``oracle=False`` the oracle and the Cramér-Rao bound are skipped (``None``): the tracker's score only.
     """
     spec = render_clip(seed, folder, long=long)
     try:
-        return _track_and_score(spec)
+        return _track_and_score(spec, oracle)
     finally:
         if not keep:
             spec.video.unlink(missing_ok=True)
 
 
-def _track_and_score(spec: ClipSpec) -> ClipResult:
+def _track_and_score(spec: ClipSpec, with_oracle: bool = True) -> ClipResult:
     from cageless.tracking.pipeline import TrackOptions, track_video
 
     seed = spec.seed
     factors = describe(spec.params)
-    oracle = score_trace(oracle_trace(spec), spec.truth, spec.bearing).to_dict()
-    crb = angle_crb_mrad(spec.params, n_frames=2)
+    oracle = score_trace(oracle_trace(spec), spec.truth, spec.bearing).to_dict() if with_oracle else None
+    crb = angle_crb_mrad(spec.params, n_frames=2) if with_oracle else None
     start = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -103,15 +104,15 @@ def _messages(caught: list[Any]) -> list[str]:
     return out
 
 
-def _run(args: tuple[int, str, bool, bool]) -> ClipResult:
+def _run(args: tuple[int, str, bool, bool, bool]) -> ClipResult:
     logging.disable(logging.WARNING)
     return run_seed(*args)
 
 
 def run_seeds(seeds: Sequence[int], folder: str | Path, workers: int = 2, long: bool = False,
-              progress: bool = True, keep: bool = True) -> list[ClipResult]:
+              progress: bool = True, keep: bool = True, oracle: bool = True) -> list[ClipResult]:
     """:func:`run_seed` over ``seeds`` in ``workers`` spawned processes; results in the order of ``seeds``."""
-    jobs = [(int(s), str(folder), long, keep) for s in seeds]
+    jobs = [(int(s), str(folder), long, keep, oracle) for s in seeds]
     if workers <= 1:
         return [_run(j) for j in tqdm(jobs, desc="clips", disable=not progress)]
     with ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn")) as pool:
