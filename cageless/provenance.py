@@ -91,13 +91,15 @@ def hash_file(path: str | Path, algorithm: str = "sha256", cache: bool = True) -
     path = Path(path)
     key = _stat_key(path) if cache else ""
     store = cache_dir() / algorithm
-    if cache and (store / key).is_file():
-        return (store / key).read_text().strip()
     if cache:
+        # in flight first: a job leaves _INFLIGHT only after it has written the cache, so no moment falls between
+        # the two checks (cache first, a job finishing in between was hashed twice: seen once under load)
         with _INFLIGHT_LOCK:
             running = _INFLIGHT.get((key, algorithm))
         if running is not None:  # prefetch_hash started it: wait instead of hashing twice
             return str(running.result())
+        if (store / key).is_file():
+            return (store / key).read_text().strip()
     return _hash_and_store(path, algorithm, key if cache else None)
 
 
