@@ -385,6 +385,35 @@ def _csv_row_error(video: Path, row_errors: Mapping[str, ConditionsError]) -> Co
     return row_errors.get(video.name, row_errors.get(stem))
 
 
+def _csv_lists(path: Path, video: Path) -> bool:
+    """Whether a ``conditions.csv`` that failed to read could name ``video``.
+
+    True when its ``file`` column names the video, or when not even that column can be read: then any
+    video may depend on it. A video the table does not name takes its conditions from its other sources.
+    """
+    try:
+        sep, _ = _csv_dialect(path)
+        names = pd.read_csv(path, dtype=str, skipinitialspace=True, sep=sep, keep_default_na=False)
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError, OSError):
+        return True
+    names.columns = [str(c).strip() for c in names.columns]
+    if "file" not in names.columns:
+        return True
+    listed = {str(n).strip() for n in names["file"]}
+    return bool({video.name, video.stem} & listed)
+
+
+def _read_csv_for(video: Path, csv_path: Path, row_errors: dict[str, ConditionsError]) -> dict[str, dict[str, float]]:
+    """The folder's ``conditions.csv`` for one video: its error if the video depends on it, else ``{}``."""
+    try:
+        return read_conditions_csv(csv_path, row_errors)
+    except ConditionsError as exc:
+        if _csv_lists(csv_path, video):
+            raise
+        log.warning("%s; %s is not listed there and takes its conditions from its other sources", exc, video.name)
+        return {}
+
+
 def _warn_disagreement(video: Path, sources: list[tuple[str, Mapping[str, float] | None]]) -> None:
     """Log each key two sources give different values for, naming which one wins."""
     given = [(label, values) for label, values in sources if values]
@@ -420,7 +449,7 @@ def resolve_conditions(
     if csv_table is None:
         csv_path = video.parent / CONDITIONS_CSV
         row_errors: dict[str, ConditionsError] = {}
-        csv_table = read_conditions_csv(csv_path, row_errors) if csv_path.is_file() else {}
+        csv_table = _read_csv_for(video, csv_path, row_errors) if csv_path.is_file() else {}
         row_error = _csv_row_error(video, row_errors)
         if row_error is not None:
             raise row_error
@@ -557,9 +586,9 @@ def discover_lab(folder: str | Path) -> list[LabEntry]:
 
     A video whose conditions cannot be resolved gets an entry carrying the
     error; the others are unaffected. A bad row of ``conditions.csv`` fails only
-    the video it names; a ``conditions.csv`` that cannot be read as a table at
-    all (no ``file`` or ``speed_rpm`` column, bad syntax) is an error for every
-    video, since any of them may depend on it.
+    the video it names. A ``conditions.csv`` that cannot be read as a table
+    (a missing or misspelled column, bad syntax) fails the videos it lists, and
+    every video when not even its ``file`` column can be read.
     """
     folder = Path(folder)
     videos = find_videos(folder)
@@ -578,8 +607,13 @@ def discover_lab(folder: str | Path) -> list[LabEntry]:
     entries = [LabEntry(video=p, error=ConditionsError(
         p, f"is a broken symbolic link (to {os.readlink(p)}): the file it points to is missing.",
         "Fix or remove the link.")) for p in _dangling_links(folder)]
+    unlisted = [v for v in videos if csv_error is not None and not _csv_lists(csv_path, v)]
+    if unlisted:
+        log.warning("%s; %s it does not list take%s %s conditions from %s other sources", csv_error,
+                    *(("the video", "s", "its", "its") if len(unlisted) == 1 else
+                      (f"the {len(unlisted)} videos", "", "their", "their")))
     for video in videos:
-        error = csv_error or _csv_row_error(video, row_errors)
+        error = (csv_error if video not in unlisted else None) or _csv_row_error(video, row_errors)
         if error is not None:
             entries.append(LabEntry(video=video, error=error))
             continue

@@ -204,6 +204,23 @@ def test_bad_csv_fails_every_video_with_its_name(tmp_path):
     assert not entry.ok and "conditions.csv" in str(entry.error)
 
 
+def test_a_misspelled_csv_column_fails_only_the_videos_the_csv_lists(tmp_path, caplog):
+    """A new user's one typo in a column name of conditions.csv failed every video of the folder, even one whose
+    sidecar gave all its conditions and which the table did not list."""
+    _touch(tmp_path / "n1800.cine")
+    _touch(tmp_path / "other.cine")
+    (tmp_path / "other.toml").write_text("speed_rpm = 3000\nradial_load_n = 500\n")
+    (tmp_path / "conditions.csv").write_text("file,speed_rpm,radial_lod_n\nn1800.cine,1800,500\n")
+    with caplog.at_level("WARNING"):
+        entries = {e.video.name: e for e in discover_lab(tmp_path)}
+    assert not entries["n1800.cine"].ok and "Did you mean 'radial_load_n'" in str(entries["n1800.cine"].error)
+    assert entries["other.cine"].resolved.conditions == OperatingConditions(3000.0, 500.0)
+    assert "the video it does not list takes its conditions from its other sources" in caplog.text
+    assert resolve_conditions(tmp_path / "other.cine").conditions.speed_rpm == 3000.0  # one video: the same
+    with pytest.raises(ConditionsError, match="radial_lod_n"):
+        resolve_conditions(tmp_path / "n1800.cine")
+
+
 def test_find_videos_refuses_a_file(tmp_path):
     with pytest.raises(ConditionsError, match="is not a folder"):
         find_videos(_touch(tmp_path / "x.cine"))

@@ -341,16 +341,25 @@ def test_an_empty_mp4_gives_one_line_not_ffmpegs_too(tmp_path):
     assert run.err.count("\n") == 1 and "moov atom" not in run.err, run.err
 
 
-def test_a_typed_speed_that_the_file_name_overrules_is_not_dropped_silently(tmp_path, capsys, cine40):
-    """`--speed-rpm` stands in only where no source gives the conditions; where the file name does, the run says the
-    typed value is not used (a new user typed 3000 for n6000_*.cine and got 6000 without a word)."""
+def test_a_typed_speed_wins_for_a_named_video_and_is_said_to_lose_in_a_folder(tmp_path, capsys, cine40):
+    """`--speed-rpm` on a video named on the command line overrides its file name, and says so (a new user typed
+    3000 for n6000_*.cine and had to rename the file); in a folder the videos' own conditions win, and the run says
+    the typed value is not used (an earlier user got 6000 without a word)."""
     from cageless.app.cli.track import collect_inputs
+    from cageless.errors import ConditionsError
 
     clip = tmp_path / "n6000_Fr500.cine"
     shutil.copy(cine40, clip)
     (entry,) = collect_inputs([str(clip)], 3000.0)
+    assert entry.resolved.conditions.speed_rpm == 3000.0
+    assert entry.resolved.conditions.radial_load_n == 500.0  # the other keys still come from the name
+    assert entry.resolved.origin["speed_rpm"] == "--speed-rpm"
+    assert "--speed-rpm 3000 overrides 6000 r/min from its file name" in capsys.readouterr().err
+    (entry,) = collect_inputs([str(tmp_path)], 3000.0)
     assert entry.resolved.conditions.speed_rpm == 6000.0
-    err = capsys.readouterr().err
-    assert "--speed-rpm 3000 is not used: its file name gives 6000 r/min" in err
+    assert "--speed-rpm 3000 is not used: its file name gives 6000 r/min" in capsys.readouterr().err
     collect_inputs([str(clip)], 6000.0)  # the same value: nothing to say
     assert capsys.readouterr().err == ""
+    (clip.with_suffix(".toml")).write_text("speed_rpm = = 1\n")  # a malformed sidecar stays an error
+    (entry,) = collect_inputs([str(clip)], 3000.0)
+    assert not entry.ok and isinstance(entry.error, ConditionsError)

@@ -61,7 +61,9 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     )
     p.add_argument("inputs", nargs="+", metavar="VIDEO_OR_FOLDER", help="videos, image folders or lab folders")
     p.add_argument("-o", "--out", default="traces", help="output folder (default ./traces)")
-    p.add_argument("--speed-rpm", type=finite_float, help="inner-ring speed for videos without conditions")
+    p.add_argument("--speed-rpm", type=finite_float,
+                   help="inner-ring speed (rpm): for a video named here it wins over its sidecar, conditions.csv "
+                   "and file name (with a warning); in a folder it stands in only for videos without conditions")
     p.add_argument("--fps", type=finite_float, help="frame-rate override (frames/s)")
     p.add_argument("--window", type=int, default=DEFAULT_WINDOW,
                    help=f"Savitzky-Golay speed window in frames, odd (default {DEFAULT_WINDOW})")
@@ -93,29 +95,45 @@ def collect_inputs(inputs: list[str], speed_rpm: float | None) -> list[LabEntry]
                 traces = " It holds cageless traces: point at the folder of videos instead." if any(
                     p.glob("*.trace.h5")) else ""
                 entries.append(LabEntry(video=p, error=CagelessError(f"{p}: no videos found in this folder.{traces}")))
-            entries.extend(_with_speed(e, speed_rpm) for e in found)
+            entries.extend(_with_speed(e, speed_rpm, named=False) for e in found)
         else:
             try:
-                entries.append(_with_speed(LabEntry(video=p, resolved=resolve_conditions(p)), speed_rpm))
+                entries.append(_with_speed(LabEntry(video=p, resolved=resolve_conditions(p)), speed_rpm, named=True))
             except CagelessError as exc:
-                entries.append(_with_speed(LabEntry(video=p, error=exc), speed_rpm))
+                entries.append(_with_speed(LabEntry(video=p, error=exc), speed_rpm, named=True))
     return refuse_shared_names(entries)
 
 
-def _with_speed(entry: LabEntry, speed_rpm: float | None) -> LabEntry:
-    """Let --speed-rpm stand in where no source gave the conditions; say so where a source overrules it."""
+def _with_speed(entry: LabEntry, speed_rpm: float | None, named: bool) -> LabEntry:
+    """Apply ``--speed-rpm`` to one video.
+
+    For a video named on the command line (``named``) the typed speed wins over every other source, and the run
+    says which value it replaces. For a video found in a folder it stands in only where no source gives the
+    conditions, and the run says where a source overrules it: one typed speed is rarely right for a whole folder.
+    A malformed source stays an error either way.
+    """
     if speed_rpm is None:
-        return entry
-    if entry.ok:
-        given = entry.resolved.conditions.speed_rpm
-        if given != speed_rpm:
-            source = entry.resolved.origin.get("speed_rpm", "its conditions")
-            print(f"warning: {entry.video}: --speed-rpm {speed_rpm:g} is not used: its {source} gives {given:g} r/min "
-                  "(the video's own conditions win; change them there, or copy the video under another name)",
-                  file=sys.stderr)
         return entry
     from cageless.conditions import ResolvedConditions
 
+    if entry.ok:
+        given = entry.resolved.conditions.speed_rpm
+        if given == speed_rpm:
+            return entry
+        source = entry.resolved.origin.get("speed_rpm", "its conditions")
+        if not named:
+            print(f"warning: {entry.video}: --speed-rpm {speed_rpm:g} is not used: its {source} gives {given:g} r/min "
+                  "(in a folder the videos' own conditions win; name the video on the command line to override them)",
+                  file=sys.stderr)
+            return entry
+        print(f"warning: {entry.video}: --speed-rpm {speed_rpm:g} overrides {given:g} r/min from its {source}",
+              file=sys.stderr)
+        conditions = replace(entry.resolved.conditions, speed_rpm=speed_rpm)
+        origin = {**entry.resolved.origin, "speed_rpm": "--speed-rpm"}
+        return replace(entry, resolved=replace(entry.resolved, conditions=conditions,
+                                                                       origin=origin))
+    if not isinstance(entry.error, MissingConditionsError):
+        return entry  # a malformed source, or no such file: the typed speed does not make it right
     resolved = ResolvedConditions(video=entry.video, conditions=OperatingConditions(speed_rpm),
                                   origin={"speed_rpm": "--speed-rpm"})
     return LabEntry(video=entry.video, resolved=resolved)
