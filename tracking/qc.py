@@ -229,10 +229,21 @@ def _write_qc(qc_dir: Path, stem: str, video_path: Path, qc: QCReport, table: pd
     qc.overlays = [p.name for p in written]
     atomic_write_text(qc_dir / f"{stem}.qc.json", json.dumps(qc.to_dict(), indent=1, default=float))
     written.append(qc_dir / f"{stem}.qc.json")
-    profile = angle_profile(trace.angle, trace.slip, 1.0, trace.valid)
+    profile = slip_profile_table(trace)
     atomic_write_text(qc_dir / f"{stem}.slip_profile.csv", profile.to_csv(index=False, float_format="%.6g"))
     return written[:-1]
 
+
+
+def slip_profile_table(trace: Trace) -> pd.DataFrame:
+    """The measured slip per 1-degree orbital-angle bin, as written to ``<stem>.slip_profile.csv``.
+
+    Columns ``angle_deg`` (bin centre), ``slip_mean_pct`` and ``slip_std_pct`` (the mean and the sample standard
+    deviation of every ball's slip in the bin, in percent) and ``count`` (samples in the bin).
+    """
+    profile = angle_profile(trace.angle, trace.slip, 1.0, trace.valid)
+    return pd.DataFrame({"angle_deg": profile["angle_deg"], "slip_mean_pct": 100.0 * profile["mean"],
+                         "slip_std_pct": 100.0 * profile["std"], "count": profile["count"]})
 
 
 #: Overlay colour (BGR) of each candidate status in the selection image.

@@ -114,6 +114,14 @@ def test_cli_folder_one_bad_video_does_not_stop_the_rest(tmp_path, capsys):
     tr = read_trace(out / "n3000_Fr500.trace.h5")
     assert tr.source == "video" and tr.speed_rpm == 3000 and tr.qc["n_balls_found"] == 14
     assert (out / "qc" / "n3000_Fr500.qc.json").is_file() and list((out / "qc").glob("n3000_Fr500.frame*.png"))
+    import pandas as pd
+    from cageless.profiles import angle_profile
+
+    profile = pd.read_csv(out / "qc" / "n3000_Fr500.slip_profile.csv")  # units in the column names
+    assert list(profile.columns) == ["angle_deg", "slip_mean_pct", "slip_std_pct", "count"]
+    fraction = angle_profile(tr.angle, tr.slip, 1.0, tr.valid)["mean"].to_numpy()
+    assert np.allclose(profile.slip_mean_pct, 100.0 * fraction, rtol=1e-5, atol=1e-9, equal_nan=True)
+    assert profile["count"].sum() == int(np.sum(np.asarray(tr.valid) & np.isfinite(tr.slip)))
 
 
 def test_cli_sample_lab_in_parallel(tmp_path, capsys):
