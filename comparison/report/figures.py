@@ -72,6 +72,7 @@ def slip_figure(d: ConditionDescription, size: tuple[float, float] = (5.6, 3.0))
             ax.plot(prof["angle_deg"], 100.0 * smooth_profile(prof["mean"].to_numpy(), c.measured.bin_deg),
                     color=colour, lw=1.6, ls="--")
         ax.plot([], [], color="0.3", lw=1.6, ls="--", label=f"smoothed, sigma {PEAK_SMOOTHING_DEG:g} deg")
+        ax.fill_between([], [], [], color="0.3", alpha=0.2, lw=0, label="band: mean +- 1 std of samples")
         ax.set(xlabel="orbital angle (deg)", ylabel="slip rate (%)", xlim=(0, 360))
         ax.legend(fontsize=7)
     return _svg(draw, size=size)
@@ -88,10 +89,22 @@ def contact_polar_figure(d: ConditionDescription) -> str:
                 sel = ev[ev.kind == kind]
                 ax.scatter(sel.angle, sel.peak_force, s=6, color=colour, label=f"{kind} ({len(sel)})")
             ax.legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.25, -0.15))
+            _log_radius(ax, ev.peak_force.to_numpy())
         else:
             ax.set_title("no ball-ball contact after the start-up", fontsize=8)
         ax.set_xlabel("peak force (N) against orbital angle")
     return _svg(draw, size=(3.6, 3.6))
+
+
+def _log_radius(ax: Any, force: np.ndarray) -> None:
+    """A logarithmic radius when the forces span over a decade, so that light rubbing does not pile up at the centre."""
+    positive = force[np.isfinite(force) & (force > 0)]
+    if positive.size < 2 or positive.max() < 10.0 * positive.min():
+        return
+    low = positive.min() / 1.5
+    ax.set_rscale("log")
+    ax.set_rlim(low, 1.3 * positive.max())
+    ax.set_rorigin(low / 3.0)
 
 
 def ring_figure(d: ConditionDescription) -> str:

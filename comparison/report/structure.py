@@ -37,10 +37,13 @@ def _section(d: ConditionDescription) -> dict[str, Any]:
     section: dict[str, Any] = {"title": d.label, "status": r.status, "facts": facts, "figures": []}
     if d.comparison is not None:
         section["figures"] = [
-            {"caption": "Revolution speed against orbital angle (mean and spread over balls and passes). Look for "
+            {"caption": "Revolution speed against orbital angle: the mean over balls and passes, and a band of "
+                        "plus and minus one standard deviation of the single samples. Look for "
                         "the dip in the unloaded zone (0-180 deg, shaded) and whether the two curves share it.",
              "svg": figures.speed_figure(d)},
-            {"caption": "Slip rate against orbital angle (mean and spread). The table's slip rates are the peaks "
+            {"caption": "Slip rate against orbital angle: mean, and a band of one standard deviation of the single "
+                        "samples (how much balls and passes differ, not how uncertain the mean is: the table's "
+                        "plus-minus is the standard error of the peak). The table's slip rates are the peaks "
                         "of these curves in the unloaded zone, each smoothed by a periodic Gaussian of sigma "
                         f"{PEAK_SMOOTHING_DEG:g} deg first; the MAE is their mean distance.",
              "svg": figures.slip_figure(d)},

@@ -140,6 +140,23 @@ def test_figures_restore_rcparams_and_close(tmp_path):
     assert dict(matplotlib.rcParams) == before
 
 
+def test_contact_polar_radius_is_logarithmic_when_forces_span_decades():
+    """A new user found light rubbing piled up at the centre of the ball-ball polar plot: over a decade of peak
+    forces the radius is logarithmic, from just below the lightest contact; within a decade it stays linear."""
+    import matplotlib.pyplot as plt
+
+    from comparison.report.figures import _log_radius
+
+    for force, scale in ((np.array([0.2, 3.0, 150.0, 0.0]), "log"), (np.array([20.0, 35.0, 150.0]), "linear")):
+        fig = plt.figure()
+        ax = fig.add_subplot(projection="polar")
+        _log_radius(ax, force)
+        assert ax.get_yscale() == scale  # the radius is the y axis of a polar plot
+        if scale == "log":
+            assert ax.get_rmin() == pytest.approx(0.2 / 1.5) and ax.get_rmax() == pytest.approx(1.3 * 150.0)
+        plt.close(fig)
+
+
 def test_measured_slip_is_referred_to_the_models_contact_angle():
     """Same orbital speeds, different contact angle: the measured slip is re-referred to the simulation's
     alpha. Reference: omega_c = omega_i (1 - D cos(alpha) / d_m) / 2 (Harris & Kotzalas, *Essential Concepts
