@@ -1,6 +1,7 @@
 """Bit-identity of tracking between two source trees: the check of a refactor that must not change results.
 
     python benchmarks/trace_identity.py --baseline OLD_SOURCE_TREE CLIP [CLIP ...] [--out DIR] [--timing]
+                                        [--speed-rpm RPM]
 
 Tracks every clip with ``cageless track CLIP -o DIR/<tree>`` (the clip's sidecar gives its conditions and
 bearing) from a fresh interpreter for this tree and for the baseline tree (e.g. ``git archive`` of main
@@ -32,12 +33,13 @@ _PRELUDE = (
 _CLI = _PRELUDE + "from cageless.app.cli import main; sys.exit(main({argv!r}))"
 
 
-def _track(src: Path, clip: Path, out: Path) -> tuple[int, float]:
-    """Track ``clip`` with the source tree ``src`` into ``out``; return the exit code and the wall time."""
+def _track(src: Path, clip: Path, out: Path, extra: list[str] | None = None) -> tuple[int, float]:
+    """Track ``clip`` with the source tree ``src`` into ``out`` (``extra``: more arguments of ``cageless track``);
+    return the exit code and the wall time."""
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    proc = subprocess.run([sys.executable, "-c", _CLI.format(src=str(src), argv=["track", str(clip), "-o", str(out),
-                                                                               "-q"])],
+    argv = ["track", str(clip), "-o", str(out), "-q", *(extra or [])]
+    proc = subprocess.run([sys.executable, "-c", _CLI.format(src=str(src), argv=argv)],
                           capture_output=True, text=True, env={**os.environ, "CAGELESS_CACHE_DIR": str(out / ".c")})
     return proc.returncode, time.perf_counter() - t0
 
@@ -83,12 +85,15 @@ def main() -> int:
     ap.add_argument("--baseline", type=Path, required=True, help="the other cageless source tree")
     ap.add_argument("--out", type=Path, default=Path("/tmp/cageless-trace-identity"))
     ap.add_argument("--timing", action="store_true")
+    ap.add_argument("--speed-rpm", type=float, help="the shaft speed, for clips without a sidecar or conditions "
+                    "(e.g. the benchmark clip of benchmarks/track.py, 3000)")
     args = ap.parse_args()
+    extra = ["--speed-rpm", str(args.speed_rpm)] if args.speed_rpm else []
     bad = 0
     for clip in args.clips:
         runs = {}
         for name, src in (("baseline", args.baseline.resolve()), ("this", HERE)):
-            runs[name] = _track(src, clip, args.out / name)
+            runs[name] = _track(src, clip, args.out / name, extra)
         trace = f"{clip.stem}.trace.h5"
         codes = {k: v[0] for k, v in runs.items()}
         timing = "  ".join(f"{k} {v[1]:.1f} s" for k, v in runs.items()) if args.timing else ""

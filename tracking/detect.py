@@ -355,7 +355,11 @@ def _span(c, half_sq, dy2, lo_lim, hi_lim):  # pragma: no cover - compiled
 
 @numba.njit(cache=True, nogil=True)
 def _local_background(frame, mask, u, v, r, ring, static):  # pragma: no cover - compiled
-    """Median of the masked pixels with r < distance <= r + 2 from (u, v); NaN if fewer than 8."""
+    """Median of the masked pixels with r < distance <= r + 2 from (u, v); NaN if fewer than 8.
+
+    Each row visits only the pixels left and right of the window's own run (the run found from the ends of
+    its ``_span``, tested exactly as a pixel is), not the whole outer disc: the same pixels in the same
+    order (1,850 pixels visited for 290 kept at the benchmark clip's 22 px windows)."""
     h, w = frame.shape
     ro = r + 2.0
     use = _window_has_static(static, u, v, ro)
@@ -363,12 +367,22 @@ def _local_background(frame, mask, u, v, r, ring, static):  # pragma: no cover -
     for y in range(max(int(np.floor(v - ro)), 0), min(int(np.ceil(v + ro)) + 1, h)):
         dy2 = (y - v) * (y - v)
         x0, x1 = _span(u, ro * ro, dy2, 0, w)
-        i0, i1 = _span(u, r * r, dy2, 0, w)
-        for x in range(x0, x1 + 1):
-            if (i0 <= x <= i1 and (x - u) * (x - u) + dy2 <= r * r) or not mask[y, x]:
-                continue
-            ring[cnt] = frame[y, x] - _static_at(frame, static, y, x) if use else frame[y, x]
-            cnt += 1
+        a, b = _span(u, r * r, dy2, 0, w)
+        # [a, b]: the pixels of the inner span that lie in the window (one run: the disc is convex in x)
+        while a <= b and (a - u) * (a - u) + dy2 > r * r:
+            a += 1
+        while b >= a and (b - u) * (b - u) + dy2 > r * r:
+            b -= 1
+        if a > b:
+            a, b = x1 + 1, x1
+        for x in range(x0, min(a, x1 + 1)):
+            if mask[y, x]:
+                ring[cnt] = frame[y, x] - _static_at(frame, static, y, x) if use else frame[y, x]
+                cnt += 1
+        for x in range(max(b + 1, x0), x1 + 1):
+            if mask[y, x]:
+                ring[cnt] = frame[y, x] - _static_at(frame, static, y, x) if use else frame[y, x]
+                cnt += 1
     return np.median(ring[:cnt]) if cnt >= 8 else np.nan
 
 

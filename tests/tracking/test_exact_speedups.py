@@ -1,16 +1,20 @@
 """Faster forms of the selection's arithmetic give the very values of the plain numpy/OpenCV forms they replace.
 
-References: numpy's own ``polyfit``, ``unwrap`` and ``median``, and the Hessian eigenvalue written out as
-before (``Sobel(...) * 0.25``, then the closed-form smaller eigenvalue of a symmetric 2 x 2 matrix).
+References: numpy's own ``polyfit``, ``unwrap`` and ``median``, the Hessian eigenvalue written out as
+before (``Sobel(...) * 0.25``, then the closed-form smaller eigenvalue of a symmetric 2 x 2 matrix), and the
+centroid's local background as commit 5920b3c computed it.
 """
 
 from __future__ import annotations
 
 import cv2
+import numba
 import numpy as np
 import pytest
 
 from cageless.tracking.candidates import _hessian_min
+from cageless.tracking.detect import (NO_STATIC, _local_background, _span, _static_at, _window_has_static,
+                                      compiled_static)
 from cageless.tracking.select import _median, _slope, _unwrap
 
 
@@ -87,3 +91,47 @@ def test_track_fit_normal_equations_are_bit_identical_to_einsum(frames):
     lhs, rhs = _normal_equations(design, w, y)
     assert lhs.tobytes() == np.einsum("tkp,tkq->tpq", dw, design).tobytes()
     assert rhs.tobytes() == np.einsum("tkp,tk->tp", dw, y).tobytes()
+
+
+@numba.njit(cache=False)
+def _local_background_whole_disc(frame, mask, u, v, r, ring, static):  # pragma: no cover - compiled
+    """The local background as it was written before it skipped the window's own pixels (commit 5920b3c): every
+    pixel of the outer disc visited, those inside the window left out one by one."""
+    h, w = frame.shape
+    ro = r + 2.0
+    use = _window_has_static(static, u, v, ro)
+    cnt = 0
+    for y in range(max(int(np.floor(v - ro)), 0), min(int(np.ceil(v + ro)) + 1, h)):
+        dy2 = (y - v) * (y - v)
+        x0, x1 = _span(u, ro * ro, dy2, 0, w)
+        i0, i1 = _span(u, r * r, dy2, 0, w)
+        for x in range(x0, x1 + 1):
+            if (i0 <= x <= i1 and (x - u) * (x - u) + dy2 <= r * r) or not mask[y, x]:
+                continue
+            ring[cnt] = frame[y, x] - _static_at(frame, static, y, x) if use else frame[y, x]
+            cnt += 1
+    return np.median(ring[:cnt]) if cnt >= 8 else np.nan
+
+
+def test_local_background_skipping_the_window_is_bit_identical_to_the_whole_disc():
+    rng = np.random.default_rng(11)
+    h, w = 61, 67
+    frame = rng.integers(0, 4096, (h, w)).astype(np.uint16)
+    mask = rng.random((h, w)) > 0.15  # holes everywhere, as static defects leave them
+    pattern = np.zeros((h, w), np.float32)
+    pattern[40:44, 5:12] = 37.5  # lint in one corner: windows there subtract it
+    static = compiled_static((pattern, 3000.0))
+    ring = np.empty(4096)
+    checked = 0
+    # Centres on and off the pixel grid, windows cut by the image edge, radii from a pixel to most of the image.
+    for _ in range(4000):
+        u, v = rng.uniform(-3.0, w + 3.0), rng.uniform(-3.0, h + 3.0)
+        if rng.random() < 0.2:
+            u, v = float(round(u)), float(round(v))
+        r = float(rng.choice([0.5, 1.0, 2.0, 3.7, 7.0, 22.257856953523373, 30.0]))
+        for st in (NO_STATIC, static):
+            new = _local_background(frame, mask, u, v, r, ring, st)
+            old = _local_background_whole_disc(frame, mask, u, v, r, ring, st)
+            assert np.float64(new).tobytes() == np.float64(old).tobytes(), (u, v, r)
+            checked += np.isfinite(old)
+    assert checked > 4000  # most windows had their 8 ring pixels: the medians compared are real ones
