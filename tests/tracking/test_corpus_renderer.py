@@ -21,7 +21,7 @@ from cageless.units import rpm_to_rad_s
 from cageless.tracking.io import open_video
 from cageless.tracking.synthetic.appearance import draw_params
 from cageless.tracking.synthetic.corpus import clip_truth, render_clip, simulate_motion
-from cageless.tracking.synthetic.matrix import FRESH, FRESH2, FRESH3, FRESH4, HOLDOUT, SETS, TUNING, coverage
+from cageless.tracking.synthetic.matrix import FRESH, FRESH2, FRESH3, FRESH4, HOLDOUT, SETS, TUNING, TUNING2, coverage
 from cageless.tracking.synthetic.scene3d import FrameState, SceneRenderer
 from cageless.tracking.synthetic.score import BARS, ideal_trace, score_trace, truth_arrays
 
@@ -143,6 +143,7 @@ def test_sets_are_disjoint():
     assert not (set(TUNING) | set(HOLDOUT) | set(FRESH)) & set(FRESH2)
     assert not (set(TUNING) | set(HOLDOUT) | set(FRESH) | set(FRESH2)) & set(FRESH3)
     assert not (set(TUNING) | set(HOLDOUT) | set(FRESH) | set(FRESH2) | set(FRESH3)) & set(FRESH4)
+    assert not (set(TUNING) | set(HOLDOUT) | set(FRESH) | set(FRESH2) | set(FRESH3) | set(FRESH4)) & set(TUNING2)
 
 
 def test_each_set_is_whole_blocks():
