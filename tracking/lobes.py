@@ -19,6 +19,7 @@ re-measured track then lies on the common circle; otherwise the table is returne
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -111,8 +112,9 @@ def _off_lobe(shifts: list[LobeShift | None], sigma_px: float) -> list[int]:
     return off if fitted - len(off) > fitted / 2 else []
 
 
-def relock_lobes(table: pd.DataFrame, frames, background: np.ndarray, mask: np.ndarray, half: float,
-                 threshold: float, iterations: int, sigma_px: float, static=None) -> tuple[pd.DataFrame, list[int]]:
+def relock_lobes(table: pd.DataFrame, frames: Callable[[int], np.ndarray], background: np.ndarray,
+                 mask: np.ndarray, half: float, threshold: float, iterations: int, sigma_px: float,
+                 static: tuple[np.ndarray, float, np.ndarray] | None = None) -> tuple[pd.DataFrame, list[int]]:
     """``table`` (the linker's, cropped pixels) with every ball on another light's lobe moved onto the others'.
 
     Parameters
@@ -155,11 +157,11 @@ def relock_lobes(table: pd.DataFrame, frames, background: np.ndarray, mask: np.n
         return table, []
     out = table.sort_values(["frame", "ball"], kind="stable").reset_index(drop=True)
     z = u.shape[1]
+    lost = ~nd[:, kept]  # samples not re-measured: missed, as the linker leaves a miss
     for name, grid in (("u_px", nu), ("v_px", nv), ("mass", nm), ("detected", nd)):
         col = out[name].to_numpy().reshape(-1, z).copy()
-        col[:, kept] = grid[:, kept]
+        col[:, kept] = np.where(lost, np.nan, grid[:, kept]) if name in ("u_px", "v_px") else grid[:, kept]
         out[name] = col.ravel()
-    out.loc[~out.detected.to_numpy(), ["u_px", "v_px"]] = np.nan
     log.info("balls %s were tracked on another light's highlight; moved by %s px", kept,
              [round(shifts[j].size, 2) for j in kept])  # type: ignore[union-attr]
     return out, kept
