@@ -1,6 +1,7 @@
-"""The tracker on the independent corpus: every clip of the six seed sets, scored against issue 14's bars.
+"""The tracker on the independent corpus: every clip of the seven seed sets, scored against issue 14's bars.
 
-    python benchmarks/tracking_corpus.py [--cache DIR] [--sets TUNING,HOLDOUT,FRESH,FRESH2,FRESH3,FRESH4] [--workers 2]
+    python benchmarks/tracking_corpus.py [--cache DIR] [--sets TUNING,HOLDOUT,FRESH,FRESH2,FRESH3,FRESH4,TUNING2]
+                                         [--workers 2]
                                          [--long] [--seeds 1000,1001] [--no-oracle] [--json out.json]
 
 Renders each clip once into ``--cache`` (default ``/tmp/cageless-corpus``; reused while the
@@ -11,7 +12,9 @@ each highlight is: where it passes, the pixels support the bars) and the Cramér
 balls found, identity swaps, angle / speed / slip-profile errors, pass or fail and why), the
 pass count and the worst clip. ``--long`` runs the long variants (one cage revolution each; their videos
 are deleted after scoring unless ``--keep``); ``--no-oracle`` scores the tracker alone (about half the time). The short clips take about 9 GB for two sets. Score HOLDOUT and FRESH to
-FRESH4 only once a change is final: they are never tuned on (tracking/synthetic/matrix.py).
+FRESH4 only once a change is final: they are never tuned on (tracking/synthetic/matrix.py). TUNING and
+TUNING2 are the sets to tune on; TUNING2 is scored here only, not in the CI matrix
+(tests/tracking/test_corpus_matrix.py); its results are in docs/tracking-internals.md.
 """
 
 from __future__ import annotations
@@ -71,6 +74,10 @@ def format_set(name: str, results: list[ClipResult]) -> str:
         lines += [f"The oracle (a Gaussian-mask centroid told where each highlight is) passes {n_oracle} of "
                   f"{len(results)}; the Cramér-Rao bound on the angle is at most "
                   f"{max(r.angle_crb_mrad or 0.0 for r in results):.3f} mrad (bar {BARS['angle_rms_mrad']})."]
+    moved = [f"{r.seed} (balls {', '.join(map(str, r.lobe_moves))})" for r in results if r.lobe_moves]
+    if moved:
+        lines += ["Balls moved from another light's highlight onto the others' (tracking/lobes.py): "
+                  + "; ".join(moved) + "."]
     lines += [f"Worst clip: seed {worst.seed} ({worst.status}: {worst.message[:160]})", ""]
     return "\n".join(lines)
 

@@ -38,6 +38,7 @@ from cageless.tracking.geometry import fit_orbit, orbital_angles
 from cageless.tracking.io import CineReader, FrameSource, open_video
 from cageless.tracking.kinematics import DEFAULT_TRACK_FIT, DEFAULT_WINDOW, revolution_speed, robust_track_fit
 from cageless.tracking.link import BallCountWarning, TrackSetup, track_frames
+from cageless.tracking.lobes import relock_lobes
 from cageless.tracking.locate import BearingLocation, background_frame, locate_bearing
 from cageless.tracking.locate_motion import (DROPOUT_GAIN, frame_gains, holds_the_motion, locate_by_motion, motion_map,
                                              plausible_band)
@@ -414,10 +415,15 @@ def track_video(
         rows, cols = frames.rows, frames.cols
         with tqdm(total=len(video), desc=path.name, unit="frame", disable=not progress, leave=False) as bar:
             table = _track_all(path, fps, video, frames, times, setup, options, bar.update)
+        table, moved = relock_lobes(table, frames, setup.background, setup.mask,
+                                    options.detector.window_sigma * max(setup.highlight_sigma, 1.0),
+                                    options.detector.weight_sigma * setup.sigma_noise, options.detector.iterations,
+                                    setup.highlight_sigma, setup.static_compiled)
         table["u_px"] += cols.start
         table["v_px"] += rows.start
         trace, qc = _finish(path, video, table, loc, conditions, bearing, options, prov,
-                            [str(w.message) for w in caught], _selection_summary(sel, cols.start, rows.start))
+                            [str(w.message) for w in caught],
+                            _selection_summary(sel, cols.start, rows.start) | {"balls_moved_to_common_lobe": moved})
         selection_table = sel.table.assign(u_px=sel.table.u_px + cols.start, v_px=sel.table.v_px + rows.start)
         first_frame = video[0] if out_dir is not None else None
     for w in caught:  # recorded for QC; still shown to the caller

@@ -53,6 +53,8 @@ class ClipResult:
     track_s: float = 0.0
     n_frames: int = 0
     warnings: list[str] = field(default_factory=list)
+    #: Balls the tracker moved from another light's highlight onto the others' (tracking/lobes.py).
+    lobe_moves: list[int] = field(default_factory=list)
 
 
 def run_seed(seed: int, folder: str | Path, long: bool = False, keep: bool = True, oracle: bool = True) -> ClipResult:
@@ -92,7 +94,8 @@ def _track_and_score(spec: ClipSpec, with_oracle: bool = True) -> ClipResult:
                       score=score.to_dict(), oracle=oracle, angle_crb_mrad=crb, render_s=spec.render_s,
                       track_s=track_s,
                       n_frames=spec.n_frames,
-                      warnings=_messages(caught))
+                      warnings=_messages(caught),
+                      lobe_moves=list(res.qc.selection.get("balls_moved_to_common_lobe", [])))
 
 
 def _messages(caught: list[Any]) -> list[str]:
