@@ -32,7 +32,7 @@ from cageless.kinematics import slip_rate, theoretical_cage_speed
 from cageless.outputs import is_foreign_file
 from cageless.provenance import VIDEO_HASH, Provenance
 from cageless.trace import Trace, VideoInfo, write_trace
-from cageless.tracking.detect import (DetectorParams, detect_full, noise_sigma, spot_sigma, static_defects,
+from cageless.tracking.detect import (DetectorParams, noise_sigma, spot_sigma, static_defects,
                                       static_pattern)
 from cageless.tracking.geometry import fit_orbit, orbital_angles
 from cageless.tracking.io import CineReader, FrameSource, open_video
