@@ -20,7 +20,8 @@ ark4's stability limits.
 ``spatial`` cases (51 samples, as a report's run writes them: ``auto``'s pilot, probes and chunks amortised as
 there), with no reference (a 5 ms step of the window would be a 10 ms call, inside the machine's noise; the
 accuracy stays measured on ``--window``). Each candidate runs ``--repeats`` times interleaved; wall and CPU
-seconds per simulated second (best of the repeats), steps, right-hand sides and the peak of Python's allocations
+seconds per simulated second (best of the repeats), steps, refused steps by cause (the error test, the onset
+control, the force-jump test), right-hand sides and the peak of Python's allocations
 during one more solve (``tracemalloc``; over two windows it shows whether memory grows with the duration).
 With ``--peer OTHER_PYTHON`` (another checkout's environment, e.g. a wrapper that sets its ``PYTHONPATH``) the
 measurement runs in separate processes, this interpreter and the peer in alternation, ``--rounds`` rounds, both
@@ -105,6 +106,7 @@ def speed_only(states: dict[str, str], window: float, repeats: int, keys: list[s
             rows.append({"case": case, "solver": key, "method": sol.method, "window_s": window,
                          "wall_s_per_sim_s": best[key][0] / window, "cpu_s_per_sim_s": best[key][1] / window,
                          "steps": sol.n_steps, "rejected": sol.n_rejected, "rhs_calls": sol.n_rhs,
+                         "onset_retries": sol.n_onset_retries, "jump_retries": sol.n_force_jump_retries,
                          "peak_traced_mib": peak, "ok": bool(sol.success)})
     return rows
 
@@ -120,7 +122,8 @@ def _child(exe: str, args: argparse.Namespace, states: dict[str, str]) -> list[d
 def _peer_table(runs: dict[str, list[list[dict[str, Any]]]]) -> str:
     """Each (case, candidate)'s best wall and CPU time per simulated second on both trees, with their ratios."""
     lines = ["| case | solver | wall this / peer | ratio | CPU this / peer | ratio | steps this / peer | "
-             "RHS this / peer | peak MiB this / peer |", "|---|---|---|---|---|---|---|---|---|"]
+             "refused (error, onset, jump) this / peer | RHS this / peer | peak MiB this / peer |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     first = runs["this"][0]
     for i, row in enumerate(first):
         a = [r[i] for r in runs["this"]]
@@ -129,9 +132,19 @@ def _peer_table(runs: dict[str, list[list[dict[str, Any]]]]) -> str:
         ca, cb = min(x["cpu_s_per_sim_s"] for x in a), min(x["cpu_s_per_sim_s"] for x in b)
         lines.append(f"| {row['case']} | {row['solver']} ({row['method']}) | {wa:.2f} / {wb:.2f} | {wa / wb:.3f} | "
                      f"{ca:.2f} / {cb:.2f} | {ca / cb:.3f} | {a[0]['steps']} / {b[0]['steps']} | "
+                     f"{_refusals(a[0])} / {_refusals(b[0])} | "
                      f"{a[0]['rhs_calls']} / {b[0]['rhs_calls']} | {a[0]['peak_traced_mib']:.1f} / "
                      f"{b[0]['peak_traced_mib']:.1f} |")
     return "\n".join(lines)
+
+
+def _refusals(row: dict[str, Any]) -> str:
+    """A row's refused steps by cause: all (the error test's, the onset control's, the force-jump test's); the
+    causes are "?" in rows of a tree that did not record them."""
+    onset, jump = row.get("onset_retries"), row.get("jump_retries")
+    if onset is None or jump is None:
+        return f"{row['rejected']} (?)"
+    return f"{row['rejected']} ({row['rejected'] - onset - jump}, {onset}, {jump})"
 
 
 def _speed_main(args: argparse.Namespace) -> None:

@@ -34,7 +34,13 @@ length (:func:`_onset_retry`), where DP5 retries at the onset length and then st
 onset-length retries (3-5 refused steps per change at 3000 rpm, 500 N). The step controller is Hairer's PI
 controller (Solving ODEs I, sect. II.4) with the exponents of an order-3 error estimate: 1/4 - 0.75 beta
 and beta = 0.04, with no growth right after a rejected step (Hairer & Wanner's facmax = 1). The step after
-the end of a span starts from the controller's proposal, not from the step the span's end clipped. A run in
+the end of a span starts from the controller's proposal, not from the step the span's end clipped. Three controls
+keep the refusals down (over 100 ms settled at 3000 rpm, 500 N, planar, 889 of 4049 steps were refused: 349 by the
+error test, 221 at contact changes, 319 by the force-jump test): a contact change predicted within 2.5 onset steps
+is crossed by an onset step instead of being stepped into (:func:`_onset_ahead`), a step the error test refuses
+across a contact change is retried as the onset control retries (:func:`_refused_across`), and the step after an
+accepted one is bounded where the force-jump test is expected to pass (:func:`_jump_bound`); 596 of 4108 refused
+then. A run in
 chunks keeps the integrator in a session (``state`` and ``rows``, :class:`cageless.simulation.solve.ArkSession`):
 a call returns after the step that crosses its last sample, and the next call resumes there, writing its first
 samples from that step's interpolant, so that the chunks take the same steps as one call.
@@ -113,10 +119,12 @@ def ark_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_st
         err = _ark_trial(model_id, t, h, y, p, log, f, ki, yt, ynew, f_end, work, atol, rtol, e, cnt)
         if not np.isfinite(err) or err > 1.0:
             held = True
-            h = _rejected(err, h, cnt)
-            if h < tiny and not np.isfinite(err):
+            h_err = _rejected(err, h, cnt)
+            if h_err < tiny and not np.isfinite(err):
                 status = STATUS_NONFINITE
                 break
+            h, t_cross = _refused_across(model_id, p, t, h, y, ynew, f[0], f_end, h_err, h_onset, sig, g0, g1, yt,
+                                         err, cnt)
             continue
         verdict, sig = _controls(model_id, ynew, p, sig, h, h_onset, f[0], f_end, jump_floor, force_jump)
         if verdict == 1:
@@ -130,11 +138,12 @@ def ark_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_st
         fac = max(1.0 if held else 0.1, min(5.0, err ** 0.22 / err_old ** 0.04 / 0.9))
         held = False
         err_old = max(err, 1e-4)
+        h_jump = _jump_bound(h, h_onset, f[0], f_end, jump_floor, force_jump)
         if t + h > t_last:  # the step that crosses the last sample: keep its start for the next call's samples
             _hold_step(t, h, y, f[0], state, rows)
         k = _ark_accept(model_id, t, h, y, ynew, f, f_end, ki, work, p, log, t_out, out, k, cnt)
         t = t + h
-        h = h / fac
+        h = min(h / fac, h_jump)
     _write_stats(stats, cnt, max(h, h_want) if status == STATUS_OK else h)
     _keep(state, rows, f, ki, t, h, err_old, held, t_cross, sig)
     return status
@@ -242,6 +251,52 @@ def _rejected(err, h, cnt):  # pragma: no cover - compiled
     return h * 0.25 if not np.isfinite(err) else h / min(5.0, err ** 0.25 / 0.9)
 
 
+#: The share of the force-jump test's limit (:func:`cageless.simulation.integrators.dp5._controls`) that the step after
+#: an accepted one aims at, extrapolating the jump linearly in the step length (see :func:`_jump_bound`).
+JUMP_AIM = 0.8
+
+
+@numba.njit(cache=True, inline="always")
+def _jump_bound(h, h_onset, f0, f1, floor, fraction):  # pragma: no cover - compiled
+    """The longest next step the force-jump test is expected to pass after an accepted step of length ``h`` whose
+    accelerations went from ``f0`` to ``f1``: the test's largest share q = |f1_i - f0_i| / (fraction
+    (max(|f0_i|, |f1_i|) + floor_i)) (<= 1, the step passed), extrapolated linearly, h JUMP_AIM / q, never below
+    ``h_onset`` (where the test stops); inf when the test is off or did not run (steps up to ``h_onset``).
+    Without it the PI controller grew the step through the impacts' rising forces into the test: 319 of 889
+    refusals over 100 ms settled at 3000 rpm, 500 N (planar), at a median 1.45 times the step before, whose share
+    was 0.76."""
+    if fraction <= 0.0 or h <= h_onset:
+        return np.inf
+    q = 0.0
+    for i in range(f0.shape[0]):
+        if floor[i] > 0.0:
+            a, b = f0[i], f1[i]
+            q = max(q, abs(b - a) / (fraction * (max(abs(a), abs(b)) + floor[i])))
+    if q > 0.0 and np.isfinite(q):
+        return max(h_onset, h * JUMP_AIM / q)
+    return np.inf
+
+
+@numba.njit(cache=True, inline="always")
+def _refused_across(model_id, p, t, h, y, ynew, f0, f1, h_err, h_onset, sig, g0, g1, yt, err,
+                    cnt):  # pragma: no cover - compiled
+    """The retry after the error test refused a step of length ``h`` (``h_err``: the controller's shrink), and a
+    contact change located ahead (the loop's ``t_cross``, -inf for none). When a contact opened or closed in the
+    step (its end's signature differs from ``sig``) and the step is longer than an onset step, the retry is placed
+    as the onset control places it (:func:`_onset_retry`: up to half an onset step before the change, located on
+    the step's interpolant, and the next step crossing it short; the onset step itself where the change lies
+    within 1.5 onset steps of the start; counted as an onset retry too). The error of a step across a contact
+    change says nothing of the length that passes: the controller's shrink (err^(1/4) / 0.9, 1.1-1.3 times at the
+    errors of 1-2 these steps have) was refused again and again until the onset control ran, on an error that
+    passed. 135 of the 349 error refusals over 100 ms settled at 3000 rpm, 500 N (planar) had a contact change in
+    the step, a few onset steps long, the change mostly within two onset steps of the start (which
+    :func:`_onset_ahead` left to the onset control). Otherwise ``h_err``."""
+    if h_onset <= 0.0 or h <= h_onset or not np.isfinite(err) or model_signature(model_id, ynew, p) == sig:
+        return h_err, -np.inf
+    cnt[4] += 1  # dp5's onset-retry counter
+    return _onset_retry(model_id, p, t, h, y, ynew, f0, f1, h_onset, g0, g1, yt)
+
+
 @numba.njit(cache=True, inline="always")
 def _ark_stages(model_id, t, h, y, p, log, f, ki, yt, ynew, work):  # pragma: no cover - compiled
     """Stages 2 .. 6 of one step of length h from (t, y), with f[0] = f(y) and ki[0] = f_I(y): f(Y_i) into f[i],
@@ -315,10 +370,12 @@ def _onset_ahead(model_id, p, t, h, y, f0, h_onset, t_cross, g0, g1, yt):  # pra
     """A step of length ``h`` shortened to end half an onset step before a contact change predicted inside it
     (the gaps at y and at the Euler predictor y + h f0, the earliest sign change of the straight line between
     them), with the change's time for the loop's ``t_cross``; ``(h, t_cross)`` unchanged when a change is
-    already located ahead or the step is within three onset steps, ``(h, -inf)`` when none is predicted (or one
-    within two onset steps of the start, which the onset control handles). Without it every contact change
-    cost a refused step first."""
-    if h_onset <= 0.0 or t_cross > t or h <= 3.0 * h_onset:
+    already located ahead or the step is an onset step at most, ``(h, -inf)`` when none is predicted, and
+    ``(h_onset, -inf)`` when one is predicted within 2.5 onset steps of the start: the onset step, which may cross
+    it. Without it every contact change cost a refused step first; before the last case (the step was taken
+    whole, and refused by the onset control or, first, by the error test) 221 onset and 135 error refusals per
+    293 contact changes over 100 ms settled at 3000 rpm, 500 N (planar), after it 70 onset refusals."""
+    if h_onset <= 0.0 or t_cross > t or h <= h_onset:
         return h, t_cross
     for i in range(y.shape[0]):
         yt[i] = y[i] + h * f0[i]
@@ -328,8 +385,10 @@ def _onset_ahead(model_id, p, t, h, y, f0, h_onset, t_cross, g0, g1, yt):  # pra
     for i in range(g0.shape[0]):
         if (g0[i] > 0.0) != (g1[i] > 0.0):
             frac = min(frac, g0[i] / (g0[i] - g1[i]))
-    if frac > 1.0 or frac * h - 0.5 * h_onset <= 2.0 * h_onset:
+    if frac > 1.0:
         return h, -np.inf
+    if frac * h - 0.5 * h_onset <= 2.0 * h_onset:  # too close to split: the onset step, which may cross it
+        return h_onset, -np.inf
     return frac * h - 0.5 * h_onset, t + frac * h
 
 

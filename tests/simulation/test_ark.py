@@ -102,6 +102,23 @@ def test_registered():
     assert "ark4" in METHODS
 
 
+def test_jump_bound_extrapolates_the_force_jump_test():
+    """The step after an accepted one is bounded where the force-jump test (dp5's ``_controls``: |f1 - f0| above
+    ``fraction`` (max(|f0|, |f1|) + floor), rows with a floor only) is expected to reach JUMP_AIM of its limit,
+    extrapolated linearly; never below the onset step, and unbounded where the test did not run. By hand: the
+    row with floor 1 went 10 -> 14, q = 4 / (0.5 (14 + 1)) = 0.5333, so 10 us x 0.8 / 0.5333 = 15 us; the row
+    without a floor (5 -> 0) is not tested."""
+    from cageless.simulation.integrators.ark import JUMP_AIM, _jump_bound
+
+    floor, f0, f1 = np.array([0.0, 1.0]), np.array([5.0, 10.0]), np.array([0.0, 14.0])
+    assert JUMP_AIM == 0.8
+    assert _jump_bound(10e-6, 1e-6, f0, f1, floor, 0.5) == pytest.approx(15e-6, rel=1e-12)
+    assert _jump_bound(1.1e-6, 1e-6, f0, np.array([0.0, 24.7]), floor, 0.5) == 1e-6  # q = 1.14: 0.77 us -> 1 us
+    assert _jump_bound(1e-6, 1e-6, f0, f1, floor, 0.5) == np.inf  # an onset step: the test does not run
+    assert _jump_bound(10e-6, 1e-6, f0, f1, floor, 0.0) == np.inf  # the test off
+    assert _jump_bound(10e-6, 1e-6, f0, f0, floor, 0.5) == np.inf  # no change
+
+
 @pytest.fixture(scope="module")
 def settled():
     from cageless.simulation.bench import _settled_problem
