@@ -84,27 +84,39 @@ def contact_polar_figure(d: ConditionDescription) -> str:
 
     def draw(fig: Any) -> None:
         ax = fig.add_subplot(projection="polar")
+        label = "peak force (N) against orbital angle"
         if ev is not None and len(ev):
+            floor = _log_floor(ev.peak_force.to_numpy())
             for kind, colour in (("impact", "C1"), ("rubbing", "C2")):
                 sel = ev[ev.kind == kind]
-                ax.scatter(sel.angle, sel.peak_force, s=6, color=colour, label=f"{kind} ({len(sel)})")
+                force = sel.peak_force.to_numpy() if floor is None else np.maximum(sel.peak_force.to_numpy(), floor)
+                ax.scatter(sel.angle, force, s=6, color=colour, label=f"{kind} ({len(sel)})")
             ax.legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.25, -0.15))
-            _log_radius(ax, ev.peak_force.to_numpy())
+            if floor is not None:
+                ax.set_rscale("log")
+                ax.set_rlim(floor, 1.3 * float(np.nanmax(ev.peak_force)))
+                ax.set_rorigin(floor / 3.0)
+                label = f"peak force (N, log radius) against orbital angle\nforces under {floor:.2g} N on the inner circle"
         else:
             ax.set_title("no ball-ball contact after the start-up", fontsize=8)
-        ax.set_xlabel("peak force (N) against orbital angle")
+        ax.set_xlabel(label, fontsize=8)
     return _svg(draw, size=(3.6, 3.6))
 
 
-def _log_radius(ax: Any, force: np.ndarray) -> None:
-    """A logarithmic radius when the forces span over a decade, so that light rubbing does not pile up at the centre."""
+#: Decades of peak force the polar plot's logarithmic radius shows below the largest.
+POLAR_DECADES = 3.0
+
+
+def _log_floor(force: np.ndarray) -> float | None:
+    """The inner radius of a logarithmic polar plot of ``force``, or None for a linear one.
+
+    The radius is logarithmic when the positive forces span over a decade, so that light rubbing does not pile
+    up at the centre; it shows :data:`POLAR_DECADES` decades at most, and lighter contacts sit on its inner circle.
+    """
     positive = force[np.isfinite(force) & (force > 0)]
     if positive.size < 2 or positive.max() < 10.0 * positive.min():
-        return
-    low = positive.min() / 1.5
-    ax.set_rscale("log")
-    ax.set_rlim(low, 1.3 * positive.max())
-    ax.set_rorigin(low / 3.0)
+        return None
+    return float(max(positive.min(), positive.max() * 10.0 ** -POLAR_DECADES))
 
 
 def ring_figure(d: ConditionDescription) -> str:

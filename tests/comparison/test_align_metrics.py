@@ -142,19 +142,15 @@ def test_figures_restore_rcparams_and_close(tmp_path):
 
 def test_contact_polar_radius_is_logarithmic_when_forces_span_decades():
     """A new user found light rubbing piled up at the centre of the ball-ball polar plot: over a decade of peak
-    forces the radius is logarithmic, from just below the lightest contact; within a decade it stays linear."""
-    import matplotlib.pyplot as plt
+    forces the radius is logarithmic from the lightest contact, showing three decades at most (lighter contacts
+    on the inner circle); within a decade it stays linear."""
+    from comparison.report.figures import POLAR_DECADES, _log_floor
 
-    from comparison.report.figures import _log_radius
-
-    for force, scale in ((np.array([0.2, 3.0, 150.0, 0.0]), "log"), (np.array([20.0, 35.0, 150.0]), "linear")):
-        fig = plt.figure()
-        ax = fig.add_subplot(projection="polar")
-        _log_radius(ax, force)
-        assert ax.get_yscale() == scale  # the radius is the y axis of a polar plot
-        if scale == "log":
-            assert ax.get_rmin() == pytest.approx(0.2 / 1.5) and ax.get_rmax() == pytest.approx(1.3 * 150.0)
-        plt.close(fig)
+    assert POLAR_DECADES == 3.0
+    assert _log_floor(np.array([0.2, 3.0, 150.0, 0.0, np.nan])) == pytest.approx(0.2)
+    assert _log_floor(np.array([1e-7, 3.0, 150.0])) == pytest.approx(0.15)  # 150 N / 10^3
+    assert _log_floor(np.array([20.0, 35.0, 150.0])) is None
+    assert _log_floor(np.array([5.0])) is None
 
 
 def test_measured_slip_is_referred_to_the_models_contact_angle():
