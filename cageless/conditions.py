@@ -428,7 +428,8 @@ def _warn_disagreement(video: Path, sources: list[tuple[str, Mapping[str, float]
 
 
 def resolve_conditions(
-    video: str | Path, csv_table: Mapping[str, Mapping[str, float]] | None = None
+    video: str | Path, csv_table: Mapping[str, Mapping[str, float]] | None = None,
+    fallback_speed_rpm: float | None = None,
 ) -> ResolvedConditions:
     """Merge a video's conditions from sidecar, ``conditions.csv`` and file name.
 
@@ -439,6 +440,9 @@ def resolve_conditions(
     csv_table
         An already-read ``conditions.csv`` (see :func:`read_conditions_csv`). When
         ``None``, the folder's ``conditions.csv`` is read if present.
+    fallback_speed_rpm
+        A speed for a video whose sources give none (``track --speed-rpm``); the
+        other keys its sources give are kept.
 
     Raises
     ------
@@ -465,6 +469,8 @@ def resolve_conditions(
         for key, value in (values or {}).items():
             merged[key] = value
             origin[key] = label
+    if "speed_rpm" not in merged and fallback_speed_rpm is not None:
+        merged["speed_rpm"], origin["speed_rpm"] = float(fallback_speed_rpm), "--speed-rpm"
     if "speed_rpm" not in merged:
         raise MissingConditionsError(
             video, "no operating conditions found.",
@@ -581,8 +587,11 @@ def refuse_shared_names(entries: list[LabEntry]) -> list[LabEntry]:
     return out
 
 
-def discover_lab(folder: str | Path) -> list[LabEntry]:
+def discover_lab(folder: str | Path, fallback_speed_rpm: float | None = None) -> list[LabEntry]:
     """Find every video of a lab folder and resolve its conditions.
+
+    ``fallback_speed_rpm`` is the speed of a video whose sources give none (see
+    :func:`resolve_conditions`).
 
     A video whose conditions cannot be resolved gets an entry carrying the
     error; the others are unaffected. A bad row of ``conditions.csv`` fails only
@@ -618,7 +627,7 @@ def discover_lab(folder: str | Path) -> list[LabEntry]:
             entries.append(LabEntry(video=video, error=error))
             continue
         try:
-            entries.append(LabEntry(video=video, resolved=resolve_conditions(video, table)))
+            entries.append(LabEntry(video=video, resolved=resolve_conditions(video, table, fallback_speed_rpm)))
         except ConditionsError as exc:
             entries.append(LabEntry(video=video, error=exc))
     return refuse_shared_names(entries)

@@ -55,6 +55,7 @@ def speed_figure(d: ConditionDescription) -> str:
         _profile(ax, c.simulated.speed, 30 / np.pi, "simulated", "C3")
         ax.set(xlabel="orbital angle (deg)", ylabel="revolution speed (r/min)", xlim=(0, 360))
         ax.axvspan(0, 180, color="0.9", zorder=0, label="unloaded zone")
+        ax.fill_between([], [], [], color="0.3", alpha=0.2, lw=0, label="band: mean +- 1 std of samples")
         ax.legend(fontsize=7)
     return _svg(draw)
 
@@ -96,7 +97,9 @@ def contact_polar_figure(d: ConditionDescription) -> str:
                 ax.set_rscale("log")
                 ax.set_rlim(floor, 1.3 * float(np.nanmax(ev.peak_force)))
                 ax.set_rorigin(floor / 3.0)
-                label = f"peak force (N, log radius) against orbital angle\nforces under {floor:.2g} N on the inner circle"
+                clipped = bool(np.any(ev.peak_force.to_numpy() < floor))
+                label = "peak force (N, log radius) against orbital angle" + (
+                    f"\nforces under {floor:.2g} N on the inner circle" if clipped else "")
         else:
             ax.set_title("no ball-ball contact after the start-up", fontsize=8)
         ax.set_xlabel(label, fontsize=8)

@@ -363,3 +363,20 @@ def test_a_typed_speed_wins_for_a_named_video_and_is_said_to_lose_in_a_folder(tm
     (clip.with_suffix(".toml")).write_text("speed_rpm = = 1\n")  # a malformed sidecar stays an error
     (entry,) = collect_inputs([str(clip)], 3000.0)
     assert not entry.ok and isinstance(entry.error, ConditionsError)
+
+
+def test_a_typed_speed_keeps_the_other_conditions_a_sidecar_gives(tmp_path, capsys, cine40):
+    """A video whose sidecar gives its loads but no speed takes the typed speed and keeps the loads, named or in a
+    folder (a review found both dropped silently: the typed speed replaced the whole entry)."""
+    from cageless.app.cli.track import collect_inputs
+
+    clip = tmp_path / "clip.cine"
+    shutil.copy(cine40, clip)
+    clip.with_suffix(".toml").write_text("radial_load_n = 500\naxial_load_n = 20\n")
+    for given in ([str(clip)], [str(tmp_path)]):
+        (entry,) = collect_inputs(given, 3000.0)
+        c = entry.resolved.conditions
+        assert (c.speed_rpm, c.radial_load_n, c.axial_load_n) == (3000.0, 500.0, 20.0)
+        assert entry.resolved.origin["speed_rpm"] == "--speed-rpm"
+        assert entry.resolved.origin["radial_load_n"] == "sidecar clip.toml"
+    assert capsys.readouterr().err == ""  # nothing overridden, nothing to say

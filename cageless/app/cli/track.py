@@ -90,7 +90,7 @@ def collect_inputs(inputs: list[str], speed_rpm: float | None) -> list[LabEntry]
             entries.append(LabEntry(video=p, error=CagelessError(
                 f"{p}: is the QC folder of a cageless output (its images are QC figures, not a video's frames).")))
         elif p.is_dir() and not any(f.suffix.lower() in IMAGE_SUFFIXES for f in p.iterdir()):
-            found = discover_lab(p)
+            found = discover_lab(p, speed_rpm)
             if not found:
                 traces = " It holds cageless traces: point at the folder of videos instead." if any(
                     p.glob("*.trace.h5")) else ""
@@ -98,45 +98,37 @@ def collect_inputs(inputs: list[str], speed_rpm: float | None) -> list[LabEntry]
             entries.extend(_with_speed(e, speed_rpm, named=False) for e in found)
         else:
             try:
-                entries.append(_with_speed(LabEntry(video=p, resolved=resolve_conditions(p)), speed_rpm, named=True))
+                entries.append(_with_speed(LabEntry(video=p, resolved=resolve_conditions(p, None, speed_rpm)), speed_rpm,
+                                           named=True))
             except CagelessError as exc:
                 entries.append(_with_speed(LabEntry(video=p, error=exc), speed_rpm, named=True))
     return refuse_shared_names(entries)
 
 
 def _with_speed(entry: LabEntry, speed_rpm: float | None, named: bool) -> LabEntry:
-    """Apply ``--speed-rpm`` to one video.
+    """Apply ``--speed-rpm`` to one video whose conditions were resolved with it as the fallback speed.
 
     For a video named on the command line (``named``) the typed speed wins over every other source, and the run
-    says which value it replaces. For a video found in a folder it stands in only where no source gives the
-    conditions, and the run says where a source overrules it: one typed speed is rarely right for a whole folder.
-    A malformed source stays an error either way.
+    says which value it replaces. For a video found in a folder it stands in only where no source gives a speed
+    (the other keys its sources give are kept), and the run says where a source overrules it: one typed speed is
+    rarely right for a whole folder. A malformed source stays an error either way.
     """
-    if speed_rpm is None:
+    if speed_rpm is None or not entry.ok:
+        return entry  # an error: a malformed source, or no such file (a missing speed was filled in when resolving)
+    given = entry.resolved.conditions.speed_rpm
+    if given == speed_rpm:
         return entry
-    from cageless.conditions import ResolvedConditions
-
-    if entry.ok:
-        given = entry.resolved.conditions.speed_rpm
-        if given == speed_rpm:
-            return entry
-        source = entry.resolved.origin.get("speed_rpm", "its conditions")
-        if not named:
-            print(f"warning: {entry.video}: --speed-rpm {speed_rpm:g} is not used: its {source} gives {given:g} r/min "
-                  "(in a folder the videos' own conditions win; name the video on the command line to override them)",
-                  file=sys.stderr)
-            return entry
-        print(f"warning: {entry.video}: --speed-rpm {speed_rpm:g} overrides {given:g} r/min from its {source}",
+    source = entry.resolved.origin.get("speed_rpm", "its conditions")
+    if not named:
+        print(f"warning: {entry.video}: --speed-rpm {speed_rpm:g} is not used: its {source} gives {given:g} r/min "
+              "(in a folder the videos' own conditions win; name the video on the command line to override them)",
               file=sys.stderr)
-        conditions = replace(entry.resolved.conditions, speed_rpm=speed_rpm)
-        origin = {**entry.resolved.origin, "speed_rpm": "--speed-rpm"}
-        return replace(entry, resolved=replace(entry.resolved, conditions=conditions,
-                                                                       origin=origin))
-    if not isinstance(entry.error, MissingConditionsError):
-        return entry  # a malformed source, or no such file: the typed speed does not make it right
-    resolved = ResolvedConditions(video=entry.video, conditions=OperatingConditions(speed_rpm),
-                                  origin={"speed_rpm": "--speed-rpm"})
-    return LabEntry(video=entry.video, resolved=resolved)
+        return entry
+    print(f"warning: {entry.video}: --speed-rpm {speed_rpm:g} overrides {given:g} r/min from its {source}",
+          file=sys.stderr)
+    conditions = replace(entry.resolved.conditions, speed_rpm=speed_rpm)
+    origin = {**entry.resolved.origin, "speed_rpm": "--speed-rpm"}
+    return replace(entry, resolved=replace(entry.resolved, conditions=conditions, origin=origin))
 
 
 def _track_one(job: tuple[Path, OperatingConditions, Bearing, Any, Path]) -> tuple[str, dict[str, Any] | str]:
