@@ -9,6 +9,8 @@ precedence first:
    and optionally ``radial_load_n, axial_load_n, fps, px_per_mm, camera_roll_deg``;
 3. the file name, e.g. ``n3000_Fr500_Fa0.cine``.
 
+Each source is read by :mod:`cageless.condition_sources`; this module merges them.
+
 Only ``speed_rpm`` is required; the loads default to 0 and the camera keys to
 what the video file says (``None`` here). A malformed source is an error, never
 silently skipped, and every error names the file it is about.
@@ -23,20 +25,24 @@ operating conditions (:attr:`ResolvedConditions.bearing_keys`) and applied with
 from __future__ import annotations
 
 import dataclasses
-import json
 import logging
 import math
 import os
 import re
-import tomllib
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-import pandas as pd
-
 from cageless.bearing import Bearing, Geometry
+from cageless.condition_sources import (
+    BEARING_KEYS,
+    CONDITION_KEYS,
+    csv_listed_names,
+    parse_file_name,
+    read_conditions_csv,
+    read_sidecar,
+)
 from cageless.errors import CagelessError, ConditionsError, MissingConditionsError, ParameterError, suggest
 from cageless.units import rpm_to_rad_s
 
@@ -61,10 +67,6 @@ __all__ = [
 
 log = logging.getLogger(__name__)
 
-CONDITION_KEYS = ("speed_rpm", "radial_load_n", "axial_load_n", "fps", "px_per_mm", "camera_roll_deg")
-#: Optional keys describing the bearing a video shows (a sidecar or a conditions.csv column).
-BEARING_KEYS = ("n_balls", "ball_diameter_mm", "pitch_diameter_mm")
-_SOURCE_KEYS = CONDITION_KEYS + BEARING_KEYS
 VIDEO_SUFFIXES = (".cine", ".avi", ".mp4", ".mkv")
 IMAGE_SUFFIXES = (".tif", ".tiff", ".png")
 CONDITIONS_CSV = "conditions.csv"
@@ -171,200 +173,6 @@ class LabEntry:
         return self.error is None
 
 
-def _check_number(path: Path, key: str, value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise ConditionsError(path, f"'{key}' must be a number, got {value!r}.")
-    return float(value)
-
-
-def read_sidecar(path: str | Path) -> dict[str, float]:
-    """Read a ``.toml`` or ``.json`` sidecar of condition keys.
-
-    Raises
-    ------
-    ConditionsError
-        On a syntax error, a non-table document, an unknown key or a non-numeric value.
-    """
-    path = Path(path)
-    text = path.read_text(encoding="utf-8")
-    try:
-        data = tomllib.loads(text) if path.suffix == ".toml" else json.loads(text)
-    except (tomllib.TOMLDecodeError, json.JSONDecodeError) as exc:
-        raise ConditionsError(path, f"cannot parse the sidecar: {exc}.", "Fix its syntax.") from exc
-    if not isinstance(data, dict):
-        raise ConditionsError(path, "the sidecar must hold a table of condition keys.")
-    out: dict[str, float] = {}
-    for key, value in data.items():
-        if key not in _SOURCE_KEYS:
-            hint = suggest(key, _SOURCE_KEYS).strip() or f"Valid keys: {', '.join(_SOURCE_KEYS)}."
-            raise ConditionsError(path, f"unknown key '{key}'.", hint)
-        out[key] = _check_number(path, key, value)
-    return out
-
-
-def read_conditions_csv(
-    path: str | Path, row_errors: dict[str, ConditionsError] | None = None
-) -> dict[str, dict[str, float]]:
-    """Read a folder's ``conditions.csv`` into ``{file name: {key: value}}``.
-
-    Empty cells are left out (they take the default). Rows are matched to videos
-    by file name or by stem.
-
-    Parameters
-    ----------
-    path
-        The CSV file.
-    row_errors
-        When given, a problem confined to one row (a non-numeric cell, a file
-        listed twice) does not fail the whole table: the row is left out and
-        its error is stored here under the row's file name, so that only that
-        video fails. A row with an empty ``file`` cell is then skipped with a
-        warning.
-
-    Raises
-    ------
-    ConditionsError
-        On a missing ``file`` or ``speed_rpm`` column, an unknown column, or
-        (without ``row_errors``) a non-numeric cell or a duplicated file.
-    """
-    path = Path(path)
-    sep, decimal = _csv_dialect(path)
-    try:
-        table = pd.read_csv(path, dtype={"file": str}, skipinitialspace=True, sep=sep, decimal=decimal)
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
-        raise ConditionsError(path, f"cannot parse the CSV: {exc}.") from exc
-    table = _checked_columns(path, table)
-    rows: dict[str, dict[str, float]] = {}
-    seen: set[str] = set()
-    for i, row in table.iterrows():
-        line = int(i) + 2  # 1-based, after the header
-        name = str(row["file"]).strip()
-        try:
-            if not name or name == "nan":
-                raise ConditionsError(path, f"line {line}: empty 'file' cell.", "Name the video in the 'file' column.")
-            if name in seen:
-                rows.pop(name, None)  # neither row can be trusted
-                raise ConditionsError(path, f"line {line}: '{name}' is listed twice.", "Keep one row per video.")
-            seen.add(name)
-            rows[name] = _csv_values(path, line, row, table.columns)
-        except ConditionsError as exc:
-            if row_errors is None:
-                raise
-            if not name or name == "nan":
-                log.warning("%s", exc)
-            else:
-                row_errors[name] = exc
-    return rows
-
-
-def _checked_columns(path: Path, table: pd.DataFrame) -> pd.DataFrame:
-    """The table with stripped column names, its required columns checked and unknown ones dropped."""
-    table.columns = [str(c).strip() for c in table.columns]
-    for required in ("file", "speed_rpm"):
-        if required not in table.columns:
-            found = ", ".join(repr(c) for c in table.columns[:8])
-            raise ConditionsError(
-                path, f"missing column '{required}' (the header has {found}).",
-                f"Columns are: file, {', '.join(CONDITION_KEYS)} (only file and speed_rpm are required), "
-                "separated by commas.",
-            )
-    for col in list(table.columns):
-        if col != "file" and col not in _SOURCE_KEYS:
-            hint = suggest(col, _SOURCE_KEYS)
-            if hint:  # a misspelled key would silently lose its value
-                raise ConditionsError(path, f"unknown column '{col}'." + hint)
-            log.warning("%s: ignoring column '%s'; the columns read are file, %s", path, col, ", ".join(_SOURCE_KEYS))
-            table = table.drop(columns=col)
-    return table
-
-
-def _csv_values(path: Path, line: int, row: pd.Series, columns: pd.Index) -> dict[str, float]:
-    """The numeric condition values of one CSV row, empty cells left out."""
-    values: dict[str, float] = {}
-    for key in _SOURCE_KEYS:
-        if key not in columns or pd.isna(row[key]):
-            continue
-        try:
-            values[key] = float(row[key])
-        except (TypeError, ValueError):
-            raise ConditionsError(
-                path, f"line {line}: '{key}' = {row[key]!r} is not a number.", "Write a plain number in that cell."
-            ) from None
-    return values
-
-
-def _csv_dialect(path: Path) -> tuple[str, str]:
-    """The field separator and decimal mark of a conditions CSV: ``","``/``"."``, or the European ``";"``/``","``.
-
-    A header with semicolons and no commas is read as semicolon-separated (with decimal commas when
-    the rows hold digits separated by a comma), and logged.
-    """
-    try:
-        with open(path, encoding="utf-8", errors="replace") as fh:
-            lines = [fh.readline() for _ in range(20)]
-    except OSError:
-        return ",", "."
-    header = lines[0]
-    if ";" in header and "," not in header:
-        decimal = "," if any(re.search(r"\d,\d", line) for line in lines[1:]) else "."
-        log.info("%s: read as semicolon-separated%s", path, " with decimal commas" if decimal == "," else "")
-        return ";", decimal
-    if "\t" in header and "," not in header:
-        return "\t", "."
-    return ",", "."
-
-
-_NUMBER = r"(\d+(?:\.\d+)?)"
-_TOKEN_PATTERNS = {
-    "speed_rpm": re.compile(rf"^n{_NUMBER}(?:rpm)?$", re.IGNORECASE),
-    "radial_load_n": re.compile(rf"^fr{_NUMBER}n?$", re.IGNORECASE),
-    "axial_load_n": re.compile(rf"^fa{_NUMBER}n?$", re.IGNORECASE),
-}
-_SUSPECT = re.compile(r"^(?:n\d|f[ra](?![a-z]))", re.IGNORECASE)
-
-
-def parse_file_name(path: str | Path) -> dict[str, float] | None:
-    """Read conditions from a file name such as ``n3000_Fr500_Fa0.cine``.
-
-    Tokens are separated by ``_``, ``-`` or spaces: ``n<rpm>``, ``Fr<N>``,
-    ``Fa<N>`` (case-insensitive, optional ``rpm``/``N`` suffix). Other tokens
-    are ignored.
-
-    Returns
-    -------
-    dict or None
-        The keys found, or ``None`` when the name carries no conditions.
-
-    Raises
-    ------
-    ConditionsError
-        When a token looks like a condition but cannot be read, a key repeats,
-        or loads are given without a speed.
-    """
-    path = Path(path)
-    stem = path.name if path.is_dir() else path.stem
-    found: dict[str, float] = {}
-    for token in re.split(r"[_\-\s]+", stem):
-        matched = False
-        for key, pattern in _TOKEN_PATTERNS.items():
-            m = pattern.match(token)
-            if m:
-                if key in found:
-                    raise ConditionsError(path, f"the file name gives '{key}' twice.")
-                found[key] = float(m.group(1))
-                matched = True
-        if not matched and _SUSPECT.match(token):
-            raise ConditionsError(
-                path, f"cannot read the file-name token '{token}'.",
-                "Use the pattern n3000_Fr500_Fa0 (speed in rpm, loads in N), or give a sidecar.",
-            )
-    if not found:
-        return None
-    if "speed_rpm" not in found:
-        raise ConditionsError(path, "the file name gives loads but no speed (e.g. n3000).")
-    return found
-
-
 def _sidecar_for(video: Path) -> Path | None:
     stem = video.name if video.is_dir() else video.stem
     candidates = [video.with_name(stem + ext) for ext in (".toml", ".json")]
@@ -385,22 +193,12 @@ def _csv_row_error(video: Path, row_errors: Mapping[str, ConditionsError]) -> Co
     return row_errors.get(video.name, row_errors.get(stem))
 
 
-def _csv_lists(path: Path, video: Path) -> bool:
-    """Whether a ``conditions.csv`` that failed to read could name ``video``.
-
-    True when its ``file`` column names the video, or when not even that column can be read: then any
-    video may depend on it. A video the table does not name takes its conditions from its other sources.
+def _csv_lists(listed: set[str] | None, video: Path) -> bool:
+    """Whether a ``conditions.csv`` that failed to read could name ``video``, from the names it lists
+    (:func:`~cageless.condition_sources.csv_listed_names`; None: not even its ``file`` column was read, and any
+    video may depend on it). A video the table does not name takes its conditions from its other sources.
     """
-    try:
-        sep, _ = _csv_dialect(path)
-        names = pd.read_csv(path, dtype=str, skipinitialspace=True, sep=sep, keep_default_na=False)
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError, OSError):
-        return True
-    names.columns = [str(c).strip() for c in names.columns]
-    if "file" not in names.columns:
-        return True
-    listed = {str(n).strip() for n in names["file"]}
-    return bool({video.name, video.stem} & listed)
+    return listed is None or bool({video.name, video.stem} & listed)
 
 
 def _read_csv_for(video: Path, csv_path: Path, row_errors: dict[str, ConditionsError]) -> dict[str, dict[str, float]]:
@@ -408,7 +206,7 @@ def _read_csv_for(video: Path, csv_path: Path, row_errors: dict[str, ConditionsE
     try:
         return read_conditions_csv(csv_path, row_errors)
     except ConditionsError as exc:
-        if _csv_lists(csv_path, video):
+        if _csv_lists(csv_listed_names(csv_path), video):
             raise
         log.warning("%s; %s is not listed there and takes its conditions from its other sources", exc, video.name)
         return {}
@@ -616,7 +414,8 @@ def discover_lab(folder: str | Path, fallback_speed_rpm: float | None = None) ->
     entries = [LabEntry(video=p, error=ConditionsError(
         p, f"is a broken symbolic link (to {os.readlink(p)}): the file it points to is missing.",
         "Fix or remove the link.")) for p in _dangling_links(folder)]
-    unlisted = [v for v in videos if csv_error is not None and not _csv_lists(csv_path, v)]
+    listed = csv_listed_names(csv_path) if csv_error is not None else None
+    unlisted = [v for v in videos if csv_error is not None and not _csv_lists(listed, v)]
     if unlisted:
         log.warning("%s; %s it does not list take%s %s conditions from %s other sources", csv_error,
                     *(("the video", "s", "its", "its") if len(unlisted) == 1 else

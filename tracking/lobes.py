@@ -13,7 +13,8 @@ Gauss-Newton; its shift from the common centre is tested against its standard er
 than :data:`MIN_SHIFT_SIGMAS` highlight widths (two lobes closer than that merge into one spot) and by more
 than :data:`MIN_T` standard errors, while more than half of the balls are not, is re-measured in every frame
 with the centroid window started at its position moved back by the shift. The move is kept only if the
-re-measured track then lies on the common circle; otherwise the table is returned unchanged.
+re-measured track then lies on the common circle; otherwise the table is returned unchanged. Frames where the
+re-measure finds nothing keep the ball's other-lobe position moved by its measured lobe offset.
 """
 
 from __future__ import annotations
@@ -112,6 +113,27 @@ def _off_lobe(shifts: list[LobeShift | None], sigma_px: float) -> list[int]:
     return off if fitted - len(off) > fitted / 2 else []
 
 
+def _fill_from_other_lobe(u: np.ndarray, v: np.ndarray, mass: np.ndarray, det: np.ndarray, nu: np.ndarray,
+                          nv: np.ndarray, nm: np.ndarray, nd: np.ndarray, kept: list[int]) -> None:
+    """Fill, in place, the samples of the moved balls that re-measuring missed: the other lobe's position moved by
+    the ball's lobe offset, the median of (other lobe - re-measured) over the frames that have both.
+
+    A lobe's offset from the ball's centre is fixed in the image (distant lights), so the offset measured where
+    both lobes were found carries the track across frames where only the other lobe was (the first lobe hidden
+    or too faint there); without it those samples were lost (40 % of one ball's with the first lobe missing in
+    2 frames of 5, ``tests/tracking/test_lobes.py``). Samples the linker had not detected stay missed (NaN).
+    """
+    for j in kept:
+        both = nd[:, j] & det[:, j]
+        miss = ~nd[:, j]
+        du = float(np.median(u[both, j] - nu[both, j]))
+        dv = float(np.median(v[both, j] - nv[both, j]))
+        nu[miss, j] = np.where(det[miss, j], u[miss, j] - du, np.nan)
+        nv[miss, j] = np.where(det[miss, j], v[miss, j] - dv, np.nan)
+        nm[miss, j] = np.where(det[miss, j], mass[miss, j], 0.0)
+        nd[miss, j] = det[miss, j]
+
+
 def relock_lobes(table: pd.DataFrame, frames: Callable[[int], np.ndarray], background: np.ndarray,
                  mask: np.ndarray, half: float, threshold: float, iterations: int, sigma_px: float,
                  static: tuple[np.ndarray, float, np.ndarray] | None = None) -> tuple[pd.DataFrame, list[int]]:
@@ -155,12 +177,12 @@ def relock_lobes(table: pd.DataFrame, frames: Callable[[int], np.ndarray], backg
     if not kept:
         log.info("balls %s look shifted onto another lobe, but re-measuring did not bring them back", off)
         return table, []
+    _fill_from_other_lobe(u, v, mass, det, nu, nv, nm, nd, kept)
     out = table.sort_values(["frame", "ball"], kind="stable").reset_index(drop=True)
     z = u.shape[1]
-    lost = ~nd[:, kept]  # samples not re-measured: missed, as the linker leaves a miss
     for name, grid in (("u_px", nu), ("v_px", nv), ("mass", nm), ("detected", nd)):
         col = out[name].to_numpy().reshape(-1, z).copy()
-        col[:, kept] = np.where(lost, np.nan, grid[:, kept]) if name in ("u_px", "v_px") else grid[:, kept]
+        col[:, kept] = grid[:, kept]
         out[name] = col.ravel()
     log.info("balls %s were tracked on another light's highlight; moved by %s px", kept,
              [round(shifts[j].size, 2) for j in kept])  # type: ignore[union-attr]

@@ -88,3 +88,36 @@ def test_no_majority_no_move():
     vt[:, ::2] += LOBE[1]
     out, moved = _relock(ut, vt, u, v)
     assert moved == []
+
+
+def test_frames_without_the_common_lobe_keep_the_ball_by_its_lobe_offset():
+    """Ball 3's first-lobe highlight missing in 2 frames of 5 (hidden, or too faint under that light): the
+    re-measure finds it in the other 24 of 40 frames, and the missed 16 are carried by the other lobe's
+    position moved by the offset measured where both were found. Before, those 16 samples were dropped (NaN,
+    40 % of the ball's track); now every sample is within the 0.12 px that the second lobe's tail pulls a
+    centroid on the first (the first test's reference), not at the other lobe's 6.3 px."""
+    u, v = _positions()
+    ut, vt = u.copy(), v.copy()
+    ut[:, 3] += LOBE[0]
+    vt[:, 3] += LOBE[1]
+    gone = np.arange(T) % 5 < 2
+    yy, xx = np.mgrid[0:SIZE, 0:SIZE]
+
+    def frame(i: int) -> np.ndarray:
+        img = np.zeros((SIZE, SIZE))
+        for du, dv, peak in ((0.0, 0.0, 1000.0), (LOBE[0], LOBE[1], 700.0)):
+            for j in range(Z):
+                if not (j == 3 and du == 0.0 and gone[i]):
+                    img += peak * np.exp(-0.5 * ((xx - u[i, j] - du) ** 2 + (yy - v[i, j] - dv) ** 2) / SIGMA**2)
+        return np.rint(img + 50).astype(np.uint16)
+
+    out, moved = relock_lobes(_table(ut, vt), frame, np.full((SIZE, SIZE), 50.0, np.float32),
+                              np.ones((SIZE, SIZE), bool), 3.5 * SIGMA, 5.0, 4, SIGMA)
+    assert moved == [3]
+    o = out.sort_values(["frame", "ball"])
+    got_u = o.u_px.to_numpy().reshape(T, Z)[:, 3]
+    got_v = o.v_px.to_numpy().reshape(T, Z)[:, 3]
+    assert o.detected.to_numpy().reshape(T, Z)[:, 3].all()
+    err = np.hypot(got_u - u[:, 3], got_v - v[:, 3])
+    assert np.all(np.isfinite(err)) and err.max() < 0.15
+    assert abs(np.median(err[gone]) - np.median(err[~gone])) < 0.01  # one estimator across both kinds of frame
