@@ -148,7 +148,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         setup_logging(args.quiet, args.verbose)
         _check_scheduler(args)
         module = importlib.import_module(f"cageless.app.cli.{args.command}")
-        return int(module.run(args, config))
+        from tqdm.contrib.logging import logging_redirect_tqdm
+
+        with logging_redirect_tqdm():  # a warning printed under a progress bar, not through it
+            return int(module.run(args, config))
     except SystemExit as exc:  # --help and --version exit through argparse
         return int(exc.code or 0) if isinstance(exc.code, int | None) else EXIT_USAGE
     except (UsageError, ParameterError) as exc:
