@@ -6,6 +6,7 @@ how to fix it; merging the sources is :mod:`cageless.conditions`' work.
 
 from __future__ import annotations
 
+import difflib
 import json
 import logging
 import re
@@ -93,7 +94,8 @@ def read_conditions_csv(
     path = Path(path)
     sep, decimal = _csv_dialect(path)
     try:
-        table = pd.read_csv(path, dtype={"file": str}, skipinitialspace=True, sep=sep, decimal=decimal)
+        table = pd.read_csv(path, dtype={"file": str}, skipinitialspace=True, sep=sep, decimal=decimal,
+                            thousands="." if decimal == "," else None)
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         raise ConditionsError(path, f"cannot parse the CSV: {exc}.") from exc
     table = _checked_columns(path, table)
@@ -126,10 +128,12 @@ def _checked_columns(path: Path, table: pd.DataFrame) -> pd.DataFrame:
     for required in ("file", "speed_rpm"):
         if required not in table.columns:
             found = ", ".join(repr(c) for c in table.columns[:8])
+            misspelled = difflib.get_close_matches(required, [str(c) for c in table.columns], n=1, cutoff=0.6)
             raise ConditionsError(
                 path, f"missing column '{required}' (the header has {found}).",
-                f"Columns are: file, {', '.join(CONDITION_KEYS)} (only file and speed_rpm are required), "
-                "separated by commas.",
+                (f"Is '{misspelled[0]}' meant to be '{required}'? " if misspelled else "")
+                + f"Columns are: file, {', '.join(_SOURCE_KEYS)} (only file and speed_rpm are required), "
+                "separated by commas (or by semicolons, with decimal commas).",
             )
     for col in list(table.columns):
         if col != "file" and col not in _SOURCE_KEYS:

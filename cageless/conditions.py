@@ -208,7 +208,7 @@ def _read_csv_for(video: Path, csv_path: Path, row_errors: dict[str, ConditionsE
     except ConditionsError as exc:
         if _csv_lists(csv_listed_names(csv_path), video):
             raise
-        log.warning("%s; %s is not listed there and takes its conditions from its other sources", exc, video.name)
+        log.warning("%s %s is not listed there and takes its conditions from its other sources", exc, video.name)
         return {}
 
 
@@ -227,7 +227,7 @@ def _warn_disagreement(video: Path, sources: list[tuple[str, Mapping[str, float]
 
 def resolve_conditions(
     video: str | Path, csv_table: Mapping[str, Mapping[str, float]] | None = None,
-    fallback_speed_rpm: float | None = None,
+    fallback_speed_rpm: float | None = None, fallback: Mapping[str, float] | None = None,
 ) -> ResolvedConditions:
     """Merge a video's conditions from sidecar, ``conditions.csv`` and file name.
 
@@ -241,6 +241,12 @@ def resolve_conditions(
     fallback_speed_rpm
         A speed for a video whose sources give none (``track --speed-rpm``); the
         other keys its sources give are kept.
+    fallback
+        The same for any of ``speed_rpm``, ``radial_load_n`` and ``axial_load_n``
+        (``track --radial-load-n``): each stands in where no source gives that key.
+
+    A video whose sources give no radial load is resolved at 0 N (an unloaded
+    bearing) with a warning naming where to give it.
 
     Raises
     ------
@@ -267,14 +273,19 @@ def resolve_conditions(
         for key, value in (values or {}).items():
             merged[key] = value
             origin[key] = label
-    if "speed_rpm" not in merged and fallback_speed_rpm is not None:
-        merged["speed_rpm"], origin["speed_rpm"] = float(fallback_speed_rpm), "--speed-rpm"
+    typed = {**({"speed_rpm": fallback_speed_rpm} if fallback_speed_rpm is not None else {}), **(fallback or {})}
+    for key, value in typed.items():
+        if key not in merged and value is not None:
+            merged[key], origin[key] = float(value), "--" + key.replace("_", "-")
     if "speed_rpm" not in merged:
         raise MissingConditionsError(
             video, "no operating conditions found.",
             f"Give them in a sidecar ({video.stem}.toml with speed_rpm = ...), a row of "
             f"{CONDITIONS_CSV}, or the file name (e.g. n3000_Fr500_Fa0{video.suffix}).",
         )
+    if "radial_load_n" not in merged:
+        log.warning("%s: no radial load given: 0 N (an unloaded bearing) is assumed. Give radial_load_n in a sidecar "
+                    "(%s.toml), a row of %s or the file name (e.g. _Fr500)", video.name, video.stem, CONDITIONS_CSV)
     bearing_keys = {k: merged.pop(k) for k in BEARING_KEYS if k in merged}
     for key, value in bearing_keys.items():
         if not (math.isfinite(value) and value > 0) or (key == "n_balls" and (value != int(value) or value < 3)):
@@ -385,11 +396,12 @@ def refuse_shared_names(entries: list[LabEntry]) -> list[LabEntry]:
     return out
 
 
-def discover_lab(folder: str | Path, fallback_speed_rpm: float | None = None) -> list[LabEntry]:
+def discover_lab(folder: str | Path, fallback_speed_rpm: float | None = None,
+                 fallback: Mapping[str, float] | None = None) -> list[LabEntry]:
     """Find every video of a lab folder and resolve its conditions.
 
-    ``fallback_speed_rpm`` is the speed of a video whose sources give none (see
-    :func:`resolve_conditions`).
+    ``fallback_speed_rpm`` is the speed of a video whose sources give none, and ``fallback`` the same for the
+    loads too (see :func:`resolve_conditions`).
 
     A video whose conditions cannot be resolved gets an entry carrying the
     error; the others are unaffected. A bad row of ``conditions.csv`` fails only
@@ -417,7 +429,7 @@ def discover_lab(folder: str | Path, fallback_speed_rpm: float | None = None) ->
     listed = csv_listed_names(csv_path) if csv_error is not None else None
     unlisted = [v for v in videos if csv_error is not None and not _csv_lists(listed, v)]
     if unlisted:
-        log.warning("%s; %s it does not list take%s %s conditions from %s other sources", csv_error,
+        log.warning("%s %s it does not list take%s %s conditions from %s other sources", csv_error,
                     *(("the video", "s", "its", "its") if len(unlisted) == 1 else
                       (f"the {len(unlisted)} videos", "", "their", "their")))
     for video in videos:
@@ -426,7 +438,8 @@ def discover_lab(folder: str | Path, fallback_speed_rpm: float | None = None) ->
             entries.append(LabEntry(video=video, error=error))
             continue
         try:
-            entries.append(LabEntry(video=video, resolved=resolve_conditions(video, table, fallback_speed_rpm)))
+            resolved = resolve_conditions(video, table, fallback_speed_rpm, fallback)
+            entries.append(LabEntry(video=video, resolved=resolved))
         except ConditionsError as exc:
             entries.append(LabEntry(video=video, error=exc))
     return refuse_shared_names(entries)

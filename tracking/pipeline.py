@@ -25,6 +25,7 @@ import numpy as np
 import pandas as pd
 from tqdm.auto import tqdm
 
+from cageless.atomic import atomic_path
 from cageless.bearing import Bearing
 from cageless.conditions import OperatingConditions
 from cageless.errors import ParameterError, TrackingError
@@ -431,15 +432,15 @@ def track_video(
     written = None
     if out_dir is not None:
         out_dir = Path(out_dir)
-        written = write_trace(target, trace)
-        try:
+        # No trace without its QC, and a failed write loses no earlier trace: the new trace replaces the old
+        # one only once its QC is written (a re-run redoes both).
+        with atomic_path(target) as pending:
+            write_trace(pending, trace)
             write_qc(out_dir / "qc", _stem(path), path, qc, table, trace, options.qc_frames, fps,
                      allow_truncated=options.allow_truncated)
             write_selection_qc(out_dir / "qc", _stem(path), first_frame, selection_table, sel.ring,
                                (cols.start, rows.start), f"{qc.n_balls_found} balls selected")
-        except BaseException:  # no trace without its QC: a re-run redoes both
-            written.unlink(missing_ok=True)
-            raise
+        written = target
     return TrackResult(trace=trace, table=table, qc=qc, path=written)
 
 

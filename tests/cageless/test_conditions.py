@@ -249,3 +249,17 @@ def test_sidecar_can_describe_the_bearing(tmp_path):
     (tmp_path / "n3000.toml").write_text("speed_rpm = 3000\nn_balls = 12.5\n")
     with pytest.raises(ConditionsError, match=r"n3000.cine.*n_balls = 12.5 must be a whole number"):
         resolve_conditions(tmp_path / "n3000.cine")
+
+
+def test_a_european_csv_reads_thousands_separators_and_a_misspelled_header_is_named(tmp_path):
+    """Semicolons with decimal commas: `3.000` is 3000 r/min, not 3 (a new user's spreadsheet export read as 3
+    r/min, inside the plausible range, and failed only later in the ball selection). A misspelled required column
+    is named with the column it probably is."""
+    from cageless.errors import ConditionsError
+
+    path = tmp_path / "conditions.csv"
+    path.write_text("file;speed_rpm;radial_load_n\nclip.cine;3.000;500,5\n", encoding="utf-8")
+    assert read_conditions_csv(path) == {"clip.cine": {"speed_rpm": 3000.0, "radial_load_n": 500.5}}
+    path.write_text("file,speed_rmp\nclip.cine,3000\n", encoding="utf-8")
+    with pytest.raises(ConditionsError, match="Is 'speed_rmp' meant to be 'speed_rpm'"):
+        read_conditions_csv(path)

@@ -52,7 +52,7 @@ def test_tutorial_runs_as_written(tmp_path):
                              capture_output=True, text=True, timeout=900)
         assert run.returncode == 0, f"cageless {' '.join(argv)}: {run.stdout}{run.stderr}"
         assert "Traceback" not in run.stderr
-    assert (tmp_path / "report" / "report.html").is_file()
+    assert (tmp_path / "quick" / "report.html").is_file()
     text = (DOCS / "tutorial.md").read_text(encoding="utf-8")
     for block in _blocks(text, "python"):
         subprocess.run([sys.executable, "-c", block], cwd=tmp_path, check=True, timeout=120)

@@ -380,3 +380,45 @@ def test_a_typed_speed_keeps_the_other_conditions_a_sidecar_gives(tmp_path, caps
         assert entry.resolved.origin["speed_rpm"] == "--speed-rpm"
         assert entry.resolved.origin["radial_load_n"] == "sidecar clip.toml"
     assert capsys.readouterr().err == ""  # nothing overridden, nothing to say
+
+def test_typed_loads_fill_in_or_override_like_the_typed_speed(tmp_path, capsys, caplog, cine40):
+    """`--radial-load-n` / `--axial-load-n` behave as `--speed-rpm`: a video with only a speed gets the typed
+    load (a new user's `track clip --speed-rpm 3000` recorded 0 N, and `compare` against the 500 N simulation of
+    the README's quick start refused the pair); a named video's own load is overridden with a warning; in a
+    folder the video's own load wins. A video with no radial load anywhere is resolved at 0 N with a warning."""
+    from cageless.app.cli.track import collect_inputs
+
+    clip = tmp_path / "n3000.cine"
+    shutil.copy(cine40, clip)
+    with caplog.at_level("WARNING"):
+        (entry,) = collect_inputs([str(clip)], None)
+    assert entry.resolved.conditions.radial_load_n == 0.0
+    assert "no radial load given: 0 N (an unloaded bearing) is assumed" in caplog.text
+    caplog.clear()
+    with caplog.at_level("WARNING"):
+        (entry,) = collect_inputs([str(clip)], None, {"radial_load_n": 500.0, "axial_load_n": None})
+    c = entry.resolved.conditions
+    assert (c.speed_rpm, c.radial_load_n, c.axial_load_n) == (3000.0, 500.0, 0.0)
+    assert entry.resolved.origin["radial_load_n"] == "--radial-load-n"
+    assert "no radial load" not in caplog.text and capsys.readouterr().err == ""
+    named = tmp_path / "n3000_Fr1000.cine"
+    clip.rename(named)
+    (entry,) = collect_inputs([str(named)], None, {"radial_load_n": 500.0})
+    assert entry.resolved.conditions.radial_load_n == 500.0
+    assert "--radial-load-n 500 overrides 1000 N from its file name" in capsys.readouterr().err
+    (entry,) = collect_inputs([str(tmp_path)], None, {"radial_load_n": 500.0})
+    assert entry.resolved.conditions.radial_load_n == 1000.0
+    assert "--radial-load-n 500 is not used: its file name gives 1000 N" in capsys.readouterr().err
+
+
+def test_a_cine_with_no_complete_frame_does_not_suggest_allow_truncated(tmp_path, capsys, cine40):
+    """Cut before its first frame's pixels, `--allow-truncated` cannot help, and the error says so instead of
+    suggesting the flag it was given (a new user's trial); cut inside the headers, it says to re-copy the file."""
+    data = cine40.read_bytes()
+    cut = tmp_path / "n3000_Fr500.cine"
+    cut.write_bytes(data[: len(data) - 40 * 320 * 200 + 100])  # every frame's pixels cut off
+    run = cli(capsys, "info", cut, "--allow-truncated")
+    assert_clean(run, 1, "is truncated", "Not one frame is complete, so --allow-truncated cannot help")
+    cut.write_bytes(data[:300])
+    run = cli(capsys, "info", cut)
+    assert_clean(run, 1, "lies past the end of the file", "re-copy it")

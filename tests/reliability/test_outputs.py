@@ -89,6 +89,23 @@ def test_r18_track_on_a_full_disk(full_disk, capsys, mini_lab):
     assert not (out / "qc").exists() or not any((out / "qc").iterdir())  # no empty or partial QC
 
 
+def test_a_rerun_whose_qc_cannot_be_written_keeps_the_earlier_trace(tmp_path, capsys, mini_lab, monkeypatch):
+    """A re-run that fails writing its QC (here a permission error, as in a read-only qc folder) fails that video
+    and leaves the trace of the earlier run as it was (found in a new-user trial: it was deleted)."""
+    out = tmp_path / "o"
+    assert_clean(cli(capsys, "track", mini_lab, "-o", out, "-q", "--workers", "1"), 0)
+    trace = out / "clip_3000rpm.trace.h5"
+    before = trace.read_bytes()
+
+    def refuse(folder, *args, **kwargs):
+        raise PermissionError(13, "Permission denied", str(folder / "x.png"))
+
+    monkeypatch.setattr("cageless.tracking.pipeline.write_qc", refuse)
+    run = cli(capsys, "track", mini_lab, "-o", out, "-q", "--workers", "1")
+    assert run.code == 1 and "FAILED clip_3000rpm.mkv" in run.err and "Traceback" not in run.err
+    assert trace.read_bytes() == before and not parts(out)
+
+
 def test_r13_a_second_writer_is_refused(tmp_path, capsys, mini_lab):
     out = tmp_path / "report"
     with output_lock(out):

@@ -102,7 +102,9 @@ class CineReader(FrameSource):
         s = fmt if isinstance(fmt, struct.Struct) else struct.Struct("<" + fmt)
         if offset < 0 or offset + s.size > self._size:
             raise VideoError(self.path, f"is truncated or corrupt: {what} lies past the end of the file "
-                             f"({self._size} bytes)", offset=offset)
+                             f"({self._size} bytes)", offset=offset,
+                             hint="Its headers are incomplete, so no frame can be read: re-copy it from the camera or "
+                             "the original disk.")
         return s.unpack_from(self._mm, offset)
 
     def _unpack_named(self, s: struct.Struct, names: tuple[str, ...], offset: int, what: str) -> dict[str, Any]:
@@ -208,9 +210,10 @@ class CineReader(FrameSource):
         if complete < n:
             bad = int(starts[complete])
             if not allow_truncated or complete == 0:
+                hint = ("Re-copy the file, or re-run with --allow-truncated to use the complete frames." if complete
+                        else "Not one frame is complete, so --allow-truncated cannot help: re-copy the file.")
                 raise VideoError(self.path, f"is truncated: frame {complete} of {n} starts at or runs past the end of "
-                                 f"the file ({self._size} bytes).", offset=bad,
-                                 hint="Re-copy the file, or re-run with --allow-truncated to use the complete frames.")
+                                 f"the file ({self._size} bytes).", offset=bad, hint=hint)
             _warn_once(f"{self.path}: truncated; using its {complete} complete frames of {n} ({n - complete} dropped).")
         self._data_start = data_start[:complete]
         self._n = complete

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -37,7 +37,8 @@ log = logging.getLogger(__name__)
 _EXAMPLES = """\
 examples:
   cageless track sample_data/lab -o out            every video of a lab folder (sidecar, conditions.csv or file name)
-  cageless track clip.cine --speed-rpm 3000 -o out one video whose conditions are nowhere else
+  cageless track clip.cine --speed-rpm 3000 --radial-load-n 500 -o out
+                                                   one video whose conditions are nowhere else
   cageless track lab -o out --window 31 --detector weighted --workers 2
 """
 
@@ -64,6 +65,10 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--speed-rpm", type=finite_float,
                    help="inner-ring speed (rpm): for a video named here it wins over its sidecar, conditions.csv "
                    "and file name (with a warning); in a folder it stands in only for videos without conditions")
+    p.add_argument("--radial-load-n", type=finite_float,
+                   help="radial load (N), recorded in the trace for the comparison: as --speed-rpm (0 N when no "
+                   "source gives it, with a warning)")
+    p.add_argument("--axial-load-n", type=finite_float, help="axial load (N): as --radial-load-n")
     p.add_argument("--fps", type=finite_float, help="frame-rate override (frames/s)")
     p.add_argument("--window", type=int, default=DEFAULT_WINDOW,
                    help=f"Savitzky-Golay speed window in frames, odd (default {DEFAULT_WINDOW})")
@@ -79,8 +84,18 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--force", action="store_true", help="accept conditions outside their plausible ranges")
 
 
-def collect_inputs(inputs: list[str], speed_rpm: float | None) -> list[LabEntry]:
-    """Expand the command-line inputs into videos with their conditions (or their errors)."""
+#: The conditions ``track`` takes on the command line, by option name.
+TYPED = {"speed_rpm": "r/min", "radial_load_n": "N", "axial_load_n": "N"}
+
+
+def collect_inputs(inputs: list[str], speed_rpm: float | None,
+                   loads: Mapping[str, float | None] | None = None) -> list[LabEntry]:
+    """Expand the command-line inputs into videos with their conditions (or their errors).
+
+    ``speed_rpm`` and ``loads`` (``radial_load_n``, ``axial_load_n``) are the values typed on the command line
+    (None: not given); see :func:`_with_typed` for how they combine with a video's own sources.
+    """
+    typed = {k: v for k, v in {"speed_rpm": speed_rpm, **(loads or {})}.items() if v is not None}
     entries: list[LabEntry] = []
     for raw in inputs:
         p = Path(raw)
@@ -90,44 +105,47 @@ def collect_inputs(inputs: list[str], speed_rpm: float | None) -> list[LabEntry]
             entries.append(LabEntry(video=p, error=CagelessError(
                 f"{p}: is the QC folder of a cageless output (its images are QC figures, not a video's frames).")))
         elif p.is_dir() and not any(f.suffix.lower() in IMAGE_SUFFIXES for f in p.iterdir()):
-            found = discover_lab(p, speed_rpm)
+            found = discover_lab(p, fallback=typed)
             if not found:
                 traces = " It holds cageless traces: point at the folder of videos instead." if any(
                     p.glob("*.trace.h5")) else ""
                 entries.append(LabEntry(video=p, error=CagelessError(f"{p}: no videos found in this folder.{traces}")))
-            entries.extend(_with_speed(e, speed_rpm, named=False) for e in found)
+            entries.extend(_with_typed(e, typed, named=False) for e in found)
         else:
             try:
-                entries.append(_with_speed(LabEntry(video=p, resolved=resolve_conditions(p, None, speed_rpm)), speed_rpm,
-                                           named=True))
+                entry = LabEntry(video=p, resolved=resolve_conditions(p, None, fallback=typed))
             except CagelessError as exc:
-                entries.append(_with_speed(LabEntry(video=p, error=exc), speed_rpm, named=True))
+                entry = LabEntry(video=p, error=exc)
+            entries.append(_with_typed(entry, typed, named=True))
     return refuse_shared_names(entries)
 
 
-def _with_speed(entry: LabEntry, speed_rpm: float | None, named: bool) -> LabEntry:
-    """Apply ``--speed-rpm`` to one video whose conditions were resolved with it as the fallback speed.
+def _with_typed(entry: LabEntry, typed: Mapping[str, float], named: bool) -> LabEntry:
+    """Apply the conditions typed on the command line to one video resolved with them as fallbacks.
 
-    For a video named on the command line (``named``) the typed speed wins over every other source, and the run
-    says which value it replaces. For a video found in a folder it stands in only where no source gives a speed
-    (the other keys its sources give are kept), and the run says where a source overrules it: one typed speed is
+    For a video named on the command line (``named``) a typed value wins over every other source, and the run
+    says which value it replaces. For a video found in a folder it stands in only where no source gives that key
+    (the other keys its sources give are kept), and the run says where a source overrules it: one typed value is
     rarely right for a whole folder. A malformed source stays an error either way.
     """
-    if speed_rpm is None or not entry.ok:
-        return entry  # an error: a malformed source, or no such file (a missing speed was filled in when resolving)
-    given = entry.resolved.conditions.speed_rpm
-    if given == speed_rpm:
-        return entry
-    source = entry.resolved.origin.get("speed_rpm", "its conditions")
-    if not named:
-        print(f"warning: {entry.video}: --speed-rpm {speed_rpm:g} is not used: its {source} gives {given:g} r/min "
-              "(in a folder the videos' own conditions win; name the video on the command line to override them)",
+    if not entry.ok:
+        return entry  # an error: a malformed source, or no such file (a missing value was filled in when resolving)
+    conditions, origin = entry.resolved.conditions, dict(entry.resolved.origin)
+    for key, value in typed.items():
+        given, flag, unit = getattr(conditions, key), "--" + key.replace("_", "-"), TYPED[key]
+        if given == value:
+            continue
+        source = origin.get(key, "its conditions")
+        if not named:
+            print(f"warning: {entry.video}: {flag} {value:g} is not used: its {source} gives {given:g} {unit} "
+                  "(in a folder the videos' own conditions win; name the video on the command line to override "
+                  "them)", file=sys.stderr)
+            continue
+        print(f"warning: {entry.video}: {flag} {value:g} overrides {given:g} {unit} from its {source}",
               file=sys.stderr)
+        conditions, origin[key] = replace(conditions, **{key: value}), flag
+    if conditions is entry.resolved.conditions:
         return entry
-    print(f"warning: {entry.video}: --speed-rpm {speed_rpm:g} overrides {given:g} r/min from its {source}",
-          file=sys.stderr)
-    conditions = replace(entry.resolved.conditions, speed_rpm=speed_rpm)
-    origin = {**entry.resolved.origin, "speed_rpm": "--speed-rpm"}
     return replace(entry, resolved=replace(entry.resolved, conditions=conditions, origin=origin))
 
 
@@ -166,7 +184,8 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     _validate(args)
     check_n_balls(args.n_balls, config)
     bearing = bearing_from_config(config)
-    entries = [plausible_entry(e, args.force) for e in collect_inputs(args.inputs, args.speed_rpm)]
+    typed = collect_inputs(args.inputs, args.speed_rpm, _typed_loads(args))
+    entries = [plausible_entry(e, args.force) for e in typed]
     _prefetch_first_hash(entries, args.workers)
     from cageless.tracking.detect import DetectorParams  # these imports take a second: the hash runs meanwhile
     from cageless.tracking.pipeline import TrackOptions
@@ -180,9 +199,13 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
         return _run_locked(args, entries, bearing, options, out)
 
 
+def _typed_loads(args: argparse.Namespace) -> dict[str, float | None]:
+    return {"radial_load_n": args.radial_load_n, "axial_load_n": args.axial_load_n}
+
+
 def _validate(args: argparse.Namespace) -> None:
     """Numbers in range and the output folder usable, before any work."""
-    check_options(args, ("speed_rpm", "fps", "window", "workers"))
+    check_options(args, ("speed_rpm", "radial_load_n", "axial_load_n", "fps", "window", "workers"))
     check_output_dir(args.out, "-o")
 
 
