@@ -205,3 +205,19 @@ def test_vectorised_centroid_pass_equals_the_plain_one_to_rounding():
         plain = _pass_plain(frame, background, mask, u, v, r, local, 60.0, NO_STATIC, False)
         assert np.allclose(fast[:3], plain[:3], rtol=1e-12, atol=0.0) and fast[3] == plain[3]
 
+
+def test_track_fit_solve_matches_lapack():
+    """kinematics._solve3 (Gaussian elimination with partial pivoting) against numpy.linalg.solve (LAPACK dgesv),
+    on random systems and on ones that need a row swap (a zero leading pivot)."""
+    from cageless.tracking.kinematics import _solve3
+
+    rng = np.random.default_rng(13)
+    for k in range(2000):
+        m = rng.normal(size=(3, 3))
+        if k % 4 == 0:
+            m[0, 0] = 0.0
+        b = rng.normal(size=3)
+        want = np.linalg.solve(m, b)
+        got = _solve3(m.copy(), b.copy())
+        scale = np.linalg.cond(m) * np.abs(want).max()
+        assert np.max(np.abs(got - want)) <= 1e-13 * scale
