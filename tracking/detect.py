@@ -446,6 +446,10 @@ def _pass(frame, background, mask, u, v, r, local, threshold, mirror, static):  
     m = 0.0
     holes = False
     use = _window_has_static(static, u, v, r)
+    if not mirror:
+        if not use and np.isfinite(local):
+            return _pass_fast(frame, mask, u, v, r, local + threshold)
+        return _pass_plain(frame, background, mask, u, v, r, local, threshold, static, use)
     for y in range(max(int(np.floor(v - r)), 0), min(int(np.ceil(v + r)) + 1, h)):
         dy2 = (y - v) * (y - v)
         x0, x1 = _span(u, r * r, dy2, 0, w)
@@ -465,6 +469,72 @@ def _pass(frame, background, mask, u, v, r, local, threshold, mirror, static):  
                 su += wgt * x
                 sv += wgt * y
                 m += wgt
+    return su, sv, m, holes
+
+
+@numba.njit(cache=True, nogil=True, fastmath=True)
+def _pass_fast(frame, mask, u, v, r, level):  # pragma: no cover - compiled
+    """:func:`_pass_plain` for a window with a local background (``level`` = it plus the threshold) and no static
+    pattern: each row's sums in SIMD lanes (``fastmath`` lets them be reassociated), a masked pixel weighted 0.
+
+    The sums differ from :func:`_pass_plain`'s in the last bits (centroids by up to 4e-12 px on the benchmark
+    clip), for 0.27 against 0.40 ms of CPU a frame for the per-frame step's 14 windows (benchmarks/centroid_replay.py)."""
+    h, w = frame.shape
+    su = 0.0
+    sv = 0.0
+    m = 0.0
+    out = 0
+    inv = 1.0 / (r * r)
+    for y in range(max(int(np.floor(v - r)), 0), min(int(np.ceil(v + r)) + 1, h)):
+        dy2 = (y - v) * (y - v)
+        x0, x1 = _span(u, r * r, dy2, 0, w)
+        ru = 0.0
+        rm = 0.0
+        for x in range(x0, x1 + 1):
+            k = mask[y, x]
+            out += 1 - np.int64(k)
+            wgt = np.float64(frame[y, x]) - level
+            dx = x - u
+            taper = 1.0 - (dx * dx + dy2) * inv
+            wgt = max(wgt, 0.0) * (taper * taper) * np.float64(k)
+            ru += wgt * x
+            rm += wgt
+        su += ru
+        sv += rm * y
+        m += rm
+    return su, sv, m, out > 0
+
+
+@numba.njit(cache=True, nogil=True)
+def _pass_plain(frame, background, mask, u, v, r, local, threshold, static, use):  # pragma: no cover - compiled
+    """:func:`_pass` without ``mirror``, the same sums bit for bit and without a branch on each pixel's weight:
+    a pixel at or below the threshold adds ``+0.0`` to each sum (all three sums stay ``>= +0.0``, so adding
+    ``+0.0`` leaves them as they are) instead of being skipped, which spares the mispredicted branches (a
+    quarter of a window's pixels are below the threshold, scattered)."""
+    h, w = frame.shape
+    su = 0.0
+    sv = 0.0
+    m = 0.0
+    holes = False
+    rr = r * r
+    have_local = np.isfinite(local)
+    for y in range(max(int(np.floor(v - r)), 0), min(int(np.ceil(v + r)) + 1, h)):
+        dy2 = (y - v) * (y - v)
+        x0, x1 = _span(u, rr, dy2, 0, w)
+        fy = np.float64(y)
+        for x in range(x0, x1 + 1):
+            if not mask[y, x]:
+                holes = True
+                continue
+            base = local if have_local else np.float64(background[y, x])
+            wgt = np.float64(frame[y, x]) - base - threshold
+            if use:
+                wgt -= _static_at(frame, static, y, x)
+            taper = 1.0 - ((x - u) * (x - u) + dy2) / rr
+            wgt = (wgt if wgt > 0.0 else 0.0) * (taper * taper)
+            su += wgt * x
+            sv += wgt * fy
+            m += wgt
     return su, sv, m, holes
 
 

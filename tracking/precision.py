@@ -145,7 +145,7 @@ def angle_noise(time_s: npt.ArrayLike, angle: npt.ArrayLike, valid: npt.ArrayLik
     """
     a = np.asarray(angle, dtype=np.float64)
     ok = np.asarray(valid, dtype=bool)
-    fit, _ = robust_track_fit(time_s, a, ok, frames, exact=False)
+    fit, _ = robust_track_fit(time_s, a, ok, frames)
     res = a - fit
     z = a.shape[1]
     sigma = np.full(z, np.nan)
@@ -245,7 +245,7 @@ def assess_precision(time_s: npt.ArrayLike, angle: npt.ArrayLike, valid: npt.Arr
     step = float(np.median(np.diff(t)))
     radial = radial_scatter(u_px, v_px, ok, centre_px, radius_px)
     have = np.isfinite(radial)
-    smooth, _ = robust_track_fit(t, np.nan_to_num(radial), have, track_fit, exact=False)
+    smooth, _ = robust_track_fit(t, np.nan_to_num(radial), have, track_fit)
     radial_angle = _rms(np.where(have, smooth, np.nan))
     filled, usable = _filled(t, radial)
     radial_speed = _rms(revolution_speed(t, filled[:, usable], window, polyorder)) if usable.any() else math.nan

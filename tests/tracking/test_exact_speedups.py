@@ -135,3 +135,89 @@ def test_local_background_skipping_the_window_is_bit_identical_to_the_whole_disc
             assert np.float64(new).tobytes() == np.float64(old).tobytes(), (u, v, r)
             checked += np.isfinite(old)
     assert checked > 4000  # most windows had their 8 ring pixels: the medians compared are real ones
+
+
+def _window_case(rng: np.random.Generator, holes: bool) -> tuple:
+    """A 16-bit frame with a noisy Gaussian highlight, its background, a mask, and a window about the spot."""
+    h, w = 90, 110
+    yy, xx = np.mgrid[0:h, 0:w]
+    u, v = float(rng.uniform(40, 70)), float(rng.uniform(35, 55))
+    spot = 3000.0 * np.exp(-((xx - u - 0.4) ** 2 + (yy - v + 0.3) ** 2) / (2 * 4.0**2))
+    frame = np.clip(800 + spot + rng.normal(0, 30, (h, w)), 0, 65535).astype(np.uint16)
+    background = np.full((h, w), 800.0, np.float32) + rng.normal(0, 3, (h, w)).astype(np.float32)
+    mask = np.ones((h, w), bool)
+    if holes:
+        mask[rng.random((h, w)) < 0.02] = False
+    return frame, background, mask, u, v, float(rng.uniform(12, 24))
+
+
+@numba.njit
+def _pass_skipping(frame, background, mask, u, v, r, local, threshold):  # pragma: no cover - compiled
+    """detect._pass without ``mirror`` and ``static`` as commit 6ed1501 wrote it: pixels at or below the threshold
+    skipped."""
+    h, w = frame.shape
+    su = 0.0
+    sv = 0.0
+    m = 0.0
+    holes = False
+    for y in range(max(int(np.floor(v - r)), 0), min(int(np.ceil(v + r)) + 1, h)):
+        dy2 = (y - v) * (y - v)
+        x0, x1 = _span(u, r * r, dy2, 0, w)
+        for x in range(x0, x1 + 1):
+            if not mask[y, x]:
+                holes = True
+                continue
+            base = local if np.isfinite(local) else background[y, x]
+            wgt = np.float64(frame[y, x]) - base - threshold
+            if wgt > 0.0:
+                taper = 1.0 - ((x - u) * (x - u) + dy2) / (r * r)
+                wgt *= taper * taper
+                su += wgt * x
+                sv += wgt * y
+                m += wgt
+    return su, sv, m, holes
+
+
+def test_plain_centroid_pass_is_bit_identical_to_the_skipping_form():
+    """detect._pass_plain adds +0.0 for a pixel at or below the threshold instead of skipping it: the same sums
+    bit for bit as the skipping loop of commit 6ed1501 (written out above)."""
+    from cageless.tracking.detect import _pass_plain
+
+    rng = np.random.default_rng(11)
+    for k in range(300):
+        frame, background, mask, u, v, r = _window_case(rng, holes=k % 2 == 1)
+        for local in (float(rng.uniform(780, 820)), np.nan):
+            got = _pass_plain(frame, background, mask, u, v, r, local, 60.0, NO_STATIC, False)
+            want = _pass_skipping(frame, background, mask, u, v, r, local, 60.0)
+            assert np.array(got[:3]).tobytes() == np.array(want[:3]).tobytes() and got[3] == want[3]
+
+
+def test_vectorised_centroid_pass_equals_the_plain_one_to_rounding():
+    """detect._pass_fast reassociates the sums (fastmath): the same sums to rounding (relative 1e-12 here; the
+    centroids move by up to 4e-12 px on the benchmark clip, benchmarks/centroid_replay.py) and the same holes."""
+    from cageless.tracking.detect import _pass_fast, _pass_plain
+
+    rng = np.random.default_rng(12)
+    for k in range(300):
+        frame, background, mask, u, v, r = _window_case(rng, holes=k % 2 == 1)
+        local = float(rng.uniform(780, 820))
+        fast = _pass_fast(frame, mask, u, v, r, local + 60.0)
+        plain = _pass_plain(frame, background, mask, u, v, r, local, 60.0, NO_STATIC, False)
+        assert np.allclose(fast[:3], plain[:3], rtol=1e-12, atol=0.0) and fast[3] == plain[3]
+
+
+def test_track_fit_solve_matches_lapack():
+    """kinematics._solve3 (Gaussian elimination with partial pivoting) against numpy.linalg.solve (LAPACK dgesv),
+    on random systems and on ones that need a row swap (a zero leading pivot)."""
+    from cageless.tracking.kinematics import _solve3
+
+    rng = np.random.default_rng(13)
+    for k in range(2000):
+        m = rng.normal(size=(3, 3))
+        if k % 4 == 0:
+            m[0, 0] = 0.0
+        b = rng.normal(size=3)
+        want = np.linalg.solve(m, b)
+        got = _solve3(m.copy(), b.copy())
+        scale = np.linalg.cond(m) * np.abs(want).max()
+        assert np.max(np.abs(got - want)) <= 1e-13 * scale
