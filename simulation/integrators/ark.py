@@ -102,51 +102,82 @@ def ark_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_st
     t, h, err_old, held, t_cross, sig, k = _start(model_id, p, log, y0, t0, h0, h_onset, t_out, out, state, rows, f,
                                                   ki, work, cnt)
     status = STATUS_OK
-    t_last = t_out[t_out.shape[0] - 1]
     tiny = 1e-13 * max(abs(t_stop), t_stop - state[_S_T0])
     h_want = h  # the controller's proposal before the end of the span clipped it: where the next span starts
     while k < t_out.shape[0]:
         h_want = h
-        if t_cross > t:
-            h = min(h, max(h_onset, t_cross - t + 0.5 * h_onset))
-        stop, h = _before_step(cnt, max_steps, t, t_stop, h, h_max, tiny)
-        if stop >= 0:
-            if stop == STATUS_OK:
-                out[k:, :] = y
-            status = stop
+        status, h = _before_step(cnt, max_steps, t, t_stop, _toward_change(t, h, t_cross, h_onset), h_max, tiny)
+        if status >= 0:
             break
         h, t_cross = _onset_ahead(model_id, p, t, h, y, f[0], h_onset, t_cross, g0, g1, yt)
         err = _ark_trial(model_id, t, h, y, p, log, f, ki, yt, ynew, f_end, work, atol, rtol, e, cnt)
         if not np.isfinite(err) or err > 1.0:
             held = True
-            h_err = _rejected(err, h, cnt)
-            if h_err < tiny and not np.isfinite(err):
-                status = STATUS_NONFINITE
+            status, h, t_cross = _refused(model_id, p, t, h, y, ynew, f[0], f_end, err, h_onset, sig, t_cross, tiny,
+                                          g0, g1, yt, cnt)
+            if status >= 0:
                 break
-            h, t_cross = _refused_across(model_id, p, t, h, y, ynew, f[0], f_end, h_err, h_onset, sig, g0, g1, yt,
-                                         err, cnt)
             continue
         verdict, sig = _controls(model_id, ynew, p, sig, h, h_onset, f[0], f_end, jump_floor, force_jump)
-        if verdict == 1:
-            h_retry = _retry_step(verdict, h, h_onset, cnt)
-            h, t_cross = _onset_retry(model_id, p, t, h, y, ynew, f[0], f_end, h_retry, g0, g1, yt)
-            continue
-        if verdict == 2:
-            h = _retry_step(verdict, h, h_onset, cnt)
+        if verdict == 1 or verdict == 2:
+            h, t_cross = _control_retry(model_id, p, verdict, t, h, y, ynew, f[0], f_end, h_onset, t_cross, g0, g1,
+                                        yt, cnt)
             continue
         cnt[5] += verdict == 3  # contact changes (dp5's counter)
-        fac = max(1.0 if held else 0.1, min(5.0, err ** 0.22 / err_old ** 0.04 / 0.9))
+        h_next, err_old = _next_step(err, err_old, held, h, h_onset, f[0], f_end, jump_floor, force_jump)
         held = False
-        err_old = max(err, 1e-4)
-        h_jump = _jump_bound(h, h_onset, f[0], f_end, jump_floor, force_jump)
-        if t + h > t_last:  # the step that crosses the last sample: keep its start for the next call's samples
+        if t + h > t_out[t_out.shape[0] - 1]:  # the step that crosses the last sample: keep its start (next call)
             _hold_step(t, h, y, f[0], state, rows)
         k = _ark_accept(model_id, t, h, y, ynew, f, f_end, ki, work, p, log, t_out, out, k, cnt)
-        t = t + h
-        h = min(h / fac, h_jump)
-    _write_stats(stats, cnt, max(h, h_want) if status == STATUS_OK else h)
+        t, h = t + h, h_next
+    if status == STATUS_OK:
+        out[k:, :] = y  # stopped with only round-off of the time axis left (none when every sample is written)
+    _write_stats(stats, cnt, max(h, h_want) if status <= STATUS_OK else h)
     _keep(state, rows, f, ki, t, h, err_old, held, t_cross, sig)
-    return status
+    return max(status, STATUS_OK)
+
+
+@numba.njit(cache=True, inline="always")
+def _toward_change(t, h, t_cross, h_onset):  # pragma: no cover - compiled
+    """The trial step from ``t`` given the proposal ``h``: the step after a located contact change's retry ends
+    half an onset step past the change at ``t_cross``, never shorter than the onset step; ``h`` when none lies
+    ahead."""
+    if t_cross > t:
+        return min(h, max(h_onset, t_cross - t + 0.5 * h_onset))
+    return h
+
+
+@numba.njit(cache=True, inline="always")
+def _refused(model_id, p, t, h, y, ynew, f0, f1, err, h_onset, sig, t_cross, tiny, g0, g1, yt,
+             cnt):  # pragma: no cover - compiled
+    """After the error test refused a step of length ``h`` (counted): (-1, the retry, the contact change located
+    ahead; :func:`_refused_across`), or (``STATUS_NONFINITE``, ...) when the state is not finite even at a
+    step below ``tiny``."""
+    h_err = _rejected(err, h, cnt)
+    if h_err < tiny and not np.isfinite(err):
+        return STATUS_NONFINITE, h_err, t_cross
+    h, t_cross = _refused_across(model_id, p, t, h, y, ynew, f0, f1, h_err, h_onset, sig, g0, g1, yt, err, cnt)
+    return -1, h, t_cross
+
+
+@numba.njit(cache=True, inline="always")
+def _control_retry(model_id, p, verdict, t, h, y, ynew, f0, f1, h_onset, t_cross, g0, g1, yt,
+                   cnt):  # pragma: no cover - compiled
+    """After the onset (``verdict`` 1) or force-jump (2) control refused an error-accepted step (counted): the
+    retry and the contact change located ahead (:func:`_onset_retry` after a contact change, dp5's half step
+    after a force jump)."""
+    h_retry = _retry_step(verdict, h, h_onset, cnt)
+    if verdict == 2:
+        return h_retry, t_cross
+    return _onset_retry(model_id, p, t, h, y, ynew, f0, f1, h_retry, g0, g1, yt)
+
+
+@numba.njit(cache=True, inline="always")
+def _next_step(err, err_old, held, h, h_onset, f0, f1, floor, force_jump):  # pragma: no cover - compiled
+    """The trial step after an accepted one of length ``h`` with error ``err``, and the controller's error to keep:
+    Hairer's PI controller (no growth after a refusal, ``held``) bounded by :func:`_jump_bound`."""
+    fac = max(1.0 if held else 0.1, min(5.0, err ** 0.22 / err_old ** 0.04 / 0.9))
+    return min(h / fac, _jump_bound(h, h_onset, f0, f1, floor, force_jump)), max(err, 1e-4)
 
 
 # The session's scalar slots (``state`` of ark_integrate): whether it holds an integrator, its time, the next trial
