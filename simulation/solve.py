@@ -402,8 +402,7 @@ def solve(problem: Problem, t_eval: npt.ArrayLike, method: str = "dp5", rtol: fl
     rtol
         Relative tolerance; the absolute tolerances are the problem's, per state.
     max_step
-        Largest step (s); ``"ark4"`` caps an infinite one at :data:`ARK_MAX_STEP_S` on a problem with contacts
-        (the impacts' timing needs it).
+        Largest step (s); ``"ark4"`` caps an infinite one at :data:`ARK_MAX_STEP_S` on problems with contacts.
     first_step
         First trial step (s); default 1e-3 of the span, at most ``max_step``.
     max_steps
