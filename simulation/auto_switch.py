@@ -70,7 +70,7 @@ from cageless.simulation._cache import compile_notice
 from cageless.simulation.kernels import PLANAR, SPATIAL
 from cageless.simulation.problem import Problem
 from cageless.simulation.integrators.dp5 import STATUS_MAX_STEPS, STATUS_OK
-from cageless.simulation.solve import ArkSession, CvodeSession, Solution, solve, step_ark, step_cvode
+from cageless.simulation.solve import ARK_MAX_STEP_S, ArkSession, CvodeSession, Solution, solve, step_ark, step_cvode
 
 __all__ = ["solve_chunks", "default_max_step", "CONTACT_MAX_STEP_S", "MAX_STEP_S", "RTOL_FACTOR", "STIFF_FRACTION",
            "RHS_COST_US", "STEP_COST_US", "SWITCH_GAIN", "STIFF_METHODS", "ARK_MODELS", "PROBE_CHUNKS",
@@ -171,7 +171,7 @@ CONTACT_MAX_STEP_S = 2e-6
 #: The IMEX method's steps are set by its error test and the contact changes (its explicit part's fastest modes,
 #: |lambda| ~ 2e4 1/s at 3000 rpm, 500 N, allow ~200 us); its cap bounds them: at 3000 rpm, 500 N (planar,
 #: settled) 20 us gave 0.0009 pp of slip in 2185 right-hand sides per 5 ms, 50 us 0.0019 pp in 1639.
-MAX_STEP_S: dict[str, float] = {"CVODE": 5e-6, "rosw": 1e-5, "ark4": 5e-5}
+MAX_STEP_S: dict[str, float] = {"CVODE": 5e-6, "rosw": 1e-5, "ark4": ARK_MAX_STEP_S}
 #: Per-method factor on the caller's rtol, so that one rtol means one accuracy whichever method runs.
 #: CVODE's error test (a weighted RMS norm over the states) is looser than DP5's max norm at the same rtol,
 #: and CVODE works at its error bound where DP5 is held far below it by stability. Measured on the energy

@@ -29,8 +29,8 @@ Around the step everything is DP5's (:mod:`cageless.simulation.integrators.dp5`,
 contact-onset and force-jump retries, cubic Hermite samples between step ends, the model's bookkeeping
 after every accepted step (the contact log), the step-size bounds and the statistics layout, with one
 addition: a step refused because a contact opened or closed in it is retried up to the change, located on
-the straight line between the contact gaps at its ends, and the next step crosses it at about the onset
-length (:func:`_onset_retry`), where DP5 retries at the onset length and then steps up to the change by
+the straight line between the contact gaps at its ends, and the next step crosses it at the onset length
+(:func:`_onset_retry`, :func:`_toward_change`), where DP5 retries at the onset length and then steps up to the change by
 onset-length retries (3-5 refused steps per change at 3000 rpm, 500 N). The step controller is Hairer's PI
 controller (Solving ODEs I, sect. II.4) with the exponents of an order-3 error estimate: 1/4 - 0.75 beta
 and beta = 0.04, with no growth right after a rejected step (Hairer & Wanner's facmax = 1). The step after
@@ -40,8 +40,10 @@ error test, 221 at contact changes, 319 by the force-jump test): a contact chang
 is crossed by an onset step instead of being stepped into (:func:`_onset_ahead`), a step the error test refuses
 across a contact change is retried as the onset control retries (:func:`_refused_across`), and the step after an
 accepted one is bounded where the force-jump test is expected to pass (:func:`_jump_bound`); 596 of 4108 refused
-then. A run in
-chunks keeps the integrator in a session (``state`` and ``rows``, :class:`cageless.simulation.solve.ArkSession`):
+then. A located change stays located until it is crossed (through error refusals and retries that locate none), the
+crossing step is the onset step itself (it was a few ulps longer, and refused), "longer than the onset step" is
+tested to :data:`cageless.simulation.integrators.dp5.ONSET_TOL` throughout, and predictions that keep being passed
+without a change stop (:data:`AHEAD_MISSES`); 584 of 4118 refused (docs/imex.md). A run in chunks keeps the integrator in a session (``state`` and ``rows``, :class:`cageless.simulation.solve.ArkSession`):
 a call returns after the step that crosses its last sample, and the next call resumes there, writing its first
 samples from that step's interpolant, so that the chunks take the same steps as one call.
 """
@@ -52,7 +54,7 @@ import numba
 import numpy as np
 
 from cageless.simulation.integrators.dp5 import (STATUS_NONFINITE, STATUS_OK, _accept, _before_step, _controls,
-                                                 _hermite, _retry_step, _samples_before, _write_stats)
+                                                 _hermite, _retry_step, _samples_before, _write_stats, over_onset)
 from cageless.simulation.kernels import (model_filter_error, model_gaps, model_implicit, model_rhs, model_signature,
                                         model_stage)
 
@@ -99,62 +101,51 @@ def ark_integrate(model_id, p, log, y0, t0, t_out, rtol, atol, h0, h_max, max_st
     the same steps as one call. With ``t_stop = t_out[-1]`` and a fresh ``state`` it is one solve."""  # noqa: D401
     f, ki, yt, ynew, f_end, e, g0, g1, work, cnt = _buffers(y0.shape[0])
     y = rows[0]  # the integrator's state lives in the session's rows
-    t, h, err_old, held, t_cross, sig, k = _start(model_id, p, log, y0, t0, h0, h_onset, t_out, out, state, rows, f,
-                                                  ki, work, cnt)
+    t, h, err_old, held, t_cross, sig, misses, k = _start(model_id, p, log, y0, t0, h0, h_onset, t_out, out, state,
+                                                          rows, f, ki, work, cnt)
     status = STATUS_OK
-    t_last = t_out[t_out.shape[0] - 1]
     tiny = 1e-13 * max(abs(t_stop), t_stop - state[_S_T0])
     h_want = h  # the controller's proposal before the end of the span clipped it: where the next span starts
     while k < t_out.shape[0]:
         h_want = h
-        if t_cross > t:
-            h = min(h, max(h_onset, t_cross - t + 0.5 * h_onset))
-        stop, h = _before_step(cnt, max_steps, t, t_stop, h, h_max, tiny)
-        if stop >= 0:
-            if stop == STATUS_OK:
-                out[k:, :] = y
-            status = stop
+        status, h = _before_step(cnt, max_steps, t, t_stop, _toward_change(t, h, t_cross, h_onset), h_max, tiny)
+        if status >= 0:
             break
-        h, t_cross = _onset_ahead(model_id, p, t, h, y, f[0], h_onset, t_cross, g0, g1, yt)
+        h, t_cross, misses = _onset_ahead(model_id, p, t, h, y, f[0], h_onset, t_cross, misses, g0, g1, yt)
         err = _ark_trial(model_id, t, h, y, p, log, f, ki, yt, ynew, f_end, work, atol, rtol, e, cnt)
         if not np.isfinite(err) or err > 1.0:
             held = True
-            h_err = _rejected(err, h, cnt)
-            if h_err < tiny and not np.isfinite(err):
-                status = STATUS_NONFINITE
+            status, h, t_cross = _refused(model_id, p, t, h, y, ynew, f[0], f_end, err, h_onset, sig, t_cross, tiny,
+                                          g0, g1, yt, cnt)
+            if status >= 0:
                 break
-            h, t_cross = _refused_across(model_id, p, t, h, y, ynew, f[0], f_end, h_err, h_onset, sig, g0, g1, yt,
-                                         err, cnt)
             continue
         verdict, sig = _controls(model_id, ynew, p, sig, h, h_onset, f[0], f_end, jump_floor, force_jump)
-        if verdict == 1:
-            h_retry = _retry_step(verdict, h, h_onset, cnt)
-            h, t_cross = _onset_retry(model_id, p, t, h, y, ynew, f[0], f_end, h_retry, g0, g1, yt)
+        if verdict == 1 or verdict == 2:
+            h, t_cross = _control_retry(model_id, p, verdict, t, h, y, ynew, f[0], f_end, h_onset, t_cross, g0, g1,
+                                        yt, cnt)
             continue
-        if verdict == 2:
-            h = _retry_step(verdict, h, h_onset, cnt)
-            continue
-        cnt[5] += verdict == 3  # contact changes (dp5's counter)
-        fac = max(1.0 if held else 0.1, min(5.0, err ** 0.22 / err_old ** 0.04 / 0.9))
+        misses = _passed(misses, verdict, t, h, t_cross, cnt)
+        h_next, err_old = _next_step(err, err_old, held, h, h_onset, f[0], f_end, jump_floor, force_jump)
         held = False
-        err_old = max(err, 1e-4)
-        h_jump = _jump_bound(h, h_onset, f[0], f_end, jump_floor, force_jump)
-        if t + h > t_last:  # the step that crosses the last sample: keep its start for the next call's samples
+        if t + h > t_out[t_out.shape[0] - 1]:  # the step that crosses the last sample: keep its start (next call)
             _hold_step(t, h, y, f[0], state, rows)
         k = _ark_accept(model_id, t, h, y, ynew, f, f_end, ki, work, p, log, t_out, out, k, cnt)
-        t = t + h
-        h = min(h / fac, h_jump)
-    _write_stats(stats, cnt, max(h, h_want) if status == STATUS_OK else h)
-    _keep(state, rows, f, ki, t, h, err_old, held, t_cross, sig)
-    return status
+        t, h = t + h, h_next
+    if status == STATUS_OK:
+        out[k:, :] = y  # stopped with only round-off of the time axis left (none when every sample is written)
+    _write_stats(stats, cnt, max(h, h_want) if status <= STATUS_OK else h)
+    _keep(state, rows, f, ki, t, h, err_old, held, t_cross, sig, misses)
+    return max(status, STATUS_OK)
 
 
 # The session's scalar slots (``state`` of ark_integrate): whether it holds an integrator, its time, the next trial
 # step, the controller's last error, whether the last trial was refused, a contact change located ahead, the contact
-# signature, the start and length of the last step that crossed a call's last sample, and the first call's start.
-_S_ACTIVE, _S_T, _S_H, _S_ERR_OLD, _S_HELD, _S_T_CROSS, _S_SIG, _S_T_PREV, _S_H_PREV, _S_T0 = range(10)
+# signature, the start and length of the last step that crossed a call's last sample, the first call's start, and
+# the predicted contact changes passed without one (:func:`_onset_ahead`).
+_S_ACTIVE, _S_T, _S_H, _S_ERR_OLD, _S_HELD, _S_T_CROSS, _S_SIG, _S_T_PREV, _S_H_PREV, _S_T0, _S_MISSES = range(11)
 #: Length of the session's ``state`` array.
-SESSION_SLOTS = 10
+SESSION_SLOTS = 11
 #: Rows of the session's ``rows`` array: y, f(y), f_I(y) at the integrator's time, the held step's start and its f.
 SESSION_ROWS = 5
 
@@ -164,13 +155,14 @@ def _start(model_id, p, log, y0, t0, h0, h_onset, t_out, out, state, rows, f, ki
     """The loop's variables at the start of a call, with f(y) and f_I(y) in f[0] and ki[0] and the samples at or
     before its time written: (t, h, the controller's last error, whether the last trial step was refused, so that
     the next accepted one may not grow (Hairer & Wanner, II.4), a contact change located ahead (see
-    :func:`_onset_retry`; the step that crosses it is short), the contact signature, the next sample's index).
-    Resumed from the session when it holds one (``state[0] > 0``), else from ``(t0, y0)`` and ``h0``."""
+    :func:`_onset_retry`; the step that crosses it is short), the contact signature, the predicted changes passed
+    without one (:func:`_onset_ahead`), the next sample's index). Resumed from the session when it holds one
+    (``state[0] > 0``), else from ``(t0, y0)`` and ``h0``."""
     if state[_S_ACTIVE] > 0.0:
         f[0, :] = rows[1]
         ki[0, :] = rows[2]
         return (state[_S_T], state[_S_H], state[_S_ERR_OLD], state[_S_HELD] > 0.0, state[_S_T_CROSS],
-                state[_S_SIG], _samples_held(t_out, out, state, rows))
+                state[_S_SIG], int(state[_S_MISSES]), _samples_held(t_out, out, state, rows))
     y = rows[0]
     y[:] = y0
     state[_S_T0] = t0
@@ -178,18 +170,18 @@ def _start(model_id, p, log, y0, t0, h0, h_onset, t_out, out, state, rows, f, ki
     model_implicit(model_id, t0, y, p, 0.0, ki[0], work)
     cnt[_RHS] = 1
     sig = model_signature(model_id, y, p) if h_onset > 0.0 else 0.0
-    return t0, h0, 1e-4, False, -np.inf, sig, _samples_before(t_out, t0, y, out)
+    return t0, h0, 1e-4, False, -np.inf, sig, 0, _samples_before(t_out, t0, y, out)
 
 
 @numba.njit(cache=True, inline="always")
-def _keep(state, rows, f, ki, t, h, err_old, held, t_cross, sig):  # pragma: no cover - compiled
+def _keep(state, rows, f, ki, t, h, err_old, held, t_cross, sig, misses):  # pragma: no cover - compiled
     """Store the loop's variables in the session (y is already in rows[0])."""
     rows[1, :] = f[0]
     rows[2, :] = ki[0]
     state[_S_ACTIVE] = 1.0
     state[_S_T], state[_S_H], state[_S_ERR_OLD] = t, h, err_old
     state[_S_HELD] = 1.0 if held else 0.0
-    state[_S_T_CROSS], state[_S_SIG] = t_cross, sig
+    state[_S_T_CROSS], state[_S_SIG], state[_S_MISSES] = t_cross, sig, misses
 
 
 @numba.njit(cache=True, inline="always")
@@ -265,7 +257,7 @@ def _jump_bound(h, h_onset, f0, f1, floor, fraction):  # pragma: no cover - comp
     Without it the PI controller grew the step through the impacts' rising forces into the test: 319 of 889
     refusals over 100 ms settled at 3000 rpm, 500 N (planar), at a median 1.45 times the step before, whose share
     was 0.76."""
-    if fraction <= 0.0 or h <= h_onset:
+    if fraction <= 0.0 or not over_onset(h, h_onset):
         return np.inf
     q = 0.0
     for i in range(f0.shape[0]):
@@ -278,7 +270,21 @@ def _jump_bound(h, h_onset, f0, f1, floor, fraction):  # pragma: no cover - comp
 
 
 @numba.njit(cache=True, inline="always")
-def _refused_across(model_id, p, t, h, y, ynew, f0, f1, h_err, h_onset, sig, g0, g1, yt, err,
+def _refused(model_id, p, t, h, y, ynew, f0, f1, err, h_onset, sig, t_cross, tiny, g0, g1, yt,
+             cnt):  # pragma: no cover - compiled
+    """After the error test refused a step of length ``h`` (counted): (-1, the retry, the contact change located
+    ahead; :func:`_refused_across`), or (``STATUS_NONFINITE``, ...) when the state is not finite even at a
+    step below ``tiny``."""
+    h_err = _rejected(err, h, cnt)
+    if h_err < tiny and not np.isfinite(err):
+        return STATUS_NONFINITE, h_err, t_cross
+    h, t_cross = _refused_across(model_id, p, t, h, y, ynew, f0, f1, h_err, h_onset, sig, t_cross, g0, g1, yt, err,
+                                 cnt)
+    return -1, h, t_cross
+
+
+@numba.njit(cache=True, inline="always")
+def _refused_across(model_id, p, t, h, y, ynew, f0, f1, h_err, h_onset, sig, t_cross, g0, g1, yt, err,
                     cnt):  # pragma: no cover - compiled
     """The retry after the error test refused a step of length ``h`` (``h_err``: the controller's shrink), and a
     contact change located ahead (the loop's ``t_cross``, -inf for none). When a contact opened or closed in the
@@ -290,11 +296,63 @@ def _refused_across(model_id, p, t, h, y, ynew, f0, f1, h_err, h_onset, sig, g0,
     errors of 1-2 these steps have) was refused again and again until the onset control ran, on an error that
     passed. 135 of the 349 error refusals over 100 ms settled at 3000 rpm, 500 N (planar) had a contact change in
     the step, a few onset steps long, the change mostly within two onset steps of the start (which
-    :func:`_onset_ahead` left to the onset control). Otherwise ``h_err``."""
-    if h_onset <= 0.0 or h <= h_onset or not np.isfinite(err) or model_signature(model_id, ynew, p) == sig:
-        return h_err, -np.inf
+    :func:`_onset_ahead` left to the onset control). Otherwise ``(h_err, t_cross)``: a change located before
+    (most often by :func:`_onset_ahead`, whose shortened step the error test refused: 131 of 291 error refusals
+    over the same 100 ms) stays located, instead of being predicted again from the retry."""
+    if h_onset <= 0.0 or not over_onset(h, h_onset) or not np.isfinite(err) or model_signature(model_id, ynew,
+                                                                                               p) == sig:
+        return h_err, t_cross
     cnt[4] += 1  # dp5's onset-retry counter
-    return _onset_retry(model_id, p, t, h, y, ynew, f0, f1, h_onset, g0, g1, yt)
+    return _onset_retry(model_id, p, t, h, y, ynew, f0, f1, h_onset, t_cross, g0, g1, yt)
+
+
+@numba.njit(cache=True, inline="always")
+def _control_retry(model_id, p, verdict, t, h, y, ynew, f0, f1, h_onset, t_cross, g0, g1, yt,
+                   cnt):  # pragma: no cover - compiled
+    """After the onset (``verdict`` 1) or force-jump (2) control refused an error-accepted step (counted): the
+    retry and the contact change located ahead (:func:`_onset_retry` after a contact change, dp5's half step
+    after a force jump)."""
+    h_retry = _retry_step(verdict, h, h_onset, cnt)
+    if verdict == 2:
+        return h_retry, t_cross
+    return _onset_retry(model_id, p, t, h, y, ynew, f0, f1, h_retry, t_cross, g0, g1, yt)
+
+
+@numba.njit(cache=True, inline="always")
+def _toward_change(t, h, t_cross, h_onset):  # pragma: no cover - compiled
+    """The trial step from ``t`` given the proposal ``h`` and a contact change located at ``t_cross``: the onset
+    step (it may cross the change) when the change lies within one, else a step ending half an onset step before
+    it, never below the onset step; ``h`` when none lies ahead. The retry after a located change ends half an
+    onset step before it, so the step that crosses it is the onset step itself (it was the change's time plus half
+    an onset step, minus t, a few ulps off the onset step, and 34 % of those crossings were refused as longer than
+    it)."""
+    d = t_cross - t
+    if d <= 0.0:
+        return h
+    if not over_onset(d, h_onset):
+        return min(h, h_onset)
+    return min(h, max(h_onset, d - 0.5 * h_onset))
+
+
+@numba.njit(cache=True, inline="always")
+def _passed(misses, verdict, t, h, t_cross, cnt):  # pragma: no cover - compiled
+    """The predicted contact changes passed without one, after the accepted step of length ``h`` from ``t``
+    (``verdict`` 3: a contact changed in it, counted, and the count restarts; a step across ``t_cross`` without a
+    change adds one; :func:`_onset_ahead` stops predicting at :data:`AHEAD_MISSES`)."""
+    if verdict == 3:
+        cnt[5] += 1  # contact changes (dp5's counter)
+        return 0
+    if t < t_cross <= t + h:
+        return misses + 1
+    return misses
+
+
+@numba.njit(cache=True, inline="always")
+def _next_step(err, err_old, held, h, h_onset, f0, f1, floor, force_jump):  # pragma: no cover - compiled
+    """The trial step after an accepted one of length ``h`` with error ``err``, and the controller's error to keep:
+    Hairer's PI controller (no growth after a refusal, ``held``) bounded by :func:`_jump_bound`."""
+    fac = max(1.0 if held else 0.1, min(5.0, err ** 0.22 / err_old ** 0.04 / 0.9))
+    return min(h / fac, _jump_bound(h, h_onset, f0, f1, floor, force_jump)), max(err, 1e-4)
 
 
 @numba.njit(cache=True, inline="always")
@@ -321,7 +379,7 @@ ONSET_ITERATIONS = 3
 
 
 @numba.njit(cache=True, inline="always")
-def _onset_retry(model_id, p, t, h, y, ynew, f0, f1, h_onset, g0, g1, yt):  # pragma: no cover - compiled
+def _onset_retry(model_id, p, t, h, y, ynew, f0, f1, h_onset, t_cross, g0, g1, yt):  # pragma: no cover - compiled
     """Where to retry a step refused because a contact opened or closed in it (longer than ``h_onset``):
     (the retry's length, the estimated time of the change). The change is located on the contact gaps at the
     step's two ends (the earliest sign change of the straight line between them), then refined by
@@ -330,8 +388,9 @@ def _onset_retry(model_id, p, t, h, y, ynew, f0, f1, h_onset, g0, g1, yt):  # pr
     in time across a 20 us step, and a change located past its time made the retry cross it and be refused
     again. The retry ends half an onset step before the change, and the step after it is held to end half an
     onset step past it (the loop's ``t_cross``), so that the change is crossed by one short step instead of
-    by a run of onset steps. Without a located change (or one within an onset step of the start) the retry
-    is the onset step itself, as DP5's."""
+    by a run of onset steps. Where the change lies within 1.5 onset steps of the start the retry is the onset
+    step itself, as DP5's, and the change stays located (:func:`_toward_change` crosses it at the onset step);
+    without one located, the onset step, and ``t_cross`` as it was."""
     model_gaps(model_id, y, p, g0)
     model_gaps(model_id, ynew, p, g1)
     frac = 1.0
@@ -342,7 +401,7 @@ def _onset_retry(model_id, p, t, h, y, ynew, f0, f1, h_onset, g0, g1, yt):  # pr
             if f_i < frac or found < 0:
                 found, frac = i, f_i
     if found < 0:
-        return h_onset, -np.inf
+        return h_onset, t_cross
     lo, hi, g_lo, g_hi = 0.0, 1.0, g0[found], g1[found]
     side = 0
     for _ in range(ONSET_ITERATIONS):
@@ -361,22 +420,31 @@ def _onset_retry(model_id, p, t, h, y, ynew, f0, f1, h_onset, g0, g1, yt):  # pr
             side = 1
         frac = lo + g_lo / (g_lo - g_hi) * (hi - lo)
     if frac * h - 0.5 * h_onset <= h_onset:
-        return h_onset, -np.inf
+        return h_onset, t + frac * h
     return frac * h - 0.5 * h_onset, t + frac * h
 
 
+#: Predicted contact changes in a row that :func:`_onset_ahead` may see passed without one before it stops
+#: predicting (until a change is accepted or none is predicted).
+AHEAD_MISSES = 2
+
+
 @numba.njit(cache=True, inline="always")
-def _onset_ahead(model_id, p, t, h, y, f0, h_onset, t_cross, g0, g1, yt):  # pragma: no cover - compiled
+def _onset_ahead(model_id, p, t, h, y, f0, h_onset, t_cross, misses, g0, g1, yt):  # pragma: no cover - compiled
     """A step of length ``h`` shortened to end half an onset step before a contact change predicted inside it
     (the gaps at y and at the Euler predictor y + h f0, the earliest sign change of the straight line between
-    them), with the change's time for the loop's ``t_cross``; ``(h, t_cross)`` unchanged when a change is
-    already located ahead or the step is an onset step at most, ``(h, -inf)`` when none is predicted, and
-    ``(h_onset, -inf)`` when one is predicted within 2.5 onset steps of the start: the onset step, which may cross
-    it. Without it every contact change cost a refused step first; before the last case (the step was taken
-    whole, and refused by the onset control or, first, by the error test) 221 onset and 135 error refusals per
-    293 contact changes over 100 ms settled at 3000 rpm, 500 N (planar), after it 70 onset refusals."""
-    if h_onset <= 0.0 or t_cross > t or h <= h_onset:
-        return h, t_cross
+    them), with the change's time for the loop's ``t_cross``, and the loop's ``misses`` (predicted changes passed
+    without one, :func:`_passed`): ``(h, t_cross, misses)`` unchanged when a change is already located ahead or
+    the step is an onset step at most, ``(h, -inf, 0)`` when none is predicted, and ``(h_onset, the change's time,
+    misses)`` when one is predicted within 2.5 onset steps of the start: the onset step, which may cross it.
+    Without it every contact change cost a refused step first; before the last case (the step was taken whole, and
+    refused by the onset control or, first, by the error test) 221 onset and 135 error refusals per 293 contact
+    changes over 100 ms settled at 3000 rpm, 500 N (planar), after it 70 onset refusals. After
+    :data:`AHEAD_MISSES` predictions in a row passed without a change it predicts nothing (``(h, -inf,
+    misses)``) until none is predicted: a gap that closes towards zero without crossing it (a grazing contact)
+    would otherwise keep predicting a change within 2.5 onset steps, and hold the loop at onset steps."""
+    if h_onset <= 0.0 or t_cross > t or not over_onset(h, h_onset):
+        return h, t_cross, misses
     for i in range(y.shape[0]):
         yt[i] = y[i] + h * f0[i]
     model_gaps(model_id, y, p, g0)
@@ -386,10 +454,12 @@ def _onset_ahead(model_id, p, t, h, y, f0, h_onset, t_cross, g0, g1, yt):  # pra
         if (g0[i] > 0.0) != (g1[i] > 0.0):
             frac = min(frac, g0[i] / (g0[i] - g1[i]))
     if frac > 1.0:
-        return h, -np.inf
+        return h, -np.inf, 0
+    if misses >= AHEAD_MISSES:
+        return h, -np.inf, misses
     if frac * h - 0.5 * h_onset <= 2.0 * h_onset:  # too close to split: the onset step, which may cross it
-        return h_onset, -np.inf
-    return frac * h - 0.5 * h_onset, t + frac * h
+        return h_onset, t + frac * h, misses
+    return frac * h - 0.5 * h_onset, t + frac * h, misses
 
 
 @numba.njit(cache=True, inline="always")

@@ -19,7 +19,7 @@ import numba
 import numpy as np
 
 from cageless.errors import ParameterError, suggest
-from cageless.simulation.integrators.dp5 import STATUS_OK
+from cageless.simulation.integrators.dp5 import ONSET_TOL, STATUS_OK
 from cageless.simulation.jacobian import JacobianStructure
 from cageless.simulation.kernels import model_gaps, model_post, model_rhs
 from cageless.simulation.problem import Problem
@@ -261,7 +261,7 @@ def step_cvode(pr: Problem, t_eval: FloatArray, rtol: float, max_step: float = n
         steps += 1
         if session.after_step(now, state):
             changes += 1
-            long_steps += now - t_last > session.onset_step * (1.0 + 1e-9)
+            long_steps += now - t_last > session.onset_step * (1.0 + ONSET_TOL)
         model_post(session.model_id, now, state, session.params, session.log)  # accepted-step bookkeeping
         while k < len(t_eval) and t_eval[k] <= now:
             y[k] = state if t_eval[k] == now else session.sample(t_eval[k])

@@ -25,7 +25,7 @@ import numpy as np
 
 from cageless.simulation.kernels import model_post, model_rhs, model_signature
 
-__all__ = ["dp5_integrate", "STATUS_OK", "STATUS_MAX_STEPS", "STATUS_STEP_UNDERFLOW", "STATUS_NONFINITE"]
+__all__ = ["dp5_integrate", "STATUS_OK", "STATUS_MAX_STEPS", "STATUS_STEP_UNDERFLOW", "STATUS_NONFINITE", "ONSET_TOL"]
 
 STATUS_OK = 0
 STATUS_MAX_STEPS = 1
@@ -42,6 +42,11 @@ A61, A62, A63, A64, A65 = 9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 
 B1, B3, B4, B5, B6 = 35 / 384, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84
 E1, E3, E4, E5, E6, E7 = 71 / 57600, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40
 
+
+#: Relative tolerance of "longer than the onset step" (:func:`over_onset`): a step meant to be the onset step may
+#: come out a few ulps longer (its end is a located contact change's time plus half an onset step, and t + h is
+#: rounded), and must not be refused for that.
+ONSET_TOL = 1e-9
 
 # Counters of the loop, kept in one integer array so the helpers can update them; their order is ``stats``'.
 _STEPS, _REJ, _RHS, _ONSET, _CHANGES, _JUMPS, _STIFF = 0, 1, 2, 4, 5, 6, 7
@@ -221,20 +226,26 @@ def _retry_step(verdict, h, h_onset, cnt):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, inline="always")
+def over_onset(h, h_onset):  # pragma: no cover - compiled
+    """Whether a step of length ``h`` is longer than the onset step ``h_onset`` by more than :data:`ONSET_TOL`."""
+    return h > h_onset * (1.0 + ONSET_TOL)
+
+
+@numba.njit(cache=True, inline="always")
 def _controls(model_id, y_new, p, sig, h, h_onset, k1, k7, jump_floor, force_jump):  # pragma: no cover
     """The contact-onset and force-jump tests of an error-accepted step: (verdict, new signature), verdict
     0 accept, 1 retry at the onset step (a contact changed in a long step), 2 retry at half the length
     (a force jumped), 3 accept with a contact change. (A contact change is accepted only at most ``h_onset``
-    long, and a force jump is tested only above it, so no step is both.)"""
+    long, and a force jump is tested only above it, so no step is both; both to :data:`ONSET_TOL`.)"""
     verdict = 0
     sig_new = sig
     if h_onset > 0.0:
         sig_new = model_signature(model_id, y_new, p)
         if sig_new != sig:
-            if h > h_onset:
+            if over_onset(h, h_onset):
                 return 1, sig
             verdict = 3
-    if force_jump > 0.0 and h > h_onset and _force_jumped(k1, k7, jump_floor, force_jump):
+    if force_jump > 0.0 and over_onset(h, h_onset) and _force_jumped(k1, k7, jump_floor, force_jump):
         return 2, sig
     return verdict, sig_new
 

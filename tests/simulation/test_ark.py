@@ -250,3 +250,125 @@ def test_spatial_newton_jacobian_matches_difference_quotients(settled_spatial):
     y = y_z.copy()
     k_i = _implicit(pr, y, hg)
     assert np.max(np.abs(y - y_z - hg * k_i)) < TOL_V  # 1.1e-12 measured
+
+
+def test_an_onset_step_a_few_ulps_long_crosses_a_contact_change(settled):
+    """dp5's contact-onset control accepts a contact change in a step at most the onset step long, to
+    ONSET_TOL (1e-9, the relative tolerance cvode.py counts long onset steps with): the step that crosses a
+    located change is the change's time plus half an onset step, minus t, a few ulps off the onset step, and
+    34 % of those crossings were refused for that (planar, 100 ms settled). Half a percent longer is refused.
+    ``sig + 1`` stands for the signature before the step (a contact changed in it)."""
+    from cageless.simulation.integrators.dp5 import ONSET_TOL, _controls
+    from cageless.simulation.kernels import model_signature
+
+    pr, _ = settled
+    y, h_onset = pr.y0.copy(), pr.onset_step
+    sig = model_signature(pr.model_id, y, pr.params)
+    zero = np.zeros_like(y)
+    assert ONSET_TOL == 1e-9
+    for h, verdict in ((h_onset * (1 + 1e-12), 3), (h_onset * (1 - 1e-12), 3), (h_onset * 1.005, 1)):
+        assert _controls(pr.model_id, y, pr.params, sig + 1.0, h, h_onset, zero, zero, zero, 0.5) == (verdict, (
+            sig if verdict == 3 else sig + 1.0))
+
+
+def test_toward_change_crosses_at_the_onset_step():
+    """The trial step towards a contact change located at ``t_cross`` (by hand, onset step 1 us): within an onset
+    step of it (to ONSET_TOL) the onset step itself, exactly (a retry ends half an onset step before the change,
+    and t_cross - t then comes out a few ulps off), else a step ending half an onset step before it, never below
+    the onset step; the proposal when none lies ahead or it is shorter."""
+    from cageless.simulation.integrators.ark import _toward_change
+
+    t, ho = 1.2345e-2, 1e-6
+    assert _toward_change(t, 50e-6, t + 0.5 * ho, ho) == ho
+    assert _toward_change(t, 50e-6, t + ho * (1 + 1e-12), ho) == ho
+    assert _toward_change(t, 50e-6, t + 3 * ho, ho) == pytest.approx(2.5 * ho, rel=1e-9)
+    assert _toward_change(t, 50e-6, t + 1.2 * ho, ho) == ho
+    assert _toward_change(t, 0.3 * ho, t + 0.5 * ho, ho) == 0.3 * ho
+    assert _toward_change(t, 50e-6, -np.inf, ho) == 50e-6
+    assert _toward_change(t, 50e-6, t - ho, ho) == 50e-6
+
+
+def _outer_gap_closing(pr, frac, h):
+    """(y, ynew, f): ball 0's radius moved linearly over a step of length h so that its outer race gap closes at
+    ``frac`` of the step (from 1 nm open), nothing else moving; f the constant rate, for the Hermite interpolant."""
+    from cageless.simulation.kernels import model_gaps
+
+    z = pr.n_balls
+    g = np.zeros(3 * z)
+    y = pr.y0.copy()
+    model_gaps(pr.model_id, y, pr.params, g)
+    y[0] -= g[0] + 1e-9  # the outer overlap is r + d/2 - D_o/2: now -1 nm
+    ynew = y.copy()
+    ynew[0] += 1e-9 / frac
+    f = np.zeros_like(y)
+    f[0] = (ynew[0] - y[0]) / h
+    g0, g1 = np.zeros(3 * z), np.zeros(3 * z)
+    model_gaps(pr.model_id, y, pr.params, g0)
+    model_gaps(pr.model_id, ynew, pr.params, g1)
+    assert np.flatnonzero((g0 > 0) != (g1 > 0)).tolist() == [0]  # only that contact changes
+    return y, ynew, f
+
+
+def test_a_located_contact_change_is_kept(settled):
+    """A change the onset retry locates within 1.5 onset steps of the step's start stays located (its time, the
+    gap being linear in time here: t + frac h), and a change located before survives a retry that locates none
+    and a refusal by the error test without a contact change; it was -inf (forgotten) on those paths, and
+    predicted again from the retry."""
+    from cageless.simulation.integrators.ark import _onset_retry, _refused_across
+    from cageless.simulation.kernels import model_signature
+
+    pr, _ = settled
+    ho = pr.onset_step
+    h, t, n = 10 * ho, 0.01, 3 * pr.n_balls
+    scratch = [np.zeros(n), np.zeros(n), np.zeros_like(pr.y0)]
+    y, ynew, f = _outer_gap_closing(pr, 0.1, h)
+    h_retry, t_cross = _onset_retry(pr.model_id, pr.params, t, h, y, ynew, f, f, ho, -np.inf, *scratch)
+    assert h_retry == ho and t_cross == pytest.approx(t + 0.1 * h, abs=1e-6 * ho)
+    y, ynew, f = _outer_gap_closing(pr, 0.5, h)
+    h_retry, t_cross = _onset_retry(pr.model_id, pr.params, t, h, y, ynew, f, f, ho, -np.inf, *scratch)
+    assert h_retry == pytest.approx(0.5 * h - 0.5 * ho) and t_cross == pytest.approx(t + 0.5 * h, abs=1e-6 * ho)
+    assert _onset_retry(pr.model_id, pr.params, t, h, y, y, f * 0, f * 0, ho, t + 7 * ho, *scratch) == (ho, t + 7 * ho)
+    sig = model_signature(pr.model_id, y, pr.params)
+    cnt = np.zeros(8, dtype=np.int64)
+    assert _refused_across(pr.model_id, pr.params, t, h, y, y, f, f, 0.6 * h, ho, sig, t + 7 * ho, *scratch, 2.0,
+                           cnt) == (0.6 * h, t + 7 * ho)
+    assert cnt[4] == 0
+
+
+def test_onset_ahead_stops_predicting_after_passed_predictions(settled):
+    """A predicted contact change (the Euler predictor's gap closing at 0.1 of a 10-onset-step step: within 2.5
+    onset steps, so the onset step crosses it) is located; after AHEAD_MISSES predictions in a row were passed
+    without a change, none is (a grazing gap would hold the loop at onset steps), until a step predicts none or a
+    change is accepted (:func:`_passed`)."""
+    from cageless.simulation.integrators.ark import AHEAD_MISSES, _onset_ahead, _passed
+
+    pr, _ = settled
+    ho = pr.onset_step
+    h, t, n = 10 * ho, 0.01, 3 * pr.n_balls
+    scratch = [np.zeros(n), np.zeros(n), np.zeros_like(pr.y0)]
+    y, _, f = _outer_gap_closing(pr, 0.1, h)
+    assert AHEAD_MISSES == 2
+    h_ahead, t_cross, misses = _onset_ahead(pr.model_id, pr.params, t, h, y, f, ho, -np.inf, 1, *scratch)
+    assert h_ahead == ho and t_cross == pytest.approx(t + 0.1 * h) and misses == 1
+    assert _onset_ahead(pr.model_id, pr.params, t, h, y, f, ho, -np.inf, AHEAD_MISSES, *scratch) == (h, -np.inf, 2)
+    assert _onset_ahead(pr.model_id, pr.params, t, h, y, f * 0, ho, -np.inf, AHEAD_MISSES, *scratch) == (h, -np.inf, 0)
+    cnt = np.zeros(8, dtype=np.int64)
+    assert _passed(1, 0, t, ho, t + 0.5 * ho, cnt) == 2  # passed the predicted change without one
+    assert _passed(1, 0, t, ho, t + 2 * ho, cnt) == 1  # not yet there
+    assert _passed(2, 3, t, ho, t + 0.5 * ho, cnt) == 0 and cnt[5] == 1  # a change accepted
+
+
+def test_ark4_caps_its_steps_on_a_bearing_by_default(settled):
+    """Without ``max_step``, ark4 on a problem with contacts steps at most ARK_MAX_STEP_S (50 us), as ``auto``
+    runs it: uncapped it was 0.0156 pp off the tight reference (DP5, rtol 1e-10, 0.25 us) over the settled 20 ms
+    planar window at 3000 rpm, 500 N, past the 0.01 pp bar, and 0.0031 pp capped (docs/imex.md, the eighth
+    step). A problem without contacts stays uncapped (test_stiff_damping_does_not_limit_the_step)."""
+    from cageless.simulation.solve import ARK_MAX_STEP_S
+
+    pr, _ = settled
+    t = np.linspace(0.0, 1e-3, 5)[1:]
+    default = solve(pr, t, method="ark4")
+    capped = solve(pr, t, method="ark4", max_step=ARK_MAX_STEP_S)
+    assert ARK_MAX_STEP_S == 5e-5
+    assert default.n_steps == capped.n_steps and np.array_equal(default.y, capped.y)
+    assert solve(pr, t, method="ark4", max_step=1.0).n_steps < default.n_steps
