@@ -43,8 +43,8 @@ from cageless.tracking.lobes import relock_lobes
 from cageless.tracking.locate import BearingLocation, background_frame, locate_bearing
 from cageless.tracking.locate_motion import (DROPOUT_GAIN, frame_gains, holds_the_motion, locate_by_motion, motion_map,
                                              plausible_band)
-from cageless.tracking.qc import (QC_LIMITS, QCReport, build_qc, refuse_located, refuse_selection, slip_warnings,
-                                  write_qc, write_selection_qc)
+from cageless.tracking.qc import (QC_LIMITS, QCReport, build_qc, refuse_located, refuse_selection, selection_frame,
+                                  slip_warnings, write_qc, write_selection_qc)
 from cageless.tracking.qc import qc_stem as _stem
 from cageless.tracking.segments import MIN_SEGMENT, OVERLAP, bounds_at_anchors, stitch
 from cageless.tracking.select import SPEED_BAND, Selection, SelectionError, select_balls
@@ -412,7 +412,7 @@ def track_video(
         try:
             loc, frames, setup, sel = _select(video, loc, background, bearing, options, conditions, path)
         except SelectionError as exc:
-            refuse_selection(exc, path, video[0], loc.crop(video.frame_shape), out_dir)
+            refuse_selection(exc, path, video.__getitem__, loc.crop(video.frame_shape), out_dir)
         rows, cols = frames.rows, frames.cols
         with tqdm(total=len(video), desc=path.name, unit="frame", disable=not progress, leave=False) as bar:
             table = _track_all(path, fps, video, frames, times, setup, options, bar.update)
@@ -426,7 +426,7 @@ def track_video(
                             [str(w.message) for w in caught],
                             _selection_summary(sel, cols.start, rows.start) | {"balls_moved_to_common_lobe": moved})
         selection_table = sel.table.assign(u_px=sel.table.u_px + cols.start, v_px=sel.table.v_px + rows.start)
-        first_frame = video[0] if out_dir is not None else None
+        shown_frame = video[selection_frame(sel.table)] if out_dir is not None else None
     for w in caught:  # recorded for QC; still shown to the caller
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     written = None
@@ -438,7 +438,7 @@ def track_video(
             write_trace(pending, trace)
             write_qc(out_dir / "qc", _stem(path), path, qc, table, trace, options.qc_frames, fps,
                      allow_truncated=options.allow_truncated)
-            write_selection_qc(out_dir / "qc", _stem(path), first_frame, selection_table, sel.ring,
+            write_selection_qc(out_dir / "qc", _stem(path), shown_frame, selection_table, sel.ring,
                                (cols.start, rows.start), f"{qc.n_balls_found} balls selected")
         written = target
     return TrackResult(trace=trace, table=table, qc=qc, path=written)

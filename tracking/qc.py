@@ -14,6 +14,7 @@ import json
 import logging
 import math
 import textwrap
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, NoReturn
@@ -33,7 +34,7 @@ from cageless.tracking.locate import BearingLocation
 from cageless.tracking.select import SelectionError
 
 __all__ = ["QC_LIMITS", "QCReport", "build_qc", "write_qc", "slip_warnings", "loaded_zone_speed_ratio",
-           "write_selection_qc", "write_refusal_qc", "refuse_selection", "refuse_located", "qc_stem", "REASON_COLOURS"]
+           "write_selection_qc", "selection_frame", "write_refusal_qc", "refuse_selection", "refuse_located", "qc_stem", "REASON_COLOURS"]
 
 log = logging.getLogger(__name__)
 
@@ -254,11 +255,23 @@ REASON_COLOURS = {
 }
 
 
+def selection_frame(table: pd.DataFrame) -> int:
+    """The frame the selection QC image shows: the first burst's most common first frame of a candidate tracklet,
+    among the selected ones where there are any (0 without candidates). A candidate's position is its position
+    in its first frame, so the marks of the candidates that start there sit on their highlights."""
+    if table.empty or "frame" not in table:
+        return 0
+    first = table[table.burst == table.burst.min()] if "burst" in table else table
+    chosen = first[first.status == "selected"] if "status" in table else first
+    return int((chosen if len(chosen) else first).frame.mode().min())
+
+
 def write_selection_qc(qc_dir: Path, stem: str, frame: np.ndarray | None, table: pd.DataFrame, ring: Any,
                        offset: tuple[int, int], title: str) -> Path:
-    """Write ``<stem>.candidates.csv`` (every candidate tracklet, its status and reason) and
-    ``<stem>.selection.png``: the first frame with every candidate marked in its reason's colour, the
-    chosen ball circle and a legend. Returns the PNG's path."""
+    """Write ``<stem>.candidates.csv`` (every candidate tracklet of every burst, its status and reason) and
+    ``<stem>.selection.png``: ``frame``, the frame :func:`selection_frame` names, with the candidates of the burst
+    that starts there marked in their reason's colour, the chosen ball circle and a legend of that burst's
+    counts. Returns the PNG's path."""
     qc_dir.mkdir(parents=True, exist_ok=True)
     atomic_write_text(qc_dir / f"{stem}.candidates.csv", table.to_csv(index=False, float_format="%.4f"))
     target = qc_dir / f"{stem}.selection.png"
@@ -268,13 +281,17 @@ def write_selection_qc(qc_dir: Path, stem: str, frame: np.ndarray | None, table:
     if ring is not None:
         c = (int(round((ring.centre[0] + offset[0]) * scale)), int(round((ring.centre[1] + offset[1]) * scale)))
         cv2.circle(img, c, int(round(ring.radius * scale)), (0, 200, 255), 1, cv2.LINE_AA)
-    for r in table.itertuples():
+    index = selection_frame(table)
+    shown = table[table.frame == index] if "frame" in table else table
+    for r in shown.itertuples():
         reason = "selected" if r.status == "selected" else r.reason
         colour = REASON_COLOURS.get(reason, (255, 255, 255))
         p = (int(round(r.u_px * scale)), int(round(r.v_px * scale)))
         cv2.circle(img, p, 3 * scale if r.status == "selected" else 2 * scale, colour, 1, cv2.LINE_AA)
-    counts = table.assign(key=np.where(table.status == "selected", "selected", table.reason)).key.value_counts()
-    y = _write_title(img, title)
+    counts = shown.assign(key=np.where(shown.status == "selected", "selected", shown.reason)).key.value_counts()
+    bursts = int(table.burst.nunique()) if "burst" in table and not table.empty else 1
+    y = _write_title(img, f"{title} (frame {index}: the candidates that start there, of {bursts} bursts; all in "
+                            f"{stem}.candidates.csv)")
     for reason, n in counts.items():
         y += 16
         _put_text(img, f"{reason}: {n}", y, REASON_COLOURS.get(str(reason), (255, 255, 255)))
@@ -330,14 +347,16 @@ def qc_stem(path: Path) -> str:
     return path.name if path.is_dir() else path.stem
 
 
-def refuse_selection(exc: SelectionError, path: Path, first_frame: np.ndarray, crop: tuple[slice, slice],
-                     out_dir: str | Path | None) -> NoReturn:
+def refuse_selection(exc: SelectionError, path: Path, frame_at: Callable[[int], np.ndarray],
+                     crop: tuple[slice, slice], out_dir: str | Path | None) -> NoReturn:
     """Re-raise a failed ball selection; with ``out_dir``, first write its QC image of every candidate and the
-    reason it was rejected (candidates in the ``crop`` = (rows, cols) of the frame), and name it in the message."""
+    reason it was rejected (candidates in the ``crop`` = (rows, cols) of the frame ``frame_at(i)`` gives), and
+    name it in the message."""
     rows, cols = crop
     if out_dir is not None and exc.table is not None:
         shown = exc.table.assign(u_px=exc.table.u_px + cols.start, v_px=exc.table.v_px + rows.start)
-        png = write_selection_qc(Path(out_dir) / "qc", qc_stem(path), first_frame, shown, exc.ring,
+        frame = frame_at(selection_frame(shown))
+        png = write_selection_qc(Path(out_dir) / "qc", qc_stem(path), frame, shown, exc.ring,
                                  (cols.start, rows.start), exc.message)
         raise SelectionError(path, f"{exc.message} No trace written; QC: {png}.", exc.hint,
                              exc.table, exc.found, exc.ring) from None

@@ -121,6 +121,31 @@ def test_bright_ring_faces_give_exactly_the_bearings_balls(bright):
     assert (d / "out" / "qc" / "bright.selection.png").is_file()
 
 
+def test_the_selection_image_marks_the_candidates_on_the_frame_they_were_found_in(bright, tmp_path):
+    """The selection QC image shows the frame where most of the first burst's candidates start, with those
+    candidates, each at its position there: on its highlight. (It showed frame 0 with every burst's candidates, which sat beside the
+    highlights: a new user's trial. At frame 0 the same positions lie off the highlights, the balls having
+    moved some 30 px since.)"""
+    from cageless.tracking.io import open_video
+    from cageless.tracking.qc import selection_frame
+
+    _, clip = bright
+    track_video(clip["video"], OperatingConditions(3000, 500), B, out_dir=tmp_path, progress=False)
+    table = pd.read_csv(tmp_path / "qc" / "bright.candidates.csv")
+    index = selection_frame(table)
+    assert index > 0 and index in set(table.loc[table.burst == table.burst.min(), "frame"])
+    chosen = table[(table.frame == index) & (table.status == "selected")]
+    assert len(chosen) == 14
+    with open_video(clip["video"]) as video:
+        def at(frame: np.ndarray) -> np.ndarray:
+            return frame[np.rint(chosen.v_px).astype(int), np.rint(chosen.u_px).astype(int)].astype(float)
+
+        shown, first = video[index], video[0]
+        background = float(np.median(shown))  # about 80 counts; the highlights' peaks 2,500-4,100
+        assert np.all(at(shown) > 20 * background)  # every mark on a highlight of the frame shown
+        assert np.median(at(first)) < 5 * background  # frame 0 would have put most beside the highlights
+
+
 def test_the_selection_is_the_same_on_one_or_two_threads(bright):
     """The candidates of a burst's frames found on two threads: the same choice, tracklets and table."""
     from dataclasses import replace
