@@ -227,7 +227,7 @@ def _warn_disagreement(video: Path, sources: list[tuple[str, Mapping[str, float]
 
 def resolve_conditions(
     video: str | Path, csv_table: Mapping[str, Mapping[str, float]] | None = None,
-    fallback_speed_rpm: float | None = None, fallback: Mapping[str, float] | None = None,
+    fallback: Mapping[str, float] | None = None,
 ) -> ResolvedConditions:
     """Merge a video's conditions from sidecar, ``conditions.csv`` and file name.
 
@@ -238,12 +238,10 @@ def resolve_conditions(
     csv_table
         An already-read ``conditions.csv`` (see :func:`read_conditions_csv`). When
         ``None``, the folder's ``conditions.csv`` is read if present.
-    fallback_speed_rpm
-        A speed for a video whose sources give none (``track --speed-rpm``); the
-        other keys its sources give are kept.
     fallback
-        The same for any of ``speed_rpm``, ``radial_load_n`` and ``axial_load_n``
-        (``track --radial-load-n``): each stands in where no source gives that key.
+        Values of ``speed_rpm``, ``radial_load_n`` or ``axial_load_n`` typed on the
+        command line (``track --speed-rpm``): each stands in where no source gives
+        that key; the other keys the sources give are kept.
 
     A video whose sources give no radial load is resolved at 0 N (an unloaded
     bearing) with a warning naming where to give it.
@@ -254,27 +252,8 @@ def resolve_conditions(
         When a source is malformed, or no source gives ``speed_rpm``.
     """
     video = Path(video)
-    if csv_table is None:
-        csv_path = video.parent / CONDITIONS_CSV
-        row_errors: dict[str, ConditionsError] = {}
-        csv_table = _read_csv_for(video, csv_path, row_errors) if csv_path.is_file() else {}
-        row_error = _csv_row_error(video, row_errors)
-        if row_error is not None:
-            raise row_error
-    sources: list[tuple[str, Mapping[str, float] | None]] = []
-    sidecar = _sidecar_for(video)
-    sources.append((f"sidecar {sidecar.name}" if sidecar else "", read_sidecar(sidecar) if sidecar else None))
-    sources.append((CONDITIONS_CSV, _csv_row(video, csv_table)))
-    sources.append(("file name", parse_file_name(video)))
-    _warn_disagreement(video, sources)
-    merged: dict[str, float] = {}
-    origin: dict[str, str] = {}
-    for label, values in reversed(sources):  # lowest precedence first, higher ones overwrite
-        for key, value in (values or {}).items():
-            merged[key] = value
-            origin[key] = label
-    typed = {**({"speed_rpm": fallback_speed_rpm} if fallback_speed_rpm is not None else {}), **(fallback or {})}
-    for key, value in typed.items():
+    merged, origin = _merged_sources(video, csv_table)
+    for key, value in (fallback or {}).items():
         if key not in merged and value is not None:
             merged[key], origin[key] = float(value), "--" + key.replace("_", "-")
     if "speed_rpm" not in merged:
@@ -296,6 +275,33 @@ def resolve_conditions(
     except ParameterError as exc:
         raise ConditionsError(video, f"invalid condition from {origin.get(exc.parameter, 'a source')}: {exc}") from exc
     return ResolvedConditions(video=video, conditions=conditions, origin=origin, bearing_keys=bearing_keys)
+
+
+def _merged_sources(video: Path, csv_table: Mapping[str, Mapping[str, float]] | None
+                    ) -> tuple[dict[str, float], dict[str, str]]:
+    """The keys a video's sources give, higher precedence winning, and which source gave each (see
+    :func:`resolve_conditions`); the folder's ``conditions.csv`` is read when ``csv_table`` is None."""
+    if csv_table is None:
+        csv_path = video.parent / CONDITIONS_CSV
+        row_errors: dict[str, ConditionsError] = {}
+        csv_table = _read_csv_for(video, csv_path, row_errors) if csv_path.is_file() else {}
+        row_error = _csv_row_error(video, row_errors)
+        if row_error is not None:
+            raise row_error
+    sidecar = _sidecar_for(video)
+    sources: list[tuple[str, Mapping[str, float] | None]] = [
+        (f"sidecar {sidecar.name}" if sidecar else "", read_sidecar(sidecar) if sidecar else None),
+        (CONDITIONS_CSV, _csv_row(video, csv_table)),
+        ("file name", parse_file_name(video)),
+    ]
+    _warn_disagreement(video, sources)
+    merged: dict[str, float] = {}
+    origin: dict[str, str] = {}
+    for label, values in reversed(sources):  # lowest precedence first, higher ones overwrite
+        for key, value in (values or {}).items():
+            merged[key] = value
+            origin[key] = label
+    return merged, origin
 
 
 def bearing_with_keys(bearing: Bearing, resolved: ResolvedConditions) -> Bearing:
@@ -396,12 +402,11 @@ def refuse_shared_names(entries: list[LabEntry]) -> list[LabEntry]:
     return out
 
 
-def discover_lab(folder: str | Path, fallback_speed_rpm: float | None = None,
-                 fallback: Mapping[str, float] | None = None) -> list[LabEntry]:
+def discover_lab(folder: str | Path, fallback: Mapping[str, float] | None = None) -> list[LabEntry]:
     """Find every video of a lab folder and resolve its conditions.
 
-    ``fallback_speed_rpm`` is the speed of a video whose sources give none, and ``fallback`` the same for the
-    loads too (see :func:`resolve_conditions`).
+    ``fallback`` holds values typed on the command line for videos whose sources give none (see
+    :func:`resolve_conditions`).
 
     A video whose conditions cannot be resolved gets an entry carrying the
     error; the others are unaffected. A bad row of ``conditions.csv`` fails only
@@ -438,7 +443,7 @@ def discover_lab(folder: str | Path, fallback_speed_rpm: float | None = None,
             entries.append(LabEntry(video=video, error=error))
             continue
         try:
-            resolved = resolve_conditions(video, table, fallback_speed_rpm, fallback)
+            resolved = resolve_conditions(video, table, fallback)
             entries.append(LabEntry(video=video, resolved=resolved))
         except ConditionsError as exc:
             entries.append(LabEntry(video=video, error=exc))

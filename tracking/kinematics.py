@@ -127,9 +127,15 @@ def robust_track_fit(time_s: npt.ArrayLike, angle: npt.ArrayLike, valid: npt.Arr
     design = np.stack([np.ones_like(x), x, x * x], axis=-1)  # (T, frames, 3)
     out = a.copy()
     keep = ok.copy()
-    if exact:  # compiled, column by column (see _robust_columns)
-        _robust_columns(design, a, ok, start, idx, passes, out, keep)
-        return out, keep
+    (_robust_columns if exact else _robust_columns_numpy)(design, a, ok, start, idx, passes, out, keep)
+    return out, keep
+
+
+def _robust_columns_numpy(design: np.ndarray, a: np.ndarray, ok: np.ndarray, start: np.ndarray, idx: np.ndarray,
+                          passes: int, out: np.ndarray, keep: np.ndarray) -> None:
+    """:func:`_robust_columns` by numpy's matrix products and LAPACK's solve (``exact=False`` of
+    :func:`robust_track_fit`, the reference the compiled form is tested against), into ``out`` and ``keep``."""
+    n = len(start)
     for j in range(a.shape[1]):
         y = a[idx, j]
         base = ok[idx, j].astype(np.float64)
@@ -147,7 +153,6 @@ def robust_track_fit(time_s: npt.ArrayLike, angle: npt.ArrayLike, valid: npt.Arr
         out[good, j] = fit[good, 0]
         own = w[np.arange(n), np.arange(n) - start]
         keep[:, j] = ok[:, j] & (own > 0)
-    return out, keep
 
 
 def _weighted_quadratic(design: np.ndarray, y: np.ndarray, w: np.ndarray) -> np.ndarray:
