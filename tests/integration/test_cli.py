@@ -279,3 +279,20 @@ def test_compare_given_a_video_says_to_track_it(tmp_path, capsys):
     assert main(["compare", str(video), str(video)]) == 1
     err = capsys.readouterr().err
     assert "clip.mkv: is a video, not a trace" in err and "cageless track" in err and "HDF5" not in err
+
+
+def test_progress_bars_only_on_a_terminal(tmp_path, capsys, monkeypatch):
+    """Standard error in a file or a pipe gets the result lines, not the bar's redraws (a new user's trial
+    found each `ok`/`FAILED` line followed by another copy of the bar); on a terminal the bar is drawn."""
+    import cageless.app.cli as cli
+
+    lab = tmp_path / "lab"
+    lab.mkdir()
+    for name in ("n3000_Fr500.cine", "n1800_Fr500.cine"):
+        (lab / name).write_bytes(b"NOPE" * 20)  # each fails while tracking, after the bar is drawn
+    assert main(["track", str(lab), "-o", str(tmp_path / "o")]) == 1
+    err = capsys.readouterr().err.splitlines()
+    assert [line.split(":")[0] for line in err if line.strip()] == ["FAILED n1800_Fr500.cine", "FAILED n3000_Fr500.cine"]
+    monkeypatch.setattr(cli, "_on_terminal", lambda stream: True)
+    assert main(["track", str(lab), "-o", str(tmp_path / "o2")]) == 1
+    assert "videos: 100%" in capsys.readouterr().err

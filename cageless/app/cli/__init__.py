@@ -123,6 +123,15 @@ def _parse(parser: ArgumentParser, argv: Sequence[str]) -> argparse.Namespace:
     raise UsageError(f"{prog}: unrecognized arguments: {' '.join(extra)}.{hint}\nRun '{prog} --help' for usage.")
 
 
+def _on_terminal(stream: object) -> bool:
+    """True when ``stream`` is a terminal: progress bars are drawn only there. In a log file or a pipe each
+    redraw (at every ``ok``/``FAILED`` line) would be one more copy of the bar's last state."""
+    try:
+        return bool(stream.isatty())  # type: ignore[attr-defined]
+    except (AttributeError, ValueError):  # no isatty, or a closed stream
+        return False
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI in-process and return its exit code.
 
@@ -146,6 +155,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             parser.print_help()
             return EXIT_USAGE
         setup_logging(args.quiet, args.verbose)
+        args.progress = not args.quiet and _on_terminal(sys.stderr)
         _check_scheduler(args)
         module = importlib.import_module(f"cageless.app.cli.{args.command}")
         from tqdm.contrib.logging import logging_redirect_tqdm

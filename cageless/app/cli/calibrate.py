@@ -92,7 +92,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
         raise UsageError(f"--workers must be >= 1, got {args.workers}")
     target = _target(args)
     res = calibrate(target, bounds, args.budget, args.seeds, args.metric, args.settle, fixed, bearing, args.workers,
-                    args.scheduler, progress=not args.quiet)
+                    args.scheduler, progress=args.progress)
     out = write_calibration(args.out or default_out_name(res), calibration_document(res, config.get("bearing")))
     what = "peak miss" if target.profile is None else args.metric.upper()
     for row in res.evaluations:

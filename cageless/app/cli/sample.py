@@ -51,7 +51,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
         _refuse_foreign(out, targets, args.overwrite)
         _record(out, targets, done=False)
         results = make_lab(out, preset=args.preset, seed=args.seed, revolutions=args.revolutions,
-                           geometry=geometry, workers=max(1, args.workers), progress=not args.quiet)
+                           geometry=geometry, workers=max(1, args.workers), progress=args.progress)
         _record(out, targets, done=True)
     for res in results:
         print(f"{res['video']}: {res['n_frames']} frames, truth in {res['truth_csv'].name}")

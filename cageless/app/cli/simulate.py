@@ -212,13 +212,13 @@ def _run(args: argparse.Namespace, scene: Any, choices: Any, config: dict[str, A
         print(f"duration: {args.duration:g} s (the start-up that compare leaves out, then one cage revolution; "
               "--duration changes it)")
     if args.ensemble == 1:
-        trace = sim.run(out=out, progress=not args.quiet, config=config)
+        trace = sim.run(out=out, progress=args.progress, config=config)
         print(f"effects: {', '.join(choice.active)}")
         print(_summary_line(trace, sim.solution, out))
         return 0 if sim.solution.success else 1
     from cageless.simulation.ensemble import run_ensemble
 
-    rows = run_ensemble(sim, args.ensemble, out, progress=not args.quiet, scheduler=args.scheduler, config=config)
+    rows = run_ensemble(sim, args.ensemble, out, progress=args.progress, scheduler=args.scheduler, config=config)
     print(f"effects: {', '.join(choice.active)}")
     for row in rows:
         print(f"seed {row['seed']}: {row['summary']}")

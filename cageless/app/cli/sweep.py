@@ -68,7 +68,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     from cageless.simulation.effects import parse_effect_overrides
 
     runs = run_sweep(vary, args.seeds, args.speed_rpm, args.radial_load_n, args.axial_load_n, args.duration,
-                     args.settle, fixed, bearing, args.workers, args.scheduler, progress=not args.quiet,
+                     args.settle, fixed, bearing, args.workers, args.scheduler, progress=args.progress,
                      effects=parse_effect_overrides(args.effect))
     paths = write_sweep(runs, list(vary), args.out)
     note = describe_calibration(config.get("calibration"))

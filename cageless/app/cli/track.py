@@ -230,7 +230,7 @@ def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bear
         from cageless.app.lab import say_if_compiling
 
         say_if_compiling("tracking")
-    with tqdm(total=len(jobs), desc="videos", unit="video", disable=args.quiet or not jobs) as bar:
+    with tqdm(total=len(jobs), desc="videos", unit="video", disable=not args.progress or not jobs) as bar:
         results = _map(jobs, workers, bar)
         for (video, *_), (status, info) in zip(jobs, results, strict=True):
             if status == "ok":
