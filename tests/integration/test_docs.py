@@ -56,3 +56,18 @@ def test_tutorial_runs_as_written(tmp_path):
     text = (DOCS / "tutorial.md").read_text(encoding="utf-8")
     for block in _blocks(text, "python"):
         subprocess.run([sys.executable, "-c", block], cwd=tmp_path, check=True, timeout=120)
+
+
+def test_api_tour_runs_as_written(tmp_path):
+    """docs/api.md's quick tour runs from a folder that sees the sample lab: the 6000 rpm clip has 14 balls in
+    84 frames (sample_data/lab/README.md) and its simulated run succeeds."""
+    blocks = _blocks((DOCS / "api.md").read_text(encoding="utf-8"), "python")
+    assert len(blocks) == 1
+    (tmp_path / "sample_data").symlink_to(REPO_ROOT / "sample_data")
+    run = subprocess.run([sys.executable, "-c", blocks[0]], cwd=tmp_path, capture_output=True, text=True,
+                         timeout=900)
+    assert run.returncode == 0, run.stdout + run.stderr
+    lines = run.stdout.splitlines()
+    assert lines[0] == "14 (84, 14)"
+    assert lines[-2].startswith("True (")
+    assert re.fullmatch(r"\d+\.\d\d % simulated, \d+\.\d\d % measured, MAE \d+\.\d\d pp", lines[-1])
