@@ -32,6 +32,7 @@ import sys
 import time
 from collections.abc import Callable, Iterable
 from concurrent.futures import Future
+from contextvars import ContextVar
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -241,7 +242,8 @@ def _run_jobs(pool: Any, jobs: list[tuple[Callable[..., tuple[str, str]], tuple[
               progress: bool, labels: list[str] | None = None) -> list[tuple[str, str]]:
     futures: list[Future[Any]] = [pool.submit(fn, *args) for fn, args in jobs]
     out = []
-    for i, fut in enumerate(tqdm(futures, desc=desc, disable=not progress or not futures, leave=False)):
+    bar = tqdm(futures, desc=desc, disable=not (progress and _BARS.get()) or not futures, leave=False)
+    for i, fut in enumerate(bar):
         try:
             out.append(fut.result())
         except Exception as exc:  # a crashed worker fails its job only  # noqa: BLE001
@@ -305,17 +307,28 @@ def _duration(key: tuple[float, float, float], video_s: Iterable[float], bearing
     return settle + max([*video_s, options.revolutions * 2 * math.pi / cage])
 
 
+#: Whether the stages draw progress bars while a :func:`run_lab` that says its progress runs.
+_BARS: ContextVar[bool] = ContextVar("cageless_lab_bars", default=True)
+
+
 def run_lab(folder: str | Path, out: str | Path, options: LabOptions | None = None, bearing: Bearing | None = None,
-            progress: bool = True) -> LabResult:
+            progress: bool = True, bars: bool | None = None) -> LabResult:
     """Run the whole workflow on a lab folder; see the module docstring.
+
+    With ``progress`` a failure is said on standard error when it happens, and so is a first compile; ``bars``
+    (default: ``progress``) draws progress bars as well (the command line draws them only on a terminal).
 
     The output folder is locked for the run: a second run into it is refused (:class:`FolderInUseError`),
     and temporary files that killed runs left there are removed first.
     """
     out = Path(out)
-    with output_lock(out, "report folder"):
-        clean_stale_parts(out)
-        return _run_lab(folder, out, options, bearing, progress)
+    token = _BARS.set(progress if bars is None else bars)
+    try:
+        with output_lock(out, "report folder"):
+            clean_stale_parts(out)
+            return _run_lab(folder, out, options, bearing, progress)
+    finally:
+        _BARS.reset(token)
 
 
 def _run_lab(folder: str | Path, out: Path, options: LabOptions | None, bearing: Bearing | None,

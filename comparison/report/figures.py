@@ -24,18 +24,27 @@ __all__ = ["speed_figure", "slip_figure", "contact_polar_figure", "ring_figure",
 _STYLE = {"font.size": 8, "axes.grid": True, "grid.alpha": 0.3, "svg.fonttype": "none"}
 
 
-def _svg(draw: Callable[[Any], None], size: tuple[float, float] = (5.6, 3.0), polar: bool = False) -> str:
+def _svg(draw: Callable[[Any], None], size: tuple[float, float] = (5.6, 3.0), polar: bool = False,
+         layout: str = "tight") -> str:
+    """``draw(fig)`` on a new figure of ``size`` inches, as SVG text. ``layout="constrained"`` leaves room for
+    a legend placed outside the axes (``fig.legend(loc="outside lower center")``)."""
     with matplotlib.rc_context(_STYLE):
-        fig = plt.figure(figsize=size)
+        fig = plt.figure(figsize=size, layout="constrained" if layout == "constrained" else None)
         try:
             draw(fig)
-            fig.tight_layout()
+            if layout != "constrained":
+                fig.tight_layout()
             buf = io.StringIO()
             fig.savefig(buf, format="svg")
         finally:
             plt.close(fig)
     text = buf.getvalue()
     return text[text.index("<svg"):]
+
+
+def _legend_below(fig: Any, ax: Any) -> None:
+    """The axes' legend under the plot, in two columns, where it covers no curve."""
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=2, fontsize=7, frameon=False)
 
 
 def _profile(ax: Any, prof: Any, scale: float, label: str, colour: str) -> None:
@@ -56,11 +65,11 @@ def speed_figure(d: ConditionDescription) -> str:
         ax.set(xlabel="orbital angle (deg)", ylabel="revolution speed (r/min)", xlim=(0, 360))
         ax.axvspan(0, 180, color="0.9", zorder=0, label="unloaded zone")
         ax.fill_between([], [], [], color="0.3", alpha=0.2, lw=0, label="band: mean +- 1 std of samples")
-        ax.legend(fontsize=7)
-    return _svg(draw)
+        _legend_below(fig, ax)
+    return _svg(draw, size=(5.6, 3.4), layout="constrained")
 
 
-def slip_figure(d: ConditionDescription, size: tuple[float, float] = (5.6, 3.0)) -> str:
+def slip_figure(d: ConditionDescription, size: tuple[float, float] = (5.6, 3.4)) -> str:
     """Slip rate against orbital angle with its spread (mean +- std over balls and revolutions)."""
     c = d.comparison
     assert c is not None
@@ -75,8 +84,8 @@ def slip_figure(d: ConditionDescription, size: tuple[float, float] = (5.6, 3.0))
         ax.plot([], [], color="0.3", lw=1.6, ls="--", label=f"smoothed, sigma {PEAK_SMOOTHING_DEG:g} deg")
         ax.fill_between([], [], [], color="0.3", alpha=0.2, lw=0, label="band: mean +- 1 std of samples")
         ax.set(xlabel="orbital angle (deg)", ylabel="slip rate (%)", xlim=(0, 360))
-        ax.legend(fontsize=7)
-    return _svg(draw, size=size)
+        _legend_below(fig, ax)
+    return _svg(draw, size=size, layout="constrained")
 
 
 def contact_polar_figure(d: ConditionDescription) -> str:
@@ -92,7 +101,7 @@ def contact_polar_figure(d: ConditionDescription) -> str:
                 sel = ev[ev.kind == kind]
                 force = sel.peak_force.to_numpy() if floor is None else np.maximum(sel.peak_force.to_numpy(), floor)
                 ax.scatter(sel.angle, force, s=6, color=colour, label=f"{kind} ({len(sel)})")
-            ax.legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.25, -0.15))
+            _legend_below(fig, ax)
             if floor is not None:
                 ax.set_rscale("log")
                 ax.set_rlim(floor, 1.3 * float(np.nanmax(ev.peak_force)))
@@ -103,7 +112,7 @@ def contact_polar_figure(d: ConditionDescription) -> str:
         else:
             ax.set_title("no ball-ball contact after the start-up", fontsize=8)
         ax.set_xlabel(label, fontsize=8)
-    return _svg(draw, size=(3.6, 3.6))
+    return _svg(draw, size=(3.6, 4.0), layout="constrained")
 
 
 #: Decades of peak force the polar plot's logarithmic radius shows below the largest.

@@ -25,7 +25,7 @@ th{background:#f3f3f3}tr.failed td{background:#fde8e8}tr.mismatch td,tr.tracking
 .note{font-size:.85em;color:#555}.fig{display:inline-block;margin:.5em;vertical-align:top}
 .fig img{max-width:100%;height:auto}figcaption{font-size:.85em;color:#444}
 .cards{display:flex;flex-wrap:wrap;gap:.8em}.card{border:1px solid #ccc;border-radius:6px;padding:.6em;width:22em}
-.card h3{margin:.1em 0 .3em}.pass{color:#17622b;font-weight:600}.fail{color:#a11;font-weight:600}
+.card h3{margin:.1em 0 .3em}.thumb{margin:.4em 0 0}.thumb img{width:100%}.thumb figcaption{font-size:.8em;color:#555}.pass{color:#17622b;font-weight:600}.fail{color:#a11;font-weight:600}
 .kv td{text-align:left}.kv td:first-child{color:#555}.failed-box{background:#fde8e8;padding:.5em}
 </style></head><body>
 <h1>{{ r.title }}</h1><p class="note">Generated {{ r.generated_utc }}.</p>
@@ -33,7 +33,7 @@ th{background:#f3f3f3}tr.failed td{background:#fde8e8}tr.mismatch td,tr.tracking
 <div class="cards">{% for s in r.summary %}<div class="card"><h3>{{ s.title }}</h3><div>{{ s.condition }}</div>
 <div>slip: model {{ s.theoretical }}, experiment {{ s.experimental }}; MAE {{ s.mae }}</div>
 <div>tracking QC: {% if s.qc_pass %}<span class="pass">pass</span>{% else %}<span class="fail">fail</span>: {{ s.qc_reasons | join('; ') }}{% endif %}</div>
-{% if s.svg %}<img alt="slip rate against orbital angle, measured and simulated" src="data:image/svg+xml;base64,{{ s.svg | b64 }}">{% endif %}</div>{% endfor %}
+{% if s.svg %}<figure class="thumb"><img alt="slip rate against orbital angle, measured and simulated" src="data:image/svg+xml;base64,{{ s.svg | b64 }}"><figcaption>Slip rate against orbital angle, mean over balls and revolutions; 0–180° is the unloaded zone.</figcaption></figure>{% endif %}</div>{% endfor %}
 {% for f in r.failures %}<div class="card"><h3>{{ f.title }}</h3><span class="fail">failed</span>: {{ f.message }}</div>{% endfor %}</div>
 <h2>Conditions</h2>
 <table><thead><tr><th>Speed (r/min)</th><th>Radial load (N)</th><th>Axial load (N)</th><th>Video</th><th>Status</th></tr></thead>

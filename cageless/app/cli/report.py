@@ -88,7 +88,8 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
         raise CagelessError(f"{args.lab}: no videos found. A lab folder holds videos (cine, avi/mp4/mkv or image "
                             "folders) with their conditions.")
     print(f"parameters: {note}" if note else f"parameters: set '{options.parameter_set}'")
-    res = run_lab(args.lab, args.out, options, bearing_from_config(config), progress=args.progress)
+    res = run_lab(args.lab, args.out, options, bearing_from_config(config), progress=not args.quiet,
+                  bars=args.progress)
     failed = []
     for row in sorted(res.rows, key=lambda r: (r.status == "failed", r.speed_rpm, r.radial_load_n, r.label)):
         if row.status == "failed":

@@ -211,6 +211,10 @@ def _run(args: argparse.Namespace, scene: Any, choices: Any, config: dict[str, A
     if getattr(args, "duration_default", False):
         print(f"duration: {args.duration:g} s (the start-up that compare leaves out, then one cage revolution; "
               "--duration changes it)")
+    if not args.quiet and not args.progress:  # with the bar, the run says it (standard error not a terminal)
+        from cageless.app.lab import say_if_compiling
+
+        say_if_compiling("simulation")
     if args.ensemble == 1:
         trace = sim.run(out=out, progress=args.progress, config=config)
         print(f"effects: {', '.join(choice.active)}")
