@@ -58,13 +58,14 @@ def clear_cache() -> int:
 
 def compile_notice() -> str | None:
     """A line for the user when the next simulation compiles the integrator first (after an install or an
-    upgrade, about one to five minutes on two cores), else ``None``."""
+    upgrade, about one to five minutes on two idle cores, up to ten on a busy machine), else ``None``."""
     from cageless.simulation.integrators.ark import ark_integrate
     from cageless.simulation.integrators.dp5 import dp5_integrate
 
     if is_compiled(dp5_integrate) is False:
-        return ("compiling the simulator (first run after an install or upgrade only; 1-5 min, then it is "
-                "cached; the progress bar stands still meanwhile, also when the run first changes solver)")
+        return ("compiling the simulator (first run after an install or upgrade only; 1-5 min, up to 10 on a busy "
+                "machine, then it is cached; the progress bar stands still meanwhile, also when the run first "
+                "changes solver)")
     if is_compiled(ark_integrate) is False:  # compiled when `auto` first switches to it, mid-run
         return ("compiling the simulator's implicit solver when the run first switches to it (after an install "
                 "or upgrade only; 1-3 min, then it is cached; the progress bar stands still meanwhile)")
