@@ -422,3 +422,15 @@ def test_a_cine_with_no_complete_frame_does_not_suggest_allow_truncated(tmp_path
     cut.write_bytes(data[:300])
     run = cli(capsys, "info", cut)
     assert_clean(run, 1, "lies past the end of the file", "re-copy it")
+
+
+def test_compare_given_the_traces_the_other_way_round_swaps_them(capsys, video_trace, sim_trace):
+    """A new user's trial typed the simulation first: the traces say which is which, so the run swaps them with a
+    warning and prints the same row as the right order."""
+    right = cli(capsys, "compare", video_trace, sim_trace, "--settle", "0")
+    swapped = cli(capsys, "compare", sim_trace, video_trace, "--settle", "0")
+    assert right.code == 0 and swapped.code == 0, swapped.text
+    assert "is the simulation and" in swapped.text and "is the simulation and" not in right.text
+    row = [ln for ln in right.text.splitlines() if ln.startswith("| ")][-1]
+    assert row in swapped.text
+    assert float(row.split("|")[5].split("±")[0]) > 0  # the theoretical slip (%), in the row the two share

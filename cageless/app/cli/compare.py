@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import argparse
+import logging
 from pathlib import Path
 from typing import Any
 
 from cageless.app.cli.common import finite_float
 
 __all__ = ["register", "run"]
+
+log = logging.getLogger(__name__)
 
 _EXAMPLES = """\
 examples:
@@ -26,7 +29,8 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
         "angle and print the Table-2-style row: theoretical and experimental slip, MAE, RMSE, maximum error.",
         epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("video_trace", help="trace of a video (source = video)")
+    p.add_argument("video_trace", help="trace of a video (source = video; given the other way round, the two "
+                   "are swapped with a warning)")
     p.add_argument("sim_trace", help="trace of a simulation (source = simulation)")
     p.add_argument("--bin-deg", type=finite_float, default=1.0, help="angle bin width (deg, default 1)")
     p.add_argument("--settle", type=finite_float,
@@ -58,10 +62,15 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     if args.figures:
         check_output_dir(args.figures, "--figures")
     measured, simulated = read_trace(args.video_trace), read_trace(args.sim_trace)
+    video_path = args.video_trace
+    if measured.source == "simulation" and simulated.source == "video":  # given the other way round: the traces say
+        log.warning("%s is the simulation and %s the video trace: compared as video %s against simulation %s",
+                    args.video_trace, args.sim_trace, args.sim_trace, args.video_trace)
+        measured, simulated, video_path = simulated, measured, args.sim_trace
     if measured.source != "video" or simulated.source != "simulation":
-        raise UsageError(f"give the video trace first and the simulation trace second (got {measured.source} "
-                         f"and {simulated.source}).")
-    c = compare(measured, simulated, args.bin_deg, args.settle, args.force, label=Path(args.video_trace).name,
+        raise UsageError(f"give a video trace and a simulation trace (got a {measured.source} trace, "
+                         f"{args.video_trace}, and a {simulated.source} trace, {args.sim_trace}).")
+    c = compare(measured, simulated, args.bin_deg, args.settle, args.force, label=Path(video_path).name,
                 slip_reference=args.slip_reference)
     print(to_markdown(table_frame([c.row])), end="")
     if args.slip_reference != "cage":
