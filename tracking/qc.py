@@ -290,11 +290,9 @@ def write_selection_qc(qc_dir: Path, stem: str, frame: np.ndarray | None, table:
         cv2.circle(img, p, 3 * scale if r.status == "selected" else 2 * scale, colour, 1, cv2.LINE_AA)
     counts = shown.assign(key=np.where(shown.status == "selected", "selected", shown.reason)).key.value_counts()
     bursts = int(table.burst.nunique()) if "burst" in table and not table.empty else 1
-    y = _write_title(img, f"{title} (frame {index}: the candidates that start there, of {bursts} bursts; all in "
-                            f"{stem}.candidates.csv)")
-    for reason, n in counts.items():
-        y += 16
-        _put_text(img, f"{reason}: {n}", y, REASON_COLOURS.get(str(reason), (255, 255, 255)))
+    legend = [(f"{reason}: {n}", REASON_COLOURS.get(str(reason), (255, 255, 255))) for reason, n in counts.items()]
+    _write_title(img, f"{title} (frame {index}: the candidates that start there, of {bursts} bursts; all in "
+                      f"{stem}.candidates.csv)", legend)
     return _write_png(target, img)
 
 
@@ -318,21 +316,27 @@ def _frame_image(frame: np.ndarray) -> tuple[np.ndarray, int]:
                       interpolation=cv2.INTER_NEAREST), scale
 
 
-def _write_title(img: np.ndarray, title: str) -> int:
-    """Write the whole of ``title`` in the image's top-left corner, wrapped; returns the last line's y."""
-    y = 2
+#: Line pitch (px) of the text written on QC images: a line's black outline must not reach the line above.
+_LINE_PX = 18
+
+
+def _write_title(img: np.ndarray, title: str, extra: list[tuple[str, tuple[int, int, int]]] | None = None) -> int:
+    """Write the whole of ``title`` in the image's top-left corner, wrapped, then the ``extra`` (text, colour)
+    lines, outlined in black so that they read on a bright frame as on a dark one; returns the
+    last line's y. Every line's outline is drawn before any line's text, so that no outline cuts into another."""
     char_px = cv2.getTextSize("x", cv2.FONT_HERSHEY_SIMPLEX, 0.45, 1)[0][0]
-    for line in textwrap.wrap(title, width=max(20, (img.shape[1] - 12) // max(char_px, 1))):
-        y += 16
-        _put_text(img, line, y)
-    return y
-
-
-def _put_text(img: np.ndarray, text: str, y: int, colour: tuple[int, int, int] = (255, 255, 255)) -> None:
-    """``text`` at (6, y), outlined in black so that it reads on a bright frame as on a dark one (white text on
-    a near-white refused frame could not be read)."""
-    cv2.putText(img, text, (6, y), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (0, 0, 0), 3, cv2.LINE_AA)
-    cv2.putText(img, text, (6, y), cv2.FONT_HERSHEY_SIMPLEX, 0.45, colour, 1, cv2.LINE_AA)
+    white = (255, 255, 255)
+    lines = [(ln, white) for ln in textwrap.wrap(title, width=max(20, (img.shape[1] - 12) // max(char_px, 1)))]
+    lines += extra or []
+    ys = [4 + _LINE_PX * (k + 1) for k in range(len(lines))]
+    for (text, _), y in zip(lines, ys, strict=True):  # the outline: the text itself, moved by 1 px each way
+        for dx, dy in ((-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1)):
+            # (not one thicker stroke: OpenCV widens a thicker text's letter spacing, and its outline ran
+            # ahead of the letters into a second, shifted copy of the title on a bright frame)
+            cv2.putText(img, text, (6 + dx, y + dy), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (0, 0, 0), 1, cv2.LINE_AA)
+    for (text, colour), y in zip(lines, ys, strict=True):
+        cv2.putText(img, text, (6, y), cv2.FONT_HERSHEY_SIMPLEX, 0.45, colour, 1, cv2.LINE_AA)
+    return ys[-1] if ys else 2
 
 
 def _write_png(target: Path, img: np.ndarray) -> Path:
