@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import sys
 from collections.abc import Callable, Mapping
 from dataclasses import replace
@@ -247,11 +248,11 @@ def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bear
 def _namer(inputs: list[str]) -> Callable[[Path], str]:
     """How a video is named on its ``ok``/``FAILED`` line, the same way on every line of a run: relative to the
     input folder it was found in (as the report names it), else as given on the command line."""
-    typed = {Path(i).resolve(): i for i in inputs}
+    typed = {Path(os.path.abspath(i)): i for i in inputs}  # not resolved: a linked video stays in its folder
     folders = [full for full in typed if full.is_dir()]
 
     def shown(video: Path) -> str:
-        full = Path(video).resolve()
+        full = Path(os.path.abspath(video))
         for folder in folders:
             if full != folder and full.is_relative_to(folder):
                 return full.relative_to(folder).as_posix()
