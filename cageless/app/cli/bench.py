@@ -35,8 +35,10 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--axial-load-n", type=float, default=0.0, help="effects: axial load (default 0 N)")
     p.add_argument("--window", type=float, default=0.005, help="accuracy: simulated window (s, default 0.005)")
     p.add_argument("--plot", help="accuracy: write the work-precision diagram to this image")
-    p.add_argument("--dir", default="bench_footage", help="tracking: where rendered footage is kept (default ./bench_footage)")
-    p.add_argument("--frames", type=int, default=2400, help="tracking: frames of full-size footage (default 2400, 4.9 GB)")
+    p.add_argument("--dir", default="bench_footage",
+                   help="tracking: where rendered footage is kept (default ./bench_footage)")
+    p.add_argument("--frames", type=int, default=2400,
+                   help="tracking: frames of full-size footage (default 2400, 4.9 GB)")
     p.add_argument("--repeats", type=int, default=3,
                    help="tracking and accuracy: timing repeats, best taken (default 3)")
     p.add_argument("--json", help="also write the results as JSON")

@@ -70,7 +70,8 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
                    help="radial load (N), recorded in the trace for the comparison: as --speed-rpm (0 N when no "
                    "source gives it, with a warning)")
     p.add_argument("--axial-load-n", type=finite_float, help="axial load (N): as --radial-load-n")
-    p.add_argument("--fps", type=finite_float, help="frame-rate override (frames/s; default: the video's time stamps, else its header rate)")
+    p.add_argument("--fps", type=finite_float,
+                   help="frame-rate override (frames/s; default: the video's time stamps, else its header rate)")
     p.add_argument("--window", type=int, default=DEFAULT_WINDOW,
                    help=f"Savitzky-Golay speed window in frames, odd (default {DEFAULT_WINDOW})")
     p.add_argument("--detector", choices=DETECTORS, default="window",
