@@ -238,17 +238,36 @@ def _announce_failure(label: str, stage: str, message: str, progress: bool) -> N
 
 
 def _run_jobs(pool: Any, jobs: list[tuple[Callable[..., tuple[str, str]], tuple[Any, ...]]], desc: str,
-              progress: bool, labels: list[str] | None = None) -> list[tuple[str, str]]:
+              progress: bool, labels: list[str] | None = None,
+              on_result: Callable[[int, tuple[str, str]], None] | None = None) -> list[tuple[str, str]]:
+    """Run ``jobs`` on ``pool`` and return their outcomes in job order.
+
+    Each outcome is handed to ``on_result(i, outcome)`` as soon as its job ends, whatever the order, so a
+    stage that is interrupted (Ctrl-C) keeps the jobs it finished; a failure is announced as it happens.
+    """
     futures: list[Future[Any]] = [pool.submit(fn, *args) for fn, args in jobs]
-    out = []
-    for i, fut in enumerate(tqdm(futures, desc=desc, disable=not progress or not futures, leave=False)):
-        try:
-            out.append(fut.result())
-        except Exception as exc:  # a crashed worker fails its job only  # noqa: BLE001
-            out.append(("failed", f"{type(exc).__name__}: {exc}"))
-        if out[-1][0] != "ok" and labels is not None:
-            _announce_failure(labels[i], desc, out[-1][1], progress)
-    return out
+    out: dict[int, tuple[str, str]] = {}
+    with tqdm(total=len(futures), desc=desc, disable=not progress or not futures, leave=False) as bar:
+        while len(out) < len(futures):
+            ready = [i for i, fut in enumerate(futures) if i not in out and fut.done()]
+            if not ready:
+                time.sleep(0.05)  # local and Dask futures alike have done(); jobs take seconds
+                continue
+            for i in ready:
+                out[i] = _outcome(futures[i])
+                if out[i][0] != "ok" and labels is not None:
+                    _announce_failure(labels[i], desc, out[i][1], progress)
+                if on_result is not None:
+                    on_result(i, out[i])
+                bar.update(1)
+    return [out[i] for i in range(len(futures))]
+
+
+def _outcome(fut: Any) -> tuple[str, str]:
+    try:
+        return fut.result()
+    except Exception as exc:  # a crashed worker fails its job only  # noqa: BLE001
+        return ("failed", f"{type(exc).__name__}: {exc}")
 
 
 # -- the workflow ---------------------------------------------------------------------------------------
@@ -405,15 +424,20 @@ def _failed_row(label: str, c: OperatingConditions | None, message: str) -> Any:
     return ComparisonRow(speed, fr, fa, nan, nan, nan, nan, nan, label=label, status="failed", message=message)
 
 
-def _collect(results: dict[Any, Any], pending: list[Any], keys: list[str], outcomes: list[tuple[str, str]],
-             cache: _Cache) -> None:
-    """Store each finished job's output path (and cache it), or its error."""
-    for item, key, (status, info) in zip(pending, keys, outcomes, strict=True):
+def _collect(results: dict[Any, Any], pending: list[Any], keys: list[str],
+             cache: _Cache) -> Callable[[int, tuple[str, str]], None]:
+    """The ``on_result`` of :func:`_run_jobs`: store job ``i``'s output path in ``results`` and the cache at
+    once (so an interrupted run's re-run skips it), or its error in ``results``."""
+
+    def store(i: int, outcome: tuple[str, str]) -> None:
+        status, info = outcome
         if status == "ok":
-            cache.store(key, info, _qc_files(Path(info)) if isinstance(item, Path) else None)
-            results[item] = info
+            cache.store(keys[i], info, _qc_files(Path(info)) if isinstance(pending[i], Path) else None)
+            results[pending[i]] = info
         else:
-            results[item] = CagelessError(info)
+            results[pending[i]] = CagelessError(info)
+
+    return store
 
 
 def _track_all(pool: Any, entries: list[LabEntry], bearings: dict[Path, Bearing], out: Path, cache: _Cache,
@@ -436,7 +460,7 @@ def _track_all(pool: Any, entries: list[LabEntry], bearings: dict[Path, Bearing]
         pending.append(e.video)
     if jobs and progress:
         say_if_compiling("tracking")
-    _collect(traces, pending, keys, _run_jobs(pool, jobs, "tracking", progress, [p.name for p in pending]), cache)
+    _run_jobs(pool, jobs, "tracking", progress, [p.name for p in pending], _collect(traces, pending, keys, cache))
     return traces, len(entries) - len(jobs)
 
 
@@ -469,6 +493,5 @@ def _simulate_all(pool: Any, entries: list[LabEntry], traces: dict[Path, Any], b
         pending.append(k)
     if jobs and progress:
         say_if_compiling("simulation")
-    _collect(sims, pending, keys, _run_jobs(pool, jobs, "simulation", progress, [_sim_name(k) for k in pending]),
-             cache)
+    _run_jobs(pool, jobs, "simulation", progress, [_sim_name(k) for k in pending], _collect(sims, pending, keys, cache))
     return sims, len(conditions) - len(jobs)

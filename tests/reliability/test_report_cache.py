@@ -142,3 +142,36 @@ def test_a_failed_job_is_announced_when_it_fails(capsys):
         out = _run_jobs(pool, [(ok, ()), (crash, ())], "tracking", True, ["a.cine", "b.cine"])
     assert out == [("ok", "a.trace.h5"), ("failed", "RuntimeError: worker died\nsecond line")]
     assert "FAILED b.cine (tracking): RuntimeError: worker died\n" in capsys.readouterr().err
+
+
+def test_an_interrupted_stage_keeps_the_jobs_it_finished(tmp_path, capsys, mini_lab, in_process_pool, monkeypatch):
+    """Ctrl-C in the middle of a stage: the jobs of that stage that had finished are in the cache, and the
+    re-run skips them. (They were stored only when the whole stage ended, so the re-run redid every
+    finished simulation of an interrupted simulation stage: a new user's trial.)"""
+    import pytest
+
+    from cageless.app import lab
+    from cageless.app.lab import LabOptions, run_lab
+
+    folder = tmp_path / "lab"
+    shutil.copytree(mini_lab, folder)
+    shutil.copy(folder / "clip_3000rpm.mkv", folder / "second.mkv")
+    (folder / "conditions.csv").write_text("file,speed_rpm,radial_load_n,fps\nclip_3000rpm.mkv,3000,500,10000\n"
+                                           "second.mkv,3000,600,10000\n")
+    real = lab._track_job
+
+    def interrupted_at_the_second(video, *args):
+        if video.endswith("second.mkv"):
+            raise KeyboardInterrupt
+        return real(video, *args)
+
+    monkeypatch.setattr(lab, "_track_job", interrupted_at_the_second)
+    out = tmp_path / "out"
+    with pytest.raises(KeyboardInterrupt):
+        run_lab(folder, out, LabOptions(duration_s=0.003, settle_s=0.002), progress=False)
+    assert [job["path"] for job in json.loads((out / CACHE_NAME).read_text())["jobs"].values()] == \
+        ["traces/clip_3000rpm.trace.h5"]
+    monkeypatch.setattr(lab, "_track_job", real)
+    run = cli(capsys, "report", folder, "-o", out, *QUICK_REPORT)
+    assert_clean(run, 0)
+    assert _skipped(run.out) == 1  # the first video's tracking
