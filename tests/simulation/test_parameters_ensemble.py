@@ -122,3 +122,16 @@ def test_ensemble_summaries_leave_out_the_start_up_as_a_single_run_does(tmp_path
     assert main(["simulate", "--speed-rpm", "6000", "--radial-load-n", "500", "--duration", "0.002", "-q",
                  "--ensemble", "2", "-o", str(tmp_path / "short.trace.h5")]) == 0
     assert capsys.readouterr().out.count("no settled slip: the run is within the 76 ms start-up") == 2
+
+
+def test_the_default_output_name_holds_the_axial_load(tmp_path, capsys, monkeypatch):
+    """Two scenes that differ only in their axial load do not share a default output (the second run
+    silently replaced the first's trace, which cageless had written: a new user's trial). A pure radial
+    scene keeps the documented name."""
+    monkeypatch.chdir(tmp_path)
+    for axial in ("200", "0"):
+        assert main(["simulate", "--speed-rpm", "6000", "--radial-load-n", "300", "--axial-load-n", axial,
+                     "--duration", "0.002", "-q"]) == 0
+    assert sorted(p.name for p in tmp_path.glob("*.trace.h5")) == ["sim_6000rpm_Fr300.trace.h5",
+                                                                   "sim_6000rpm_Fr300_Fa200.trace.h5"]
+    assert read_trace(tmp_path / "sim_6000rpm_Fr300_Fa200.trace.h5").axial_load_n == 200.0

@@ -90,7 +90,8 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
                    help="run seeds 0..N-1 (N traces, both cores; default 1)")
     p.add_argument("--scheduler", help="with --ensemble: address of a Dask scheduler to run the seeds on")
     p.add_argument("--sample-rate", type=finite_float, default=10_000.0, help="samples per second (default 10000)")
-    p.add_argument("-o", "--out", help="trace file to write (default sim_<rpm>rpm_Fr<N>.trace.h5)")
+    p.add_argument("-o", "--out", help="trace file to write (default sim_<rpm>rpm_Fr<N>.trace.h5, with _Fa<N> "
+                   "under an axial load)")
 
 
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
@@ -161,8 +162,15 @@ def _validate(args: argparse.Namespace, bearing: Any) -> None:
     if args.out:
         check_output_file(args.out, "-o", overwrite=args.overwrite)
     elif args.ensemble == 1:
-        check_output_file(f"sim_{args.speed_rpm:g}rpm_Fr{args.radial_load_n:g}.trace.h5", "the default output",
+        check_output_file(_default_out(args), "the default output",
                           overwrite=args.overwrite)
+
+
+def _default_out(args: argparse.Namespace) -> str:
+    """``sim_<rpm>rpm_Fr<N>.trace.h5``, with ``_Fa<N>`` under an axial load (so scenes that differ only in it
+    do not replace each other's trace)."""
+    axial = f"_Fa{args.axial_load_n:g}" if args.axial_load_n else ""
+    return f"sim_{args.speed_rpm:g}rpm_Fr{args.radial_load_n:g}{axial}.trace.h5"
 
 
 def _bearing_line(bearing: Any) -> str:
@@ -201,7 +209,7 @@ def _run(args: argparse.Namespace, scene: Any, choices: Any, config: dict[str, A
     choice = sim.model
     if args.ensemble < 1:
         raise UsageError(f"--ensemble must be >= 1, got {args.ensemble}")
-    out = args.out or f"sim_{args.speed_rpm:g}rpm_Fr{args.radial_load_n:g}.trace.h5"
+    out = args.out or _default_out(args)
     from cageless.app.calibrate import describe_calibration
 
     from cageless.simulation.parameter_sets import DEFAULT_SET
