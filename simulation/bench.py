@@ -362,7 +362,8 @@ def format_effects(result: dict[str, Any]) -> str:
     """The ablation study as a Markdown table."""
     sc = result["scene"]
     lines = [f"Effect ablation, {sc['speed_rpm']:g} rpm, {sc['radial_load_n']:g} N radial, {sc['axial_load_n']:g} N "
-             f"axial ({sc['level']}), {1e3 * sc['duration_s']:g} ms, profiles after {1e3 * sc['settle_s']:g} ms", "",
+             f"axial ({sc['level']}): {1e3 * sc['duration_s']:.0f} ms simulated after a start-up of "
+             f"{1e3 * sc['settle_s']:.0f} ms, which the profiles leave out", "",
              "| effect removed | peak slip (%) | profile change, RMS (pp) | wall (s) | saving |",
              "|---|---|---|---|---|"]
     for r in result["rows"]:
