@@ -83,6 +83,8 @@ class LabOptions:
     n_balls: int | None = None
     #: Track the complete frames of a cut-off ``.cine`` (``--allow-truncated``) instead of failing its row.
     allow_truncated: bool = False
+    #: Savitzky-Golay speed window of the tracking (frames, odd; ``None``: the tracker's default, 21).
+    window: int | None = None
     #: What slip is referred to in the comparison (a key of ``cageless.comparison.compare.SLIP_REFERENCES``).
     slip_reference: str = "cage"
 
@@ -94,7 +96,8 @@ class LabOptions:
                 "n_balls": self.n_balls,
                 "slip_reference": self.slip_reference, "peak_estimator": peak_estimator(),
                 **({"calibration": self.calibration} if self.calibration else {}),
-                **({"allow_truncated": True} if self.allow_truncated else {})}
+                **({"allow_truncated": True} if self.allow_truncated else {}),
+                **({"window": self.window} if self.window is not None else {})}
 
 
 @dataclass
@@ -124,10 +127,13 @@ def say_if_compiling(package: str) -> None:
 
 
 def _track_job(video: str, conditions: OperatingConditions, bearing: Bearing, out_dir: str,
-               n_balls: int | None = None, allow_truncated: bool = False) -> tuple[str, str]:
+               n_balls: int | None = None, allow_truncated: bool = False,
+               window: int | None = None) -> tuple[str, str]:
     from cageless.tracking.pipeline import TrackOptions, track_video
 
     options = TrackOptions(n_balls=n_balls, allow_truncated=allow_truncated)
+    if window is not None:
+        options = replace(options, window=window)
     try:
         res = track_video(video, conditions, bearing, options, out_dir=out_dir, progress=False,
                           config={"command": "report"})
@@ -445,6 +451,8 @@ def _track_all(pool: Any, entries: list[LabEntry], bearings: dict[Path, Bearing]
     traces: dict[Path, Any] = {}
     jobs, keys, pending = [], [], []
     n_balls, cut = options.n_balls, {"allow_truncated": True} if options.allow_truncated else {}
+    if options.window is not None:  # keys of runs with the default window stay as they were
+        cut["window"] = options.window
     for e in entries:
         # Keyed on the video's XXH3-128: entries an earlier version keyed on its BLAKE3 do not match (a miss).
         key = cache.key("track", {"input": hash_file(e.video, VIDEO_HASH),
@@ -455,7 +463,7 @@ def _track_all(pool: Any, entries: list[LabEntry], bearings: dict[Path, Bearing]
             traces[e.video] = hit
             continue
         jobs.append((_track_job, (str(e.video), e.resolved.conditions, bearings[e.video], str(out / "traces"),
-                                  n_balls, options.allow_truncated)))
+                                  n_balls, options.allow_truncated, options.window)))
         keys.append(key)
         pending.append(e.video)
     if jobs and progress:

@@ -175,3 +175,26 @@ def test_an_interrupted_stage_keeps_the_jobs_it_finished(tmp_path, capsys, mini_
     run = cli(capsys, "report", folder, "-o", out, *QUICK_REPORT)
     assert_clean(run, 0)
     assert _skipped(run.out) == 1  # the first video's tracking
+
+
+def test_report_window_reaches_the_tracker_and_its_cache_key(tmp_path, capsys, mini_lab, in_process_pool,
+                                                             monkeypatch):
+    """`report --window N` tracks with that speed window (a clip shorter than the default 21 frames failed its
+    row with 'Record longer, or lower --window', an option report did not have: a new user's trial); another
+    window is another tracking job, and an even one is refused before any work."""
+    import cageless.tracking.pipeline as pipeline
+
+    windows = []
+    real = pipeline.track_video
+
+    def recording(video, conditions, bearing, options, **kw):
+        windows.append(options.window)
+        return real(video, conditions, bearing, options, **kw)
+
+    monkeypatch.setattr(pipeline, "track_video", recording)
+    out = tmp_path / "out"
+    assert_clean(cli(capsys, "report", mini_lab, "-o", out, "--window", "11", *QUICK_REPORT), 0)
+    run = cli(capsys, "report", mini_lab, "-o", out, *QUICK_REPORT)
+    assert_clean(run, 0)
+    assert windows == [11, 21] and _skipped(run.out) == 1  # the simulation; the tracking was redone
+    assert cli(capsys, "report", mini_lab, "-o", tmp_path / "o2", "--window", "12", *QUICK_REPORT).code == 2
