@@ -453,9 +453,14 @@ def _track_all(pool: Any, entries: list[LabEntry], bearings: dict[Path, Bearing]
     n_balls, cut = options.n_balls, {"allow_truncated": True} if options.allow_truncated else {}
     if options.window is not None:  # keys of runs with the default window stay as they were
         cut["window"] = options.window
+    first_of: dict[str, Path] = {}
     for e in entries:
+        digest = hash_file(e.video, VIDEO_HASH)
+        if first_of.setdefault(digest, e.video) != e.video:
+            log.warning("%s holds the same bytes as %s (%s %s): each is a row of the report; remove the copy if it "
+                        "was made by mistake", e.video.name, first_of[digest].name, VIDEO_HASH, digest[:12])
         # Keyed on the video's XXH3-128: entries an earlier version keyed on its BLAKE3 do not match (a miss).
-        key = cache.key("track", {"input": hash_file(e.video, VIDEO_HASH),
+        key = cache.key("track", {"input": digest,
                                   "conditions": e.resolved.conditions.to_dict(),
                                   "bearing": bearings[e.video].to_dict(), "n_balls": n_balls, **cut})
         hit = cache.hit(key)

@@ -198,3 +198,16 @@ def test_report_window_reaches_the_tracker_and_its_cache_key(tmp_path, capsys, m
     assert_clean(run, 0)
     assert windows == [11, 21] and _skipped(run.out) == 1  # the simulation; the tracking was redone
     assert cli(capsys, "report", mini_lab, "-o", tmp_path / "o2", "--window", "12", *QUICK_REPORT).code == 2
+
+
+def test_a_video_copied_under_another_name_is_pointed_out(tmp_path, capsys, mini_lab, in_process_pool):
+    """Two videos with the same bytes in one lab folder (a copy made by mistake counts one measurement twice):
+    the report still has both rows, and warns, naming both (it said nothing: a new user's trial)."""
+    folder = tmp_path / "lab"
+    shutil.copytree(mini_lab, folder)
+    shutil.copy(folder / "clip_3000rpm.mkv", folder / "copy of clip.mkv")
+    with open(folder / "conditions.csv", "a") as fh:
+        fh.write("copy of clip.mkv,3000,500,0,10000\n")
+    run = cli(capsys, "report", folder, "-o", tmp_path / "out", *QUICK_REPORT)
+    assert_clean(run, 0, "WARNING: copy of clip.mkv holds the same bytes as clip_3000rpm.mkv (xxh3_128 ")
+    assert len(pd.read_csv(tmp_path / "out" / "slip_table.csv")) == 2
