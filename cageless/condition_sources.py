@@ -111,7 +111,7 @@ def read_conditions_csv(
                 rows.pop(name, None)  # neither row can be trusted
                 raise ConditionsError(path, f"line {line}: '{name}' is listed twice.", "Keep one row per video.")
             seen.add(name)
-            rows[name] = _csv_values(path, line, row, table.columns)
+            rows[name] = _csv_values(path, line, row, table.columns, decimal)
         except ConditionsError as exc:
             if row_errors is None:
                 raise
@@ -145,14 +145,21 @@ def _checked_columns(path: Path, table: pd.DataFrame) -> pd.DataFrame:
     return table
 
 
-def _csv_values(path: Path, line: int, row: pd.Series, columns: pd.Index) -> dict[str, float]:
-    """The numeric condition values of one CSV row, empty cells left out."""
+def _csv_values(path: Path, line: int, row: pd.Series, columns: pd.Index, decimal: str = ".") -> dict[str, float]:
+    """The numeric condition values of one CSV row, empty cells left out.
+
+    A cell pandas left as text (a column where another row holds a word) is read in the table's own number
+    format: with decimal commas, ``6.000`` is 6000 and ``500,5`` is 500.5, as in the columns pandas parsed.
+    """
     values: dict[str, float] = {}
     for key in _SOURCE_KEYS:
         if key not in columns or pd.isna(row[key]):
             continue
+        cell = row[key]
+        if isinstance(cell, str) and decimal == ",":
+            cell = cell.strip().replace(".", "").replace(",", ".")
         try:
-            values[key] = float(row[key])
+            values[key] = float(cell)
         except (TypeError, ValueError):
             raise ConditionsError(
                 path, f"line {line}: '{key}' = {row[key]!r} is not a number.", "Write a plain number in that cell."

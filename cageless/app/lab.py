@@ -84,6 +84,8 @@ class LabOptions:
     n_balls: int | None = None
     #: Track the complete frames of a cut-off ``.cine`` (``--allow-truncated``) instead of failing its row.
     allow_truncated: bool = False
+    #: Savitzky-Golay speed window of the tracking (frames, odd; ``None``: the tracker's default, 21).
+    window: int | None = None
     #: What slip is referred to in the comparison (a key of ``cageless.comparison.compare.SLIP_REFERENCES``).
     slip_reference: str = "cage"
 
@@ -95,7 +97,8 @@ class LabOptions:
                 "n_balls": self.n_balls,
                 "slip_reference": self.slip_reference, "peak_estimator": peak_estimator(),
                 **({"calibration": self.calibration} if self.calibration else {}),
-                **({"allow_truncated": True} if self.allow_truncated else {})}
+                **({"allow_truncated": True} if self.allow_truncated else {}),
+                **({"window": self.window} if self.window is not None else {})}
 
 
 @dataclass
@@ -125,10 +128,13 @@ def say_if_compiling(package: str) -> None:
 
 
 def _track_job(video: str, conditions: OperatingConditions, bearing: Bearing, out_dir: str,
-               n_balls: int | None = None, allow_truncated: bool = False) -> tuple[str, str]:
+               n_balls: int | None = None, allow_truncated: bool = False,
+               window: int | None = None) -> tuple[str, str]:
     from cageless.tracking.pipeline import TrackOptions, track_video
 
     options = TrackOptions(n_balls=n_balls, allow_truncated=allow_truncated)
+    if window is not None:
+        options = replace(options, window=window)
     try:
         res = track_video(video, conditions, bearing, options, out_dir=out_dir, progress=False,
                           config={"command": "report"})
@@ -239,18 +245,37 @@ def _announce_failure(label: str, stage: str, message: str, progress: bool) -> N
 
 
 def _run_jobs(pool: Any, jobs: list[tuple[Callable[..., tuple[str, str]], tuple[Any, ...]]], desc: str,
-              progress: bool, labels: list[str] | None = None) -> list[tuple[str, str]]:
+              progress: bool, labels: list[str] | None = None,
+              on_result: Callable[[int, tuple[str, str]], None] | None = None) -> list[tuple[str, str]]:
+    """Run ``jobs`` on ``pool`` and return their outcomes in job order.
+
+    Each outcome is handed to ``on_result(i, outcome)`` as soon as its job ends, whatever the order, so a
+    stage that is interrupted (Ctrl-C) keeps the jobs it finished; a failure is announced as it happens.
+    """
     futures: list[Future[Any]] = [pool.submit(fn, *args) for fn, args in jobs]
-    out = []
-    bar = tqdm(futures, desc=desc, disable=not (progress and _BARS.get()) or not futures, leave=False)
-    for i, fut in enumerate(bar):
-        try:
-            out.append(fut.result())
-        except Exception as exc:  # a crashed worker fails its job only  # noqa: BLE001
-            out.append(("failed", f"{type(exc).__name__}: {exc}"))
-        if out[-1][0] != "ok" and labels is not None:
-            _announce_failure(labels[i], desc, out[-1][1], progress)
-    return out
+    out: dict[int, tuple[str, str]] = {}
+    with tqdm(total=len(futures), desc=desc, disable=not (progress and _BARS.get()) or not futures,
+              leave=False) as bar:
+        while len(out) < len(futures):
+            ready = [i for i, fut in enumerate(futures) if i not in out and fut.done()]
+            if not ready:
+                time.sleep(0.05)  # local and Dask futures alike have done(); jobs take seconds
+                continue
+            for i in ready:
+                out[i] = _outcome(futures[i])
+                if out[i][0] != "ok" and labels is not None:
+                    _announce_failure(labels[i], desc, out[i][1], progress)
+                if on_result is not None:
+                    on_result(i, out[i])
+                bar.update(1)
+    return [out[i] for i in range(len(futures))]
+
+
+def _outcome(fut: Any) -> tuple[str, str]:
+    try:
+        return fut.result()
+    except Exception as exc:  # a crashed worker fails its job only  # noqa: BLE001
+        return ("failed", f"{type(exc).__name__}: {exc}")
 
 
 # -- the workflow ---------------------------------------------------------------------------------------
@@ -418,15 +443,20 @@ def _failed_row(label: str, c: OperatingConditions | None, message: str) -> Any:
     return ComparisonRow(speed, fr, fa, nan, nan, nan, nan, nan, label=label, status="failed", message=message)
 
 
-def _collect(results: dict[Any, Any], pending: list[Any], keys: list[str], outcomes: list[tuple[str, str]],
-             cache: _Cache) -> None:
-    """Store each finished job's output path (and cache it), or its error."""
-    for item, key, (status, info) in zip(pending, keys, outcomes, strict=True):
+def _collect(results: dict[Any, Any], pending: list[Any], keys: list[str],
+             cache: _Cache) -> Callable[[int, tuple[str, str]], None]:
+    """The ``on_result`` of :func:`_run_jobs`: store job ``i``'s output path in ``results`` and the cache at
+    once (so an interrupted run's re-run skips it), or its error in ``results``."""
+
+    def store(i: int, outcome: tuple[str, str]) -> None:
+        status, info = outcome
         if status == "ok":
-            cache.store(key, info, _qc_files(Path(info)) if isinstance(item, Path) else None)
-            results[item] = info
+            cache.store(keys[i], info, _qc_files(Path(info)) if isinstance(pending[i], Path) else None)
+            results[pending[i]] = info
         else:
-            results[item] = CagelessError(info)
+            results[pending[i]] = CagelessError(info)
+
+    return store
 
 
 def _track_all(pool: Any, entries: list[LabEntry], bearings: dict[Path, Bearing], out: Path, cache: _Cache,
@@ -434,9 +464,16 @@ def _track_all(pool: Any, entries: list[LabEntry], bearings: dict[Path, Bearing]
     traces: dict[Path, Any] = {}
     jobs, keys, pending = [], [], []
     n_balls, cut = options.n_balls, {"allow_truncated": True} if options.allow_truncated else {}
+    if options.window is not None:  # keys of runs with the default window stay as they were
+        cut["window"] = options.window
+    first_of: dict[str, Path] = {}
     for e in entries:
+        digest = hash_file(e.video, VIDEO_HASH)
+        if first_of.setdefault(digest, e.video) != e.video:
+            log.warning("%s holds the same bytes as %s (%s %s): each is a row of the report; remove the copy if it "
+                        "was made by mistake", e.video.name, first_of[digest].name, VIDEO_HASH, digest[:12])
         # Keyed on the video's XXH3-128: entries an earlier version keyed on its BLAKE3 do not match (a miss).
-        key = cache.key("track", {"input": hash_file(e.video, VIDEO_HASH),
+        key = cache.key("track", {"input": digest,
                                   "conditions": e.resolved.conditions.to_dict(),
                                   "bearing": bearings[e.video].to_dict(), "n_balls": n_balls, **cut})
         hit = cache.hit(key)
@@ -444,12 +481,12 @@ def _track_all(pool: Any, entries: list[LabEntry], bearings: dict[Path, Bearing]
             traces[e.video] = hit
             continue
         jobs.append((_track_job, (str(e.video), e.resolved.conditions, bearings[e.video], str(out / "traces"),
-                                  n_balls, options.allow_truncated)))
+                                  n_balls, options.allow_truncated, options.window)))
         keys.append(key)
         pending.append(e.video)
     if jobs and progress:
         say_if_compiling("tracking")
-    _collect(traces, pending, keys, _run_jobs(pool, jobs, "tracking", progress, [p.name for p in pending]), cache)
+    _run_jobs(pool, jobs, "tracking", progress, [p.name for p in pending], _collect(traces, pending, keys, cache))
     return traces, len(entries) - len(jobs)
 
 
@@ -482,6 +519,5 @@ def _simulate_all(pool: Any, entries: list[LabEntry], traces: dict[Path, Any], b
         pending.append(k)
     if jobs and progress:
         say_if_compiling("simulation")
-    _collect(sims, pending, keys, _run_jobs(pool, jobs, "simulation", progress, [_sim_name(k) for k in pending]),
-             cache)
+    _run_jobs(pool, jobs, "simulation", progress, [_sim_name(k) for k in pending], _collect(sims, pending, keys, cache))
     return sims, len(conditions) - len(jobs)

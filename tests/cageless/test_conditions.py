@@ -263,3 +263,16 @@ def test_a_european_csv_reads_thousands_separators_and_a_misspelled_header_is_na
     path.write_text("file,speed_rmp\nclip.cine,3000\n", encoding="utf-8")
     with pytest.raises(ConditionsError, match="Is 'speed_rmp' meant to be 'speed_rpm'"):
         read_conditions_csv(path)
+
+
+def test_a_european_csv_reads_thousands_beside_a_bad_row(tmp_path):
+    """A bad cell in another row (`drei`) leaves the column as text; `6.000` is still 6000 r/min and `500,5`
+    still 500.5 N. (It read 6 r/min, inside the plausible range, so the video failed later in the ball
+    selection instead: a new user's trial.)"""
+    from cageless.errors import ConditionsError
+
+    path = tmp_path / "conditions.csv"
+    path.write_text("file;speed_rpm;radial_load_n\na.cine;6.000;500,5\nb.mkv;drei;1.200,25\n", encoding="utf-8")
+    errors: dict[str, ConditionsError] = {}
+    assert read_conditions_csv(path, row_errors=errors) == {"a.cine": {"speed_rpm": 6000.0, "radial_load_n": 500.5}}
+    assert list(errors) == ["b.mkv"] and "'speed_rpm' = 'drei' is not a number" in str(errors["b.mkv"])

@@ -296,3 +296,20 @@ def test_progress_bars_only_on_a_terminal(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(cli, "_on_terminal", lambda stream: True)
     assert main(["track", str(lab), "-o", str(tmp_path / "o2")]) == 1
     assert "videos: 100%" in capsys.readouterr().err
+
+
+def test_failed_lines_name_each_video_once_in_a_folder_with_spaces_and_links(tmp_path, capsys):
+    """A lab folder whose path holds spaces and non-ASCII letters, with a video that is a symbolic link to a
+    file elsewhere: the FAILED line names the video once, relative to the folder (it named the full path,
+    twice: 'FAILED /x/my lab/a.cine: /x/my lab/a.cine: wrong magic bytes', a new user's trial)."""
+    store = tmp_path / "camera store"
+    store.mkdir()
+    (store / "raw 17.cine").write_bytes(b"NOPE" * 20)
+    lab = tmp_path / "Prüfstand lab — 2026"
+    lab.mkdir()
+    (lab / "n3000_Fr500.cine").write_bytes(b"NOPE" * 20)
+    (lab / "n6000_Fr500 link.cine").symlink_to(store / "raw 17.cine")
+    assert main(["track", str(lab), "-o", str(tmp_path / "o"), "-q"]) == 1
+    err = sorted(capsys.readouterr().err.splitlines())
+    assert [line.split(": ", 1)[0] for line in err] == ["FAILED n3000_Fr500.cine", "FAILED n6000_Fr500 link.cine"]
+    assert all(line.split(": ", 1)[1].startswith("wrong magic bytes") for line in err), err

@@ -27,3 +27,19 @@ def test_help_does_not_name_the_design_document(command, capsys):
     assert main([command, "--help"]) == 0
     text = capsys.readouterr().out
     assert "usage: cageless" in text and "DESIGN" not in text
+
+
+@pytest.mark.parametrize("command", SUBCOMMANDS)
+def test_every_option_with_a_default_states_it(command):
+    """An option that has a value when it is not given says which in its help (a new user's trial found
+    `simulate --orientation`, `--seed`, `--ensemble`, `--misalignment-rad`, `--moment-load-nm` and
+    `calibrate --metric` silent about theirs). Counters (-v) and switches (store_true) are left out."""
+    import argparse
+
+    from cageless.app.cli import build_parser
+
+    sub = build_parser()._subparsers._group_actions[0].choices[command]  # type: ignore[union-attr]
+    silent = [a.option_strings[-1] for a in sub._actions
+              if a.option_strings and a.default not in (None, False, [], argparse.SUPPRESS)
+              and not isinstance(a, argparse._CountAction) and "default" not in (a.help or "")]
+    assert silent == []

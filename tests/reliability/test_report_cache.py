@@ -142,3 +142,72 @@ def test_a_failed_job_is_announced_when_it_fails(capsys):
         out = _run_jobs(pool, [(ok, ()), (crash, ())], "tracking", True, ["a.cine", "b.cine"])
     assert out == [("ok", "a.trace.h5"), ("failed", "RuntimeError: worker died\nsecond line")]
     assert "FAILED b.cine (tracking): RuntimeError: worker died\n" in capsys.readouterr().err
+
+
+def test_an_interrupted_stage_keeps_the_jobs_it_finished(tmp_path, capsys, mini_lab, in_process_pool, monkeypatch):
+    """Ctrl-C in the middle of a stage: the jobs of that stage that had finished are in the cache, and the
+    re-run skips them. (They were stored only when the whole stage ended, so the re-run redid every
+    finished simulation of an interrupted simulation stage: a new user's trial.)"""
+    import pytest
+
+    from cageless.app import lab
+    from cageless.app.lab import LabOptions, run_lab
+
+    folder = tmp_path / "lab"
+    shutil.copytree(mini_lab, folder)
+    shutil.copy(folder / "clip_3000rpm.mkv", folder / "second.mkv")
+    (folder / "conditions.csv").write_text("file,speed_rpm,radial_load_n,fps\nclip_3000rpm.mkv,3000,500,10000\n"
+                                           "second.mkv,3000,600,10000\n")
+    real = lab._track_job
+
+    def interrupted_at_the_second(video, *args):
+        if video.endswith("second.mkv"):
+            raise KeyboardInterrupt
+        return real(video, *args)
+
+    monkeypatch.setattr(lab, "_track_job", interrupted_at_the_second)
+    out = tmp_path / "out"
+    with pytest.raises(KeyboardInterrupt):
+        run_lab(folder, out, LabOptions(duration_s=0.003, settle_s=0.002), progress=False)
+    assert [job["path"] for job in json.loads((out / CACHE_NAME).read_text())["jobs"].values()] == \
+        ["traces/clip_3000rpm.trace.h5"]
+    monkeypatch.setattr(lab, "_track_job", real)
+    run = cli(capsys, "report", folder, "-o", out, *QUICK_REPORT)
+    assert_clean(run, 0)
+    assert _skipped(run.out) == 1  # the first video's tracking
+
+
+def test_report_window_reaches_the_tracker_and_its_cache_key(tmp_path, capsys, mini_lab, in_process_pool,
+                                                             monkeypatch):
+    """`report --window N` tracks with that speed window (a clip shorter than the default 21 frames failed its
+    row with 'Record longer, or lower --window', an option report did not have: a new user's trial); another
+    window is another tracking job, and an even one is refused before any work."""
+    import cageless.tracking.pipeline as pipeline
+
+    windows = []
+    real = pipeline.track_video
+
+    def recording(video, conditions, bearing, options, **kw):
+        windows.append(options.window)
+        return real(video, conditions, bearing, options, **kw)
+
+    monkeypatch.setattr(pipeline, "track_video", recording)
+    out = tmp_path / "out"
+    assert_clean(cli(capsys, "report", mini_lab, "-o", out, "--window", "11", *QUICK_REPORT), 0)
+    run = cli(capsys, "report", mini_lab, "-o", out, *QUICK_REPORT)
+    assert_clean(run, 0)
+    assert windows == [11, 21] and _skipped(run.out) == 1  # the simulation; the tracking was redone
+    assert cli(capsys, "report", mini_lab, "-o", tmp_path / "o2", "--window", "12", *QUICK_REPORT).code == 2
+
+
+def test_a_video_copied_under_another_name_is_pointed_out(tmp_path, capsys, mini_lab, in_process_pool):
+    """Two videos with the same bytes in one lab folder (a copy made by mistake counts one measurement twice):
+    the report still has both rows, and warns, naming both (it said nothing: a new user's trial)."""
+    folder = tmp_path / "lab"
+    shutil.copytree(mini_lab, folder)
+    shutil.copy(folder / "clip_3000rpm.mkv", folder / "copy of clip.mkv")
+    with open(folder / "conditions.csv", "a") as fh:
+        fh.write("copy of clip.mkv,3000,500,0,10000\n")
+    run = cli(capsys, "report", folder, "-o", tmp_path / "out", *QUICK_REPORT)
+    assert_clean(run, 0, "WARNING: copy of clip.mkv holds the same bytes as clip_3000rpm.mkv (xxh3_128 ")
+    assert len(pd.read_csv(tmp_path / "out" / "slip_table.csv")) == 2

@@ -72,3 +72,38 @@ def test_effects_ablation_table():
     assert rows["rolling_losses"]["profile_change_pp"] > 0.0
     assert rows["rolling_losses"]["peak_slip_pct"] < rows["(none: full model)"]["peak_slip_pct"]
     assert "| lubricant_damping |" in format_effects(result)
+
+
+def test_effects_table_header_rounds_the_start_up():
+    """The header names the window and the start-up in whole milliseconds (it printed 'profiles after
+    75.6661 ms' for 6000 rpm: a new user's trial)."""
+    from cageless.simulation.bench import format_effects
+
+    scene = {"speed_rpm": 6000.0, "radial_load_n": 500.0, "axial_load_n": 0.0, "level": "planar",
+             "duration_s": 0.15, "settle_s": 0.0756661}
+    head = format_effects({"scene": scene, "rows": []}).splitlines()[0]
+    assert head == ("Effect ablation, 6000 rpm, 500 N radial, 0 N axial (planar): 150 ms simulated after a start-up "
+                    "of 76 ms, which the profiles leave out")
+
+
+def test_work_precision_plot_tells_every_solver_apart_and_hides_no_point():
+    """Fourteen series: each colour and marker pair once, and the legend outside the axes (the matplotlib
+    colour cycle repeated after ten series, and the legend covered most points: a new user's trial)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from cageless.simulation.bench import accuracy_figure
+
+    rows = [{"solver": f"s{k}", "wall_s_per_sim_s": 10.0 * (k + 1), "slip_error_pp": 10.0 ** -(k % 7)}
+            for k in range(14)]
+    fig = accuracy_figure({"rows": rows})
+    try:
+        ax = fig.axes[0]
+        styles = {(line.get_color(), line.get_marker()) for line in ax.get_lines()}
+        assert len(ax.get_lines()) == 14 and len(styles) == 14
+        fig.canvas.draw()
+        assert ax.get_legend().get_window_extent().x0 >= ax.get_window_extent().x1
+    finally:
+        plt.close(fig)

@@ -30,15 +30,17 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
         epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("study", choices=("tracking", "accuracy", "effects"), help="which study to run")
-    p.add_argument("--speed-rpm", type=float, default=1800.0, help="effects: scene speed (default 1800)")
+    p.add_argument("--speed-rpm", type=float, default=1800.0, help="effects: scene speed (rpm, default 1800)")
     p.add_argument("--radial-load-n", type=float, default=500.0, help="effects: radial load (default 500 N)")
     p.add_argument("--axial-load-n", type=float, default=0.0, help="effects: axial load (default 0 N)")
     p.add_argument("--window", type=float, default=0.005, help="accuracy: simulated window (s, default 0.005)")
     p.add_argument("--plot", help="accuracy: write the work-precision diagram to this image")
-    p.add_argument("--dir", default="bench_footage", help="where rendered footage is kept (default ./bench_footage)")
-    p.add_argument("--frames", type=int, default=2400, help="frames of full-size footage (default 2400, 4.9 GB)")
+    p.add_argument("--dir", default="bench_footage",
+                   help="tracking: where rendered footage is kept (default ./bench_footage)")
+    p.add_argument("--frames", type=int, default=2400,
+                   help="tracking: frames of full-size footage (default 2400, 4.9 GB)")
     p.add_argument("--repeats", type=int, default=3,
-                   help="timing repeats, best taken (default 3)")
+                   help="tracking and accuracy: timing repeats, best taken (default 3)")
     p.add_argument("--json", help="also write the results as JSON")
 
 

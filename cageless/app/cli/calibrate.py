@@ -38,7 +38,8 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
                    help="without a trace: the peak slip (%%) of the mean profile in the unloaded zone to reach")
     p.add_argument("--vary", action="append", default=[], metavar="NAME=LOW:HIGH",
                    help="a parameter to fit and its range (repeatable), e.g. cho_n_s_m=2000:8000")
-    p.add_argument("--metric", choices=("mae", "rmse"), default="mae", help="profile error to minimise (trace)")
+    p.add_argument("--metric", choices=("mae", "rmse"), default="mae",
+                   help="profile error to minimise against a trace (default mae)")
     p.add_argument("--budget", type=int, help="objective evaluations (default 12; 10 per parameter for several)")
     p.add_argument("--seeds", type=int, default=2, help="simulations (seeds 0..K-1) pooled per evaluation (default 2)")
     p.add_argument("--duration", type=finite_float,

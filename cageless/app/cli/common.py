@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 import logging
 import math
+import os
 import re
 from collections.abc import Sequence
 from typing import Any, NoReturn
@@ -225,11 +226,13 @@ def check_n_balls(n_balls: int | None, config: dict[str, Any]) -> None:
 
 
 def failed_line(video: Path | str, why: object, shown: Path | str | None = None) -> str:
-    """``FAILED <video>: <why>``, naming the video once even when the message starts with its path (or its
-    file name); ``shown`` is how the video is named on the line (default: as given)."""
+    """``FAILED <video>: <why>``, naming the video once even when the message starts with its file name or a
+    path to it (an absolute one may hold spaces); ``shown`` is how the video is named on the line (default:
+    as given)."""
     text = str(why)
     head = f"{Path(video).name}: "
     cut = text.find(head)
-    if cut == 0 or (cut > 0 and text[cut - 1] in "/\\" and " " not in text[:cut]):  # the name, or a path to it
+    # the name, or a path to it: absolute (spaces and all), or relative without spaces (not a sentence)
+    if cut == 0 or (cut > 0 and text[cut - 1] in "/\\" and (os.path.isabs(text[:cut]) or " " not in text[:cut])):
         text = text[cut + len(head):]
     return f"FAILED {shown if shown is not None else video}: {text}"

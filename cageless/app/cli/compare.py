@@ -41,7 +41,9 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
                    "paper's definition) or each trace's own loaded-zone speed, which removes a flat bias from a "
                    "stated speed, scale or clearance slightly off")
     p.add_argument("--force", action="store_true", help="compare traces of different conditions or bearings")
-    p.add_argument("--align-ball", type=int, help="also align this ball's speed in time (cross-correlation)")
+    p.add_argument("--align-ball", type=int,
+                   help="also align this ball's speed in time (cross-correlation; balls are numbered 0..Z-1, "
+                   "counter-clockwise)")
     p.add_argument("--figures", help="write the speed, slip, contact and ring figures (SVG) to this folder")
 
 

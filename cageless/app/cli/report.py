@@ -53,6 +53,9 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
                    "numbers and conditions outside their plausible ranges")
     p.add_argument("--n-balls", type=int, metavar="N",
                    help="ball count the videos show, when it differs from the bearing's (default: the bearing's)")
+    p.add_argument("--window", type=int, metavar="FRAMES",
+                   help="Savitzky-Golay speed window of the tracking, in frames, odd, >= 3 (default 21); a shorter "
+                   "one tracks shorter clips, with noisier speeds")
     p.add_argument("--allow-truncated", action="store_true",
                    help="track the complete frames of a cut-off .cine instead of failing its row")
 
@@ -73,15 +76,17 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     from cageless.validate import check_options
 
     check_n_balls(args.n_balls, config)
+    if args.window is not None and (args.window < 3 or args.window % 2 == 0):
+        raise UsageError(f"--window {args.window}: must be an odd number of frames >= 3.")
     values = parameter_values(args, config)  # [parameters] of --config, then --set; before any work starts
-    check_options(args, ("duration", "settle", "revolutions", "rtol", "workers"))
+    check_options(args, ("duration", "settle", "revolutions", "rtol", "workers", "window"))
     check_output_dir(args.out, "-o")
     check_products(args.out, REPORT_PRODUCTS, CACHE_NAME)
     note = describe_calibration(config.get("calibration"))
     options = LabOptions(duration_s=args.duration, settle_s=args.settle, revolutions=args.revolutions,
                          rtol=args.rtol, workers=args.workers,
                          scheduler=args.scheduler, force=args.force, parameters=values, calibration=note,
-                         n_balls=args.n_balls, allow_truncated=args.allow_truncated,
+                         n_balls=args.n_balls, allow_truncated=args.allow_truncated, window=args.window,
                          slip_reference=args.slip_reference,
                          parameter_set=args.parameter_set or DEFAULT_SET)
     if not find_videos(args.lab):  # find_videos names a missing folder; say so before any output

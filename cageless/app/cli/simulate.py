@@ -47,19 +47,23 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
                    help="total simulated time, start-up included (s; default: the start-up that compare and report "
                    "leave out, three cage revolutions, then one more revolution: 0.2 s at 3000 rpm)")
     p.add_argument("--gravity", type=finite_float, default=9.81, help="gravity (m/s^2, default 9.81; 0 for none)")
-    p.add_argument("--orientation", choices=("horizontal", "vertical"), default="horizontal", help="shaft orientation")
+    p.add_argument("--orientation", choices=("horizontal", "vertical"), default="horizontal",
+                   help="shaft orientation (default horizontal; vertical puts gravity along the shaft)")
     p.add_argument("--misalignment-rad", type=finite_float, default=0.0,
-                   help="prescribed inner-ring tilt about y (rad); the ring tilts further under the contacts")
+                   help="prescribed inner-ring tilt about y (rad, default 0); the ring tilts further under the "
+                   "contacts")
     p.add_argument("--moment-load-nm", type=finite_float, default=0.0,
-                   help="moment load on the inner ring about y (N m); selects the spatial level")
+                   help="moment load on the inner ring about y (N m, default 0); selects the spatial level")
     p.add_argument("--oil-air-density", type=finite_float, help="oil-air mixture density (kg/m^3; default 42.4, 5 %% oil by volume, in a lubricated scene; 0 turns drag off)")
     p.add_argument("--clearance-um", type=finite_float,
                    help="diametral clearance (um), races moved apart symmetrically (default: the bearing's, 0 for "
                    "the paper's; ISO 5753-1 C4 for this size is 23-41 um)")
     p.add_argument("--dry", action="store_true", help="no lubricant")
-    p.add_argument("--seed", type=int, default=0, help="perturbs the initial gaps")
-    p.add_argument("--level", help="force the model level: planar or spatial")
-    p.add_argument("--effect", action="append", default=[], metavar="NAME=on|off", help="force an effect")
+    p.add_argument("--seed", type=int, default=0, help="seed that perturbs the initial gaps (default 0)")
+    p.add_argument("--level", help="force the model level: planar or spatial (default: the scene's; --explain "
+                   "says which and why)")
+    p.add_argument("--effect", action="append", default=[], metavar="NAME=on|off",
+                   help="force an effect on or off (repeatable; --explain lists the effects)")
     p.add_argument("--force", action="store_true", help="allow forced choices that contradict the scene, and "
                    "numbers outside their plausible ranges")
     p.add_argument("--overwrite", action="store_true", help="allow -o to replace a file that is not a cageless trace")
@@ -82,10 +86,12 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
                    "simulation/parameters.py lists them with their sources)")
     p.add_argument("--speed-ramp", type=finite_float, default=0.0,
                    help="time for the ring to reach its speed from rest (s, default 0: at speed from the start)")
-    p.add_argument("--ensemble", type=int, default=1, metavar="N", help="run seeds 0..N-1 (N traces, both cores)")
+    p.add_argument("--ensemble", type=int, default=1, metavar="N",
+                   help="run seeds 0..N-1 (N traces, both cores; default 1)")
     p.add_argument("--scheduler", help="with --ensemble: address of a Dask scheduler to run the seeds on")
     p.add_argument("--sample-rate", type=finite_float, default=10_000.0, help="samples per second (default 10000)")
-    p.add_argument("-o", "--out", help="trace file to write (default sim_<rpm>rpm_Fr<N>.trace.h5)")
+    p.add_argument("-o", "--out", help="trace file to write (default sim_<rpm>rpm_Fr<N>.trace.h5, with _Fa<N> "
+                   "under an axial load)")
 
 
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
@@ -156,8 +162,15 @@ def _validate(args: argparse.Namespace, bearing: Any) -> None:
     if args.out:
         check_output_file(args.out, "-o", overwrite=args.overwrite)
     elif args.ensemble == 1:
-        check_output_file(f"sim_{args.speed_rpm:g}rpm_Fr{args.radial_load_n:g}.trace.h5", "the default output",
+        check_output_file(_default_out(args), "the default output",
                           overwrite=args.overwrite)
+
+
+def _default_out(args: argparse.Namespace) -> str:
+    """``sim_<rpm>rpm_Fr<N>.trace.h5``, with ``_Fa<N>`` under an axial load (so scenes that differ only in it
+    do not replace each other's trace)."""
+    axial = f"_Fa{args.axial_load_n:g}" if args.axial_load_n else ""
+    return f"sim_{args.speed_rpm:g}rpm_Fr{args.radial_load_n:g}{axial}.trace.h5"
 
 
 def _bearing_line(bearing: Any) -> str:
@@ -196,7 +209,7 @@ def _run(args: argparse.Namespace, scene: Any, choices: Any, config: dict[str, A
     choice = sim.model
     if args.ensemble < 1:
         raise UsageError(f"--ensemble must be >= 1, got {args.ensemble}")
-    out = args.out or f"sim_{args.speed_rpm:g}rpm_Fr{args.radial_load_n:g}.trace.h5"
+    out = args.out or _default_out(args)
     from cageless.app.calibrate import describe_calibration
 
     from cageless.simulation.parameter_sets import DEFAULT_SET

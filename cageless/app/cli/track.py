@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import sys
 from collections.abc import Callable, Mapping
 from dataclasses import replace
@@ -69,7 +70,8 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
                    help="radial load (N), recorded in the trace for the comparison: as --speed-rpm (0 N when no "
                    "source gives it, with a warning)")
     p.add_argument("--axial-load-n", type=finite_float, help="axial load (N): as --radial-load-n")
-    p.add_argument("--fps", type=finite_float, help="frame-rate override (frames/s)")
+    p.add_argument("--fps", type=finite_float,
+                   help="frame-rate override (frames/s; default: the video's time stamps, else its header rate)")
     p.add_argument("--window", type=int, default=DEFAULT_WINDOW,
                    help=f"Savitzky-Golay speed window in frames, odd (default {DEFAULT_WINDOW})")
     p.add_argument("--detector", choices=DETECTORS, default="window",
@@ -247,11 +249,11 @@ def _run_locked(args: argparse.Namespace, entries: list[LabEntry], bearing: Bear
 def _namer(inputs: list[str]) -> Callable[[Path], str]:
     """How a video is named on its ``ok``/``FAILED`` line, the same way on every line of a run: relative to the
     input folder it was found in (as the report names it), else as given on the command line."""
-    typed = {Path(i).resolve(): i for i in inputs}
+    typed = {Path(os.path.abspath(i)): i for i in inputs}  # not resolved: a linked video stays in its folder
     folders = [full for full in typed if full.is_dir()]
 
     def shown(video: Path) -> str:
-        full = Path(video).resolve()
+        full = Path(os.path.abspath(video))
         for folder in folders:
             if full != folder and full.is_relative_to(folder):
                 return full.relative_to(folder).as_posix()
