@@ -145,6 +145,9 @@ def test_info_real_cine_text(shared_dir, capsys):
     assert main(["info", str(shared_dir / "reference" / "cine" / "cine_781.cine")]) == 0
     out = capsys.readouterr().out
     assert "header rate       90000 fps" in out and "time from         timestamps" in out
+    # the JSON's duration_s (15 frames at the 9003.2 fps of the time stamps) and the first-to-last span (14
+    # periods), both named: the text showed only the span, the JSON only the other (a new user's trial)
+    assert "duration          0.00166607 s (15 frames); 0.001555 s first to last frame" in out
 
 
 def test_info_bad_video_is_exit_1(tmp_path, capsys):

@@ -31,6 +31,15 @@ examples:
 """
 
 
+def _duration(m: dict[str, Any]) -> str:
+    """The ``duration_s`` of the JSON (frames over the rate in use), and the span from the first frame's time to
+    the last's, which is one frame period shorter."""
+    parts = [] if m.get("duration_s") is None else [f"{m['duration_s']:.6g} s ({m['n_frames']} frames)"]
+    if m.get("last_time_s") is not None:
+        parts.append(f"{m['last_time_s']:.6g} s first to last frame")
+    return "; ".join(parts) or "unknown"
+
+
 def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     """Add the ``info`` subcommand."""
     p = subparsers.add_parser(
@@ -140,7 +149,7 @@ def _format_video(m: dict[str, Any]) -> str:
         f"  header rate       {fps(m['header_fps'])}",
         f"  time-stamp rate   {fps(m['timestamp_fps'])}",
         f"  time from         {m['time_source'] or 'nothing (give --fps)'}",
-        "  duration          " + ("unknown" if m.get("last_time_s") is None else f"{m['last_time_s']:.6g} s (first to last frame)"),
+        "  duration          " + _duration(m),
         "  exposure          " + ("unknown" if m["exposure_s"] is None else f"{m['exposure_s'] * 1e6:.4g} us"),
     ]
     if m["camera"]:
