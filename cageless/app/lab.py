@@ -348,16 +348,33 @@ def run_lab(folder: str | Path, out: str | Path, options: LabOptions | None = No
     """
     out = Path(out)
     token = _BARS.set(progress if bars is None else bars)
+    said = _Said()  # the warnings about the inputs, for the report as well as the console
+    logging.getLogger("cageless").addHandler(said)
     try:
         with output_lock(out, "report folder"):
             clean_stale_parts(out)
-            return _run_lab(folder, out, options, bearing, progress)
+            return _run_lab(folder, out, options, bearing, progress, said.messages)
     finally:
+        logging.getLogger("cageless").removeHandler(said)
         _BARS.reset(token)
 
 
+class _Said(logging.Handler):
+    """Keeps the text of each distinct warning logged in this process (the conditions' sources disagreeing,
+    columns ignored, a 0 N load assumed, a video copied twice), in the order said."""
+
+    def __init__(self) -> None:
+        super().__init__(level=logging.WARNING)
+        self.messages: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        text = record.getMessage()
+        if text not in self.messages:
+            self.messages.append(text)
+
+
 def _run_lab(folder: str | Path, out: Path, options: LabOptions | None, bearing: Bearing | None,
-             progress: bool) -> LabResult:
+             progress: bool, notices: list[str]) -> LabResult:
     from cageless.comparison.compare import ComparisonRow
     from cageless.comparison.report import build_report, write_report
     from cageless.comparison.table import write_tables
@@ -400,7 +417,7 @@ def _run_lab(folder: str | Path, out: Path, options: LabOptions | None, bearing:
         "configuration": options.to_dict(), "bearing": bearing.to_dict(),
         **{f"bearing of {e.video.name}": bearings[e.video].name for e in good if _bearing_label(bearings[e.video],
                                                                                                   bearing)}},
-        timings=timings)
+        timings=timings, notices=notices)
     report = write_report(structure, out / "report.html")
     return LabResult(report=report, table=tables["csv"], rows=rows, n_failed=len(failed), timings=timings,
                      skipped=skipped)

@@ -38,6 +38,7 @@ th{background:#f3f3f3}tr.failed td{background:#fde8e8}tr.mismatch td,tr.tracking
 <h2>Conditions</h2>
 <table><thead><tr><th>Speed (r/min)</th><th>Radial load (N)</th><th>Axial load (N)</th><th>Video</th><th>Status</th></tr></thead>
 <tbody>{% for c in r.conditions %}<tr>{% for v in c %}<td>{{ v }}</td>{% endfor %}</tr>{% endfor %}</tbody></table>
+{% if r.notices %}<h3>Warnings about the inputs</h3><ul class="notices">{% for n in r.notices %}<li>{{ n }}</li>{% endfor %}</ul>{% endif %}
 <h2>Slip rate: model against experiment</h2>
 {{ r.table_html | safe }}
 {% for f in r.failures %}<div class="failed-box"><b>{{ f.title }}</b> failed: {{ f.message }}</div>{% endfor %}

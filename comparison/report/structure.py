@@ -108,8 +108,9 @@ def _precision_text(p: Mapping[str, Any]) -> str:
 
 def build_report(descriptions: Sequence[ConditionDescription], failed_rows: Sequence[ComparisonRow] = (),
                  reproduction: Mapping[str, Any] | None = None, timings: Mapping[str, float] | None = None,
-                 title: str = "cageless: model against experiment") -> dict[str, Any]:
-    """The report's structure: conditions, the Table-2-style table, one section per condition, QC, reproduction."""
+                 title: str = "cageless: model against experiment", notices: Sequence[str] = ()) -> dict[str, Any]:
+    """The report's structure: conditions (with ``notices``, the warnings said about the inputs), the
+    Table-2-style table, one section per condition, QC, reproduction."""
     descriptions = sorted(descriptions, key=lambda d: (d.row.speed_rpm, d.row.radial_load_n, d.row.axial_load_n,
                                                        d.row.label))  # the slip table's order
     rows = [d.row for d in descriptions] + list(failed_rows)
@@ -137,5 +138,6 @@ def build_report(descriptions: Sequence[ConditionDescription], failed_rows: Sequ
         "failures": [{"title": r.label, "message": r.message} for r in failed_rows],
         "qc": [_qc(d) for d in descriptions if d.qc],
         "reproduction": repro,
+        "notices": list(notices),
         "timings": [(k, f"{v:.1f} s") for k, v in (timings or {}).items()],
     }

@@ -82,6 +82,7 @@ def test_a_bad_video_is_a_failed_row_and_the_rest_completes(tmp_path, capsys):
     shutil.copy(LAB / "n6000_Fr500_Fa0.cine", lab)
     (lab / "n3000_Fr500_Fa0.cine").write_bytes(b"not a cine file" * 100)
     (lab / "mystery.avi").write_bytes(b"\x00" * 10)  # no conditions anywhere
+    (lab / "conditions.csv").write_text("file,speed_rpm,radial_load_n,operator\nn6000_Fr500_Fa0.cine,6000,500,AB\n")
     out = tmp_path / "out"
     assert main(["report", str(lab), "-o", str(out), "-q", *ONE_REV]) == 1
     text = capsys.readouterr().err
@@ -92,6 +93,9 @@ def test_a_bad_video_is_a_failed_row_and_the_rest_completes(tmp_path, capsys):
     assert sorted(table.status) == ["failed", "failed", "ok"]
     html = _report_checks(out, 3)
     assert "n3000_Fr500_Fa0.cine" in html and "failed" in html
+    # what was said about the inputs on the console is in the report too (a new user's trial: only the console)
+    notices = html.split("<h3>Warnings about the inputs</h3>", 1)[1].split("</ul>", 1)[0]
+    assert "ignoring column" in notices and "operator" in notices and notices.count("<li>") >= 1
 
 
 def _after(trace: Trace, start_s: float) -> Trace:
