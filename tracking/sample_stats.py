@@ -22,7 +22,7 @@ from cageless.tracking.io.base import FrameSource
 from cageless.tracking.locate import background_frame
 from cageless.tracking.locate_motion import DROPOUT_GAIN, motion_map
 
-__all__ = ["SampleStats", "sample_statistics", "sorting_network"]
+__all__ = ["SampleStats", "kth_smallest", "sample_statistics", "sorting_network"]
 
 #: Rows per band (25 frames x 32 rows x 1280 px x 2 B = 2 MB), as :func:`~cageless.tracking.locate.background_frame`.
 _BAND_ROWS = 32
@@ -76,22 +76,69 @@ def sorting_network(n: int) -> npt.NDArray[np.intp]:
 
 
 @numba.njit(cache=True, nogil=True)
+def _tile_buffer(band):  # pragma: no cover - compiled
+    """A tile of ``m`` rows (the least power of two >= the frames of ``band``) by :data:`_TILE` lanes."""
+    m = 1
+    while m < band.shape[0]:
+        m *= 2
+    return np.empty((m, _TILE), dtype=band.dtype)
+
+
+@numba.njit(cache=True, nogil=True)
+def _load_tile(band, r, c0, tn, pad, buf):  # pragma: no cover - compiled
+    """Row ``r``, columns ``c0..c0+tn-1`` of every frame of ``band`` into ``buf``, ``pad`` in the rows above."""
+    for k in range(band.shape[0]):
+        for t in range(tn):
+            buf[k, t] = band[k, r, c0 + t]
+    for k in range(band.shape[0], buf.shape[0]):
+        for t in range(tn):
+            buf[k, t] = pad
+
+
+@numba.njit(cache=True, nogil=True)
+def _sort_tile(buf, tn, pairs):  # pragma: no cover - compiled
+    """Sort each of the first ``tn`` lanes of ``buf`` (its rows) by the comparators ``pairs``."""
+    for p in range(pairs.shape[0]):
+        i, j = pairs[p, 0], pairs[p, 1]
+        for t in range(tn):
+            a, b = buf[i, t], buf[j, t]
+            buf[i, t] = min(a, b)
+            buf[j, t] = max(a, b)
+
+
+@numba.njit(cache=True, nogil=True)
+def _kth(stack, pad, pairs, k, out):  # pragma: no cover - compiled
+    """``out[r, c]``: the ``k``-th smallest (from 0) of ``stack[:, r, c]``."""
+    buf = _tile_buffer(stack)
+    for r in range(stack.shape[1]):
+        for c0 in range(0, stack.shape[2], _TILE):
+            tn = min(_TILE, stack.shape[2] - c0)
+            _load_tile(stack, r, c0, tn, pad, buf)
+            _sort_tile(buf, tn, pairs)
+            for t in range(tn):
+                out[r, c0 + t] = buf[k, t]
+
+
+def kth_smallest(frames: np.ndarray, k: int) -> np.ndarray:
+    """``np.partition(frames, k, axis=0)[k]`` (the same values) for a stack of 8- or 16-bit frames, by the sorting
+    network across tiles of pixels; other stacks by :func:`numpy.partition`."""
+    n = frames.shape[0]
+    if frames.dtype not in (np.uint8, np.uint16) or frames.ndim != 3 or not 0 < n <= 32:
+        return np.partition(frames, k, axis=0)[k]
+    out = np.empty(frames.shape[1:], frames.dtype)
+    _kth(frames, np.iinfo(frames.dtype).max, sorting_network(n), int(k) % n, out)
+    return out
+
+
+@numba.njit(cache=True, nogil=True)
 def _band_stats(band, pad, pairs, drop, k_mid, k_low, even, med, low, s1, s2):  # pragma: no cover - compiled
     """One band of rows: ``band`` is (n, rows, W); the sorted tile has ``pad`` above the ``n`` values."""
     n, rows, w = band.shape
-    m = 1
-    while m < n:
-        m *= 2
-    buf = np.empty((m, _TILE), dtype=band.dtype)
+    buf = _tile_buffer(band)
     for r in range(rows):
         for c0 in range(0, w, _TILE):
             tn = min(_TILE, w - c0)
-            for k in range(n):
-                for t in range(tn):
-                    buf[k, t] = band[k, r, c0 + t]
-            for k in range(n, m):
-                for t in range(tn):
-                    buf[k, t] = pad
+            _load_tile(band, r, c0, tn, pad, buf)
             for t in range(tn):  # the motion map's sums: the same float64 additions in frame order
                 s1[r, c0 + t] = 0.0
                 s2[r, c0 + t] = 0.0
@@ -106,12 +153,7 @@ def _band_stats(band, pad, pairs, drop, k_mid, k_low, even, med, low, s1, s2):  
                         x = np.float64(buf[k, t])
                         s1[r, c0 + t] -= x
                         s2[r, c0 + t] -= x * x
-            for p in range(pairs.shape[0]):
-                i, j = pairs[p, 0], pairs[p, 1]
-                for t in range(tn):
-                    a, b = buf[i, t], buf[j, t]
-                    buf[i, t] = min(a, b)
-                    buf[j, t] = max(a, b)
+            _sort_tile(buf, tn, pairs)
             for t in range(tn):
                 if even:
                     med[r, c0 + t] = np.float32((np.float64(buf[k_mid - 1, t]) + np.float64(buf[k_mid, t])) / 2.0)

@@ -16,7 +16,7 @@ import pytest
 from cageless.tracking.io import open_video, write_cine
 from cageless.tracking.locate import background_frame
 from cageless.tracking.locate_motion import motion_map
-from cageless.tracking.sample_stats import sample_statistics, sorting_network
+from cageless.tracking.sample_stats import kth_smallest, sample_statistics, sorting_network
 
 
 @pytest.mark.parametrize("n", [1, 2, 3, 5, 7, 8, 12, 16])
@@ -93,3 +93,12 @@ def test_other_pixel_types_take_the_plain_functions():
     assert got.median.tobytes() == background_frame(video).tobytes()
     assert got.low.tobytes() == background_frame(video, quantile=0.25).tobytes()
     assert got.spread.tobytes() == motion_map(video).tobytes()
+
+
+@pytest.mark.parametrize("n", [1, 4, 16, 25, 32])
+@pytest.mark.parametrize("dtype", [np.uint8, np.uint16])
+def test_kth_smallest_is_numpys_partition(n, dtype):
+    frames = _frames(max(n, 4), dtype, 40 + n)[:n]
+    frames = np.ascontiguousarray(frames[:, :, :290])  # a width that is not a multiple of the tile
+    for k in sorted({0, n // 4, n // 2, n - 1}):
+        assert kth_smallest(frames, k).tobytes() == np.partition(frames, k, axis=0)[k].tobytes()
