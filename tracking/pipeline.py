@@ -419,6 +419,7 @@ def track_video(
             loc, frames, setup, sel = _select(video, loc, background, bearing, options, conditions, path, sample.low)
         except SelectionError as exc:
             refuse_selection(exc, path, video.__getitem__, loc.crop(video.frame_shape), out_dir)
+        del sample  # its low quantile and motion map are done with (8 MB at full size)
         rows, cols = frames.rows, frames.cols
         with tqdm(total=len(video), desc=path.name, unit="frame", disable=not progress, leave=False) as bar:
             table = _track_all(path, fps, video, frames, times, setup, options, bar.update)
