@@ -88,7 +88,8 @@ _PIPELINE = _PRELUDE + (
     "print(json.dumps({{'s': time.perf_counter() - t, 'cpu_s': time.process_time() - c, 'n': int(r.trace.n_samples), "
     "'loop_s': loop[0], 'loop_cpu_s': loop[1]}}))"
 )
-_CLI = _PRELUDE + "from cageless.app.cli import main; sys.exit(main({argv!r}))"
+#: The console script's own entry (its exit included), as ``cageless ...`` runs it.
+_CLI = _PRELUDE + "sys.argv = ['cageless', *{argv!r}]; from cageless.app.cli import entry_point; entry_point()"
 #: CPU time (user + system, s) and bytes read from storage of the last child :func:`_child` ran.
 _LAST_CPU_S = float("nan")
 _LAST_READ_BYTES = float("nan")

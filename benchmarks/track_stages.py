@@ -3,9 +3,10 @@
     python benchmarks/track_stages.py CLIP [--threads 1] [--copy]
 
 Runs :func:`cageless.tracking.pipeline.track_video` on ``CLIP`` once to warm up (numba cache, page cache,
-input-hash cache), then once more with timers around the pipeline's stages (the median backgrounds, the
-localisation, the ball selection and its blob response maps and tracklet linking, the masks and noise, the
-per-frame loop with its compiled step, its Python step and its page drops, the fitting and QC record, and within it
+input-hash cache), then once more with timers around the pipeline's stages (the sample statistics: the median
+backgrounds and the motion map in one pass, or in a tree before it the median backgrounds; the localisation, the
+ball selection and its blob response maps and tracklet linking, the masks and noise, the per-frame loop with its
+compiled step, its Python step and its page drops, the fitting and QC record, and within it
 the trace's precision estimate) and prints
 each stage's CPU (``process_time``: with ``--threads 1`` each stage's own) and wall time, in ms a frame and in
 s. Nested stages are counted in their parents too. With ``--copy`` the per-frame loop gets in-memory copies of
@@ -28,7 +29,9 @@ _TIMES: defaultdict[str, list[float]] = defaultdict(lambda: [0.0, 0.0, 0.0])
 
 
 def _wrap(owner: Any, name: str) -> None:
-    inner = getattr(owner, name)
+    inner = getattr(owner, name, None)
+    if inner is None:  # a stage this tree does not have
+        return
 
     @functools.wraps(inner)
     def timed(*args: Any, **kwargs: Any) -> Any:
@@ -59,7 +62,8 @@ def main() -> None:
     ap.add_argument("--speed-rpm", type=float, default=3000.0)
     ap.add_argument("--copy", action="store_true", help="the per-frame loop on in-memory copies of its blocks")
     args = ap.parse_args()
-    for name in ("background_frame", "_locate", "_select", "_track_all", "_finish", "assess_table", "noise_sigma",
+    for name in ("sample_statistics", "background_frame", "_locate",
+                 "_select", "_track_all", "_finish", "assess_table", "noise_sigma",
                  "static_defects", "static_pattern"):
         _wrap(pipeline, name)
     _wrap(select, "link_tracklets")

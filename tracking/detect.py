@@ -34,6 +34,7 @@ import numpy.typing as npt
 
 from cageless.errors import ParameterError
 from cageless.tracking.locate_motion import DROPOUT_GAIN, frame_gains
+from cageless.tracking.sample_stats import kth_smallest
 
 __all__ = [
     "DetectorParams", "DETECTORS", "Detections", "detect_full", "centroid_windows", "noise_sigma", "pixel_noise",
@@ -127,7 +128,7 @@ def static_defects(background: np.ndarray, sigma_noise: float, k: float = 8.0,
     out = (bg - cv2.medianBlur(bg, size)) > k * sigma_noise
     if frames is not None and len(frames):
         q = len(frames) // 4  # bright in three quarters of them: a dark frame or a ball passing over a glint
-        low = np.partition(frames, q, axis=0)[q].astype(np.float32)
+        low = kth_smallest(frames, q).astype(np.float32)  # np.partition's value, sooner (tested)
         out &= (low - cv2.medianBlur(low, size)) > k * sigma_noise
     return out
 

@@ -46,6 +46,7 @@ from cageless.tracking.locate_motion import (DROPOUT_GAIN, frame_gains, holds_th
 from cageless.tracking.qc import (QC_LIMITS, QCReport, build_qc, refuse_located, refuse_selection, selection_frame,
                                   slip_warnings, write_qc, write_selection_qc)
 from cageless.tracking.qc import qc_stem as _stem
+from cageless.tracking.sample_stats import sample_statistics
 from cageless.tracking.segments import MIN_SEGMENT, OVERLAP, bounds_at_anchors, stitch
 from cageless.tracking.select import SPEED_BAND, Selection, SelectionError, select_balls
 from cageless.tracking.position_bias import remove_place_bias
@@ -214,15 +215,16 @@ class _CropView:
 
 
 def _locate(video: FrameSource, background: np.ndarray, bearing: Bearing, path: Path,
-            px_per_mm: float | None = None) -> BearingLocation:
+            px_per_mm: float | None = None, spread: np.ndarray | None = None) -> BearingLocation:
     """The bearing and its ball band from brightness; from motion when that fails, gives a band that
     does not fit a ball, a band where little moves (dark ring faces, balls over bright faces), or (at a stated
-    ``px_per_mm``) a band that does not hold the pitch circle (corpus seed 7304: a contour centre 0.58 balls off)."""
+    ``px_per_mm``) a band that does not hold the pitch circle (corpus seed 7304: a contour centre 0.58 balls off).
+    ``spread``: the motion map when the caller has it (:func:`~cageless.tracking.sample_stats.sample_statistics`)."""
     g = bearing.geometry
     ratio = g.ball_diameter_m / (0.5 * g.pitch_diameter_m)
     pitch_px = 0.5 * g.pitch_diameter_m * 1e3 * px_per_mm if px_per_mm else None
     err: TrackingError | None = None
-    spread = motion_map(video)
+    spread = motion_map(video) if spread is None else spread
     try:
         loc = locate_bearing(background, path)
         if (plausible_band(loc, ratio) and holds_the_motion(spread, loc)
@@ -243,8 +245,9 @@ def _locate(video: FrameSource, background: np.ndarray, bearing: Bearing, path: 
 
 def _setup(video: FrameSource, loc: BearingLocation, background: np.ndarray, bearing: Bearing,
            options: TrackOptions, frames: _CroppedFrames, conditions: OperatingConditions,
-           path: Path, k_sigma: float) -> tuple[TrackSetup, Selection]:
-    """Masks and noise level, then the ball selection (:mod:`cageless.tracking.select`) and the highlight width."""
+           path: Path, k_sigma: float, low: np.ndarray | None = None) -> tuple[TrackSetup, Selection]:
+    """Masks and noise level, then the ball selection (:mod:`cageless.tracking.select`) and the highlight width.
+    ``low``: the full frames' :data:`SELECT_QUANTILE` background when the caller has it (cropped here)."""
     rows, cols = frames.rows, frames.cols
     margin = max(1.5, 0.04 * (loc.band_outer - loc.band_inner))
     mask = loc.annulus_mask(video.frame_shape, margin)[rows, cols]
@@ -272,7 +275,8 @@ def _setup(video: FrameSource, loc: BearingLocation, background: np.ndarray, bea
     # then keeps its ghost, which cuts the highlight into stripes (frame minus background).
     # Over the crop only: a per-pixel quantile, so the values of the full frames cropped (tested), on 41 % of the
     # pixels of the 1280 x 800 benchmark clip (0.20 -> 0.045 s of CPU there).
-    sel_bg = background_frame(_CropView(video, rows, cols), quantile=SELECT_QUANTILE, workers=options.threads)
+    sel_bg = (background_frame(_CropView(video, rows, cols), quantile=SELECT_QUANTILE, workers=options.threads)
+              if low is None else np.ascontiguousarray(low[rows, cols]))
     sel = select_balls(frames, video.times, sel_bg, mask, z=z, ball_diameter_m=g.ball_diameter_m,
                        pitch_diameter_m=g.pitch_diameter_m, omega_i=conditions.speed_rad_s, centre0=centre0,
                        r_prior=r_prior, path=path, prior_known=known, k_sigma=k_sigma,
@@ -304,7 +308,7 @@ SELECT_K_SIGMA = (4.0, 3.0)
 
 
 def _select(video: FrameSource, loc: BearingLocation, background: np.ndarray, bearing: Bearing,
-            options: TrackOptions, conditions: OperatingConditions, path: Path
+            options: TrackOptions, conditions: OperatingConditions, path: Path, low: np.ndarray | None = None
             ) -> tuple[BearingLocation, _CroppedFrames, TrackSetup, Selection]:
     """:func:`_setup` on the located band; while that shows too few balls, again on a wider band, then with a
     lower candidate threshold, the first error raised when every try fails.
@@ -333,7 +337,7 @@ def _select(video: FrameSource, loc: BearingLocation, background: np.ndarray, be
     for k_sigma in SELECT_K_SIGMA:
         for band in bands:
             try:
-                return _select_in(video, band, background, bearing, options, conditions, path, k_sigma)
+                return _select_in(video, band, background, bearing, options, conditions, path, k_sigma, low)
             except SelectionError as exc:
                 first = first or exc
                 if (exc.found or 0) >= z:
@@ -345,11 +349,11 @@ def _select(video: FrameSource, loc: BearingLocation, background: np.ndarray, be
 
 
 def _select_in(video: FrameSource, loc: BearingLocation, background: np.ndarray, bearing: Bearing,
-               options: TrackOptions, conditions: OperatingConditions, path: Path, k_sigma: float
-               ) -> tuple[BearingLocation, _CroppedFrames, TrackSetup, Selection]:
+               options: TrackOptions, conditions: OperatingConditions, path: Path, k_sigma: float,
+               low: np.ndarray | None = None) -> tuple[BearingLocation, _CroppedFrames, TrackSetup, Selection]:
     rows, cols = loc.crop(video.frame_shape)
     frames = _CroppedFrames(video, rows, cols, options.chunk)
-    setup, sel = _setup(video, loc, background, bearing, options, frames, conditions, path, k_sigma)
+    setup, sel = _setup(video, loc, background, bearing, options, frames, conditions, path, k_sigma, low)
     return loc, frames, setup, sel
 
 
@@ -404,15 +408,18 @@ def track_video(
         if len(video) < options.window:
             raise TrackingError(path, f"has {len(video)} frames, fewer than the speed window of {options.window}: "
                                 "too short to give a speed.", "Record longer, or lower --window.")
-        background = background_frame(video, workers=options.threads)
+        # the median background, the selection's low quantile and the motion map, from one pass over the frames
+        sample = sample_statistics(video, quantile=SELECT_QUANTILE, workers=options.threads)
+        background = sample.median
         try:
-            loc = _locate(video, background, bearing, path, conditions.px_per_mm)
+            loc = _locate(video, background, bearing, path, conditions.px_per_mm, sample.spread)
         except TrackingError as exc:
             refuse_located(exc, path, video[0], out_dir)
         try:
-            loc, frames, setup, sel = _select(video, loc, background, bearing, options, conditions, path)
+            loc, frames, setup, sel = _select(video, loc, background, bearing, options, conditions, path, sample.low)
         except SelectionError as exc:
             refuse_selection(exc, path, video.__getitem__, loc.crop(video.frame_shape), out_dir)
+        del sample  # its low quantile and motion map are done with (8 MB at full size)
         rows, cols = frames.rows, frames.cols
         with tqdm(total=len(video), desc=path.name, unit="frame", disable=not progress, leave=False) as bar:
             table = _track_all(path, fps, video, frames, times, setup, options, bar.update)
