@@ -23,6 +23,15 @@ equations in (r', theta'), solved by Newton's method from the predictor with an 
 inner contact's normal held at the iterate; the residual itself exact), to
 :data:`TOL_V` in velocity. The race contacts are those of :func:`cageless.simulation.models.planar._outer_race`
 and ``_inner_race``, term for term.
+
+The planar solves are compiled with the model right-hand sides' fast-math flags
+(:data:`cageless.simulation.forces.FASTMATH`: fused multiply-add, reciprocals, signed zeros; no reassociation, so
+a fresh compile and numba's cache agree bit for bit): 2-3 % off ``ark4``'s planar CPU time, the same steps,
+the samples changed at round-off (docs/imex.md, the ninth step). The spatial solves
+(:mod:`cageless.simulation.models.implicit_normal_spatial`, which inline :func:`_solve3` and :func:`converged` under
+their own flags) and ``ark_integrate``'s loop stay without them: with them on the loop (with or without the
+spatial solves') a fresh compile and the cached code gave different round-off on the spatial model, which the
+determinism rule forbids.
 """
 
 from __future__ import annotations
@@ -32,6 +41,7 @@ import math
 import numba
 import numpy as np
 
+from cageless.simulation.forces import FASTMATH
 from cageless.simulation.models import base as B
 from cageless.simulation.models.planar import planar_rhs_trig
 
@@ -44,7 +54,7 @@ TOL_V = 1e-11
 MAX_NEWTON = 12
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
 def converged(step, last):  # pragma: no cover - compiled
     """Newton's stopping test after an update of size ``step`` (the one before: ``last``, inf at the first):
     the update itself within :data:`TOL_V`, or, from the contraction theta = step / last, the distance left to
@@ -60,7 +70,7 @@ def converged(step, last):  # pragma: no cover - compiled
     return theta < 1.0 and theta / (1.0 - theta) * step <= TOL_V
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
 def _forces(r, rd, thd, c, s, ring, p, hg):  # pragma: no cover - compiled
     """Ball's race normal forces in polar components (F_rad, F_tan) at (r, r', theta') and their approximate
     derivatives along (r', theta') with r = r_Z + hg r': (F_rad, F_tan, dFr/drd, dFr/dthd, dFt/drd, dFt/dthd)."""
@@ -95,7 +105,7 @@ def _forces(r, rd, thd, c, s, ring, p, hg):  # pragma: no cover - compiled
     return fr, ft, dfr_rd, dfr_th, dft_rd, dft_th
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
 def _ball_stage(r_z, rd_z, thd_z, c, s, ring, p, hg):  # pragma: no cover - compiled
     """Newton's method on r' = r'_Z + hg F_rad / m, theta' = theta'_Z + hg F_tan / (m r), r = r_Z + hg r':
     the stage's (r, r', theta')."""
@@ -122,7 +132,7 @@ def _ball_stage(r_z, rd_z, thd_z, c, s, ring, p, hg):  # pragma: no cover - comp
     return r, rd, thd
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, fastmath=FASTMATH)
 def planar_implicit_normal(y, p, hg, k_i):  # pragma: no cover - compiled
     """The planar model's implicit part (see the module) into ``k_i``; with ``hg > 0`` the stage equation
     y = y_Z + hg f_I(y) is solved first, in place on ``y`` (the predictor on entry)."""
@@ -134,7 +144,7 @@ def planar_implicit_normal(y, p, hg, k_i):  # pragma: no cover - compiled
         _ball_implicit(y, p, hg, k_i, j, z, math.cos(y[z + j]), math.sin(y[z + j]), ring)
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
 def _ball_implicit(y, p, hg, k_i, j, z, c, s, ring):  # pragma: no cover - compiled
     """Ball j's share of :func:`planar_implicit_normal` (c, s: the cos and sin of its angle)."""
     m = p[B.P_M]
@@ -153,7 +163,7 @@ def _ball_implicit(y, p, hg, k_i, j, z, c, s, ring):  # pragma: no cover - compi
         k_i[3 * z + j] = ft / (m * r)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, fastmath=FASTMATH)
 def planar_stage(t, y, p, log, hg, k_i, dydt):  # pragma: no cover - compiled
     """One IMEX stage of the planar model: the stage equation solved in place on ``y`` and f_I into ``k_i``
     (:func:`planar_implicit_normal`), then the whole right-hand side at the solved ``y`` into ``dydt``. The
@@ -172,7 +182,7 @@ def planar_stage(t, y, p, log, hg, k_i, dydt):  # pragma: no cover - compiled
     planar_rhs_trig(t, y, p, log, dydt, True)
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
 def _solve3(m, b0, b1, b2):  # pragma: no cover - compiled
     """x = M^-1 b for a general 3 x 3 M (a tuple of 9, row by row), by Cramer's rule."""
     a, b, c, d, e, f, g, h, i = m
@@ -184,7 +194,7 @@ def _solve3(m, b0, b1, b2):  # pragma: no cover - compiled
     return x0, x1, x2
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, fastmath=FASTMATH)
 def planar_filter_error(y, p, hg, e):  # pragma: no cover - compiled
     """Replace each ball's (r, r', theta') rows of the error estimate ``e`` by (I - hg J_I)^-1 e, J_I the
     Jacobian of the implicit part on those rows at ``y`` (Shampine's filter, as RADAU5's estimate;

@@ -92,7 +92,9 @@ def test_the_default_scene_switches_once_past_its_start_up():
     assert set(probes[0]["costs"]) == {"ark4"} and 0.08 < probes[0]["cost_ratio"] < 0.15
     assert probes[0]["cost_ratio"] < SWITCH_GAIN * probes[0]["skipped"]["CVODE"] < SWITCH_GAIN * 0.35
     assert probes[1]["cost_ratio"] > 1.0 and probes[0]["stiff_fraction"] > 0.6
-    assert probes[2]["to"] == "ark4" and 0.1 < probes[2]["cost_ratio"] < 0.25  # measured 0.13, CVODE skipped
+    # measured 0.13, CVODE skipped; 0.084 once the planar implicit solves took the fast-math flags (the ark4 run
+    # over 3-6 ms changed at round-off, and the start-up is chaotic)
+    assert probes[2]["to"] == "ark4" and 0.05 < probes[2]["cost_ratio"] < 0.25
 
 
 def test_a_scene_stiff_from_the_start_starts_on_cvode(monkeypatch):
