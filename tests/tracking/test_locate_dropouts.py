@@ -7,6 +7,8 @@ d_m / 2 +- D / 2).
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
 import numpy as np
 import pytest
 
@@ -14,19 +16,8 @@ from cageless.tracking.detect import static_defects
 from cageless.tracking.locate import BALL_BAND, BearingLocation
 from cageless.tracking.locate_motion import DROPOUT_GAIN, frame_gains, motion_map
 
-
-class _Frames:
-    """The three things :func:`motion_map` reads from a video: its length, frame shape and frames."""
-
-    def __init__(self, frames: np.ndarray) -> None:
-        self.frames = frames
-        self.frame_shape = frames.shape[1:]
-
-    def __len__(self) -> int:
-        return len(self.frames)
-
-    def __getitem__(self, i: int) -> np.ndarray:
-        return self.frames[i]
+sys.path.insert(0, str(Path(__file__).parent))
+from frame_stubs import ArrayFrames  # noqa: E402
 
 
 def _clip(n: int = 25, dark: tuple[int, ...] = ()) -> np.ndarray:
@@ -45,7 +36,7 @@ def _clip(n: int = 25, dark: tuple[int, ...] = ()) -> np.ndarray:
 def test_a_dropout_is_not_motion():
     frames = _clip(dark=(7, 16))
     steady = np.delete(frames, [7, 16], axis=0).astype(np.float64)
-    spread = motion_map(_Frames(frames))
+    spread = motion_map(ArrayFrames(frames))
     np.testing.assert_allclose(spread, steady.std(axis=0), atol=1e-3)
     assert spread[:10].max() == 0.0  # the background far from the spot's row does not move
     with_dropouts = frames.astype(np.float64).std(axis=0)

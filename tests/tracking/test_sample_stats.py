@@ -9,6 +9,8 @@ theorem Z: a comparator network that sorts every sequence of 0s and 1s sorts eve
 from __future__ import annotations
 
 import itertools
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,6 +19,9 @@ from cageless.tracking.io import open_video, write_cine
 from cageless.tracking.locate import background_frame
 from cageless.tracking.locate_motion import motion_map
 from cageless.tracking.sample_stats import kth_smallest, sample_statistics, sorting_network
+
+sys.path.insert(0, str(Path(__file__).parent))
+from frame_stubs import ArrayFrames  # noqa: E402
 
 
 @pytest.mark.parametrize("n", [1, 2, 3, 5, 7, 8, 12, 16])
@@ -70,25 +75,8 @@ def test_one_pass_gives_the_backgrounds_and_the_motion_map(tmp_path, n_frames, f
                 assert a.tobytes() == b.tobytes()
 
 
-class _FloatFrames:
-    """A source of float32 frames: the one pass does not apply, the three functions are used."""
-
-    def __init__(self, frames: np.ndarray) -> None:
-        self.frames = frames
-        self.frame_shape = frames.shape[1:]
-
-    def __len__(self) -> int:
-        return len(self.frames)
-
-    def __getitem__(self, i: int) -> np.ndarray:
-        return self.frames[i]
-
-    def frame_view(self, i: int) -> np.ndarray:
-        return self.frames[i]
-
-
 def test_other_pixel_types_take_the_plain_functions():
-    video = _FloatFrames(_frames(9, np.uint16, 1).astype(np.float32) / 7)
+    video = ArrayFrames(_frames(9, np.uint16, 1).astype(np.float32) / 7)
     got = sample_statistics(video)
     assert got.median.tobytes() == background_frame(video).tobytes()
     assert got.low.tobytes() == background_frame(video, quantile=0.25).tobytes()
