@@ -10,6 +10,7 @@ pool does not survive a fork).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -27,13 +28,13 @@ def seed_path(out: str | Path, seed: int) -> Path:
     return out.with_name(f"{stem}_seed{seed}{suffix}")
 
 
-def _one(sim: Simulation, out: str, config: dict[str, Any] | None) -> dict[str, Any]:
+def _one(sim: Simulation, out: str, config: dict[str, Any] | None, inputs: Sequence[str] = ()) -> dict[str, Any]:
     """Run one seed; its peak slip leaves out the start-up that ``compare`` leaves out, as the single run's
     summary does (NaN, and said so, when the run ends within it)."""
     from cageless.kinematics import startup_duration
     from cageless.simulation.run import peak_unloaded_slip
 
-    tr = sim.run(out=out, progress=False, config=config)
+    tr = sim.run(out=out, progress=False, config=config, inputs=inputs)
     sol = sim.solution
     assert sol is not None
     startup = startup_duration(tr.speed_rpm, tr.ball_diameter_m, tr.pitch_diameter_m)
@@ -48,9 +49,10 @@ def _one(sim: Simulation, out: str, config: dict[str, Any] | None) -> dict[str, 
 
 
 def run_ensemble(sim: Simulation, n_seeds: int, out: str | Path, workers: int = 2, progress: bool = True,
-                 scheduler: str | None = None, config: dict[str, Any] | None = None) -> list[dict[str, Any]]:
+                 scheduler: str | None = None, config: dict[str, Any] | None = None,
+                 inputs: Sequence[str | Path] = ()) -> list[dict[str, Any]]:
     """Run seeds 0..n_seeds-1 of ``sim`` (:meth:`~cageless.simulation.simulation.Simulation.with_seed`); one row per seed,
-    in seed order. ``config`` adds to each trace's recorded configuration.
+    in seed order. ``config`` adds to each trace's recorded configuration, ``inputs`` to its recorded inputs.
 
     Locally the seeds run in ``workers`` spawned processes; with ``scheduler`` (a Dask scheduler
     address) each seed is one task on that cluster, and the traces are written by the workers (so
@@ -59,5 +61,6 @@ def run_ensemble(sim: Simulation, n_seeds: int, out: str | Path, workers: int = 
     members = [sim.with_seed(k) for k in range(n_seeds)]
     paths = [str(Path(seed_path(out, k)).resolve()) for k in range(n_seeds)]
     with job_pool(min(workers, n_seeds), scheduler) as pool:
-        return gather([pool.submit(_one, m, p, config) for m, p in zip(members, paths, strict=True)], "seeds",
+        files = [str(Path(f).resolve()) for f in inputs]
+        return gather([pool.submit(_one, m, p, config, files) for m, p in zip(members, paths, strict=True)], "seeds",
                       progress)

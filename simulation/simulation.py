@@ -15,7 +15,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import time
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -152,9 +152,10 @@ class Simulation:
         return {"diametral_clearance_m": g.diametral_clearance_m, "note": clearance_note(g)}
 
     def run(self, out: str | Path | None = None, progress: bool = False,
-            config: dict[str, Any] | None = None) -> Trace:
+            config: dict[str, Any] | None = None, inputs: Sequence[str | Path] = ()) -> Trace:
         """Solve, build the trace and (with ``out``) write it atomically; ``config`` adds to its recorded
-        configuration.
+        configuration, and ``inputs`` (files the run was configured from, such as a ``--config`` TOML) to its
+        recorded inputs, each with its hash.
 
         A solver failure does not raise: :attr:`solution` ``.success`` is False and the trace's ``status``
         says ``"incomplete: <why>"``; samples after the failure are NaN.
@@ -166,7 +167,7 @@ class Simulation:
         prov = Provenance.start(config={"scene": self.scene.to_dict(), "model": json.loads(self.model.to_json()),
                                         "solver": c.solver_config(), "parameters": self.parameters.to_dict(),
                                         "peak_estimator": peak_estimator(), "clearance": self._clearance(),
-                                        **(config or {})})
+                                        **(config or {})}, inputs=inputs)
         pr = self.build()
         t = self.sample_times()
         start = time.perf_counter()

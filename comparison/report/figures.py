@@ -64,7 +64,7 @@ def speed_figure(d: ConditionDescription) -> str:
         _profile(ax, c.simulated.speed, 30 / np.pi, "simulated", "C3")
         ax.set(xlabel="orbital angle (deg)", ylabel="revolution speed (r/min)", xlim=(0, 360))
         ax.axvspan(0, 180, color="0.9", zorder=0, label="unloaded zone")
-        ax.fill_between([], [], [], color="0.3", alpha=0.2, lw=0, label="band: mean +- 1 std of samples")
+        ax.fill_between([], [], [], color="0.3", alpha=0.2, lw=0, label="band: mean ± 1 std of samples")
         _legend_below(fig, ax)
     return _svg(draw, size=(5.6, 3.4), layout="constrained")
 
@@ -82,7 +82,7 @@ def slip_figure(d: ConditionDescription, size: tuple[float, float] = (5.6, 3.4))
             ax.plot(prof["angle_deg"], 100.0 * smooth_profile(prof["mean"].to_numpy(), c.measured.bin_deg),
                     color=colour, lw=1.6, ls="--")
         ax.plot([], [], color="0.3", lw=1.6, ls="--", label=f"smoothed, sigma {PEAK_SMOOTHING_DEG:g} deg")
-        ax.fill_between([], [], [], color="0.3", alpha=0.2, lw=0, label="band: mean +- 1 std of samples")
+        ax.fill_between([], [], [], color="0.3", alpha=0.2, lw=0, label="band: mean ± 1 std of samples")
         ax.set(xlabel="orbital angle (deg)", ylabel="slip rate (%)", xlim=(0, 360))
         _legend_below(fig, ax)
     return _svg(draw, size=size, layout="constrained")
@@ -139,10 +139,10 @@ def ring_figure(d: ConditionDescription) -> str:
         a1, a2 = fig.subplots(1, 2)
         if yz is not None and len(yz):
             a1.plot(1e6 * yz[:, 0], 1e6 * yz[:, 1], lw=0.5, color="C0")
-        a1.set(xlabel="y (um)", ylabel="z (um)", title="ring centre orbit")
+        a1.set(xlabel="y (µm)", ylabel="z (µm)", title="ring centre orbit")
         if pc is not None and len(pc):
             a2.scatter(1e6 * pc[:, 0], 1e6 * pc[:, 1], s=6, color="C3")
-        a2.set(xlabel="y (um)", ylabel="z (um)", title="Poincare section (per shaft revolution)")
+        a2.set(xlabel="y (µm)", ylabel="z (µm)", title="Poincaré section (per shaft revolution)")
     return _svg(draw, size=(6.4, 2.9))
 
 

@@ -224,18 +224,20 @@ def _run(args: argparse.Namespace, scene: Any, choices: Any, config: dict[str, A
     if getattr(args, "duration_default", False):
         print(f"duration: {args.duration:g} s (the start-up that compare leaves out, then one cage revolution; "
               "--duration changes it)")
+    inputs = [args.config] if args.config else []  # its hash joins the trace's inputs, beside its values
     if not args.quiet and not args.progress:  # with the bar, the run says it (standard error not a terminal)
         from cageless.app.lab import say_if_compiling
 
         say_if_compiling("simulation")
     if args.ensemble == 1:
-        trace = sim.run(out=out, progress=args.progress, config=config)
+        trace = sim.run(out=out, progress=args.progress, config=config, inputs=inputs)
         print(f"effects: {', '.join(choice.active)}")
         print(_summary_line(trace, sim.solution, out))
         return 0 if sim.solution.success else 1
     from cageless.simulation.ensemble import run_ensemble
 
-    rows = run_ensemble(sim, args.ensemble, out, progress=args.progress, scheduler=args.scheduler, config=config)
+    rows = run_ensemble(sim, args.ensemble, out, progress=args.progress, scheduler=args.scheduler, config=config,
+                        inputs=inputs)
     print(f"effects: {', '.join(choice.active)}")
     for row in rows:
         print(f"seed {row['seed']}: {row['summary']}")
