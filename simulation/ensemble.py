@@ -10,6 +10,7 @@ pool does not survive a fork).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -31,18 +32,14 @@ def seed_path(out: str | Path, seed: int) -> Path:
 def _one(sim: Simulation, out: str, config: dict[str, Any] | None, inputs: Sequence[str] = ()) -> dict[str, Any]:
     """Run one seed; its peak slip leaves out the start-up that ``compare`` leaves out, as the single run's
     summary does (NaN, and said so, when the run ends within it)."""
-    from cageless.kinematics import startup_duration
-    from cageless.simulation.run import peak_unloaded_slip
+    from cageless.simulation.run import settled_peak_slip
 
     tr = sim.run(out=out, progress=False, config=config, inputs=inputs)
     sol = sim.solution
     assert sol is not None
-    startup = startup_duration(tr.speed_rpm, tr.ball_diameter_m, tr.pitch_diameter_m)
-    if float(tr.time[-1]) > startup:
-        peak = peak_unloaded_slip(tr, settle_s=startup)
-        slip = f"peak slip in the unloaded zone after {1e3 * startup:.0f} ms: {100 * peak:.2f}%"
-    else:
-        peak, slip = float("nan"), f"no settled slip: the run is within the {1e3 * startup:.0f} ms start-up"
+    peak, startup = settled_peak_slip(tr)
+    slip = (f"no settled slip: the run is within the {1e3 * startup:.0f} ms start-up" if math.isnan(peak) else
+            f"peak slip in the unloaded zone after {1e3 * startup:.0f} ms: {100 * peak:.2f}%")
     return {"seed": sim.scene.seed, "success": sol.success, "path": out, "peak_unloaded_slip": peak,
             "settle_s": startup, "summary": f"{tr.status}, {sol.n_steps} steps, {tr.simulation.wall_s:.1f} s wall, "
                                            f"{slip} -> {out}"}

@@ -18,7 +18,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cageless.errors import UsageError
-from cageless.kinematics import slip_rate, theoretical_cage_speed
+from cageless.kinematics import slip_rate, startup_duration, theoretical_cage_speed
 from cageless.profiles import PEAK_SMOOTHING_DEG, UNLOADED_ZONE_DEG, angle_profile, unloaded_zone_peak
 from cageless.trace import SimulationInfo, Trace
 from cageless.simulation.effects import ModelChoice
@@ -60,6 +60,15 @@ def peak_unloaded_slip(trace: Trace, settle_s: float = 0.0, bin_deg: float = 1.0
     """
     keep = (trace.time >= settle_s)[:, None] & trace.valid
     return unloaded_zone_peak(angle_profile(trace.angle, trace.slip, bin_deg, valid=keep), sigma_deg)
+
+
+def settled_peak_slip(trace: Trace) -> tuple[float, float]:
+    """The peak unloaded-zone slip after the start-up that ``compare`` and ``report`` leave out
+    (:func:`cageless.kinematics.startup_duration`), NaN when the run ends within it; and that start-up (s)."""
+    startup = startup_duration(trace.speed_rpm, trace.ball_diameter_m, trace.pitch_diameter_m)
+    if float(trace.time[-1]) <= startup:
+        return math.nan, startup
+    return peak_unloaded_slip(trace, settle_s=startup), startup
 
 
 def check_supported(scene: Scene, choice: ModelChoice | None = None) -> None:

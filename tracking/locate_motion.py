@@ -29,7 +29,7 @@ import numpy as np
 from cageless.tracking.io.base import FrameSource
 from cageless.tracking.locate import _STRETCH_TOPS, BearingLocation, _to_u8, fit_circle
 
-__all__ = ["motion_map", "moving_pixels", "frame_gains", "frame_level", "DROPOUT_GAIN", "locate_by_motion",
+__all__ = ["motion_map", "moving_pixels", "frame_gains", "frame_level", "dropout_frames", "DROPOUT_GAIN", "locate_by_motion",
            "plausible_band", "holds_the_motion"]
 
 log = logging.getLogger(__name__)
@@ -56,15 +56,11 @@ def motion_map(video: FrameSource, n_sample: int = 25) -> np.ndarray:
         levels[k] = frame_level(f)
         acc += f
         acc2 += f * f
-    ref = float(np.median(levels))
-    dropouts = idx[levels < DROPOUT_GAIN * ref] if ref > 0 else idx[:0]
-    if idx.size - dropouts.size >= 2:
-        for i in dropouts:  # taken out again (a few frames read twice, not 25 frames held)
-            f = video[int(i)].astype(np.float64)
-            acc -= f
-            acc2 -= f * f
-    else:
-        dropouts = idx[:0]  # no steady level to compare with: take the frames as they are
+    dropouts = idx[dropout_frames(levels)]
+    for i in dropouts:  # taken out again (a few frames read twice, not 25 frames held)
+        f = video[int(i)].astype(np.float64)
+        acc -= f
+        acc2 -= f * f
     used = idx.size - dropouts.size
     mean = acc / used
     return np.sqrt(np.maximum(acc2 / used - mean * mean, 0.0)).astype(np.float32)
@@ -79,6 +75,15 @@ def frame_level(frame: np.ndarray) -> float:
     """A frame's overall level: the mean of the frame subsampled 4 x 4 (the few moving highlights hardly change
     it; a mean, not a median, so that a dark 8-bit scene's level is not rounded to a few DN)."""
     return float(np.mean(frame[::4, ::4], dtype=np.float64))
+
+
+def dropout_frames(levels: np.ndarray) -> np.ndarray:
+    """Which of the sample frames of these :func:`frame_level` values are lighting dropouts, below
+    :data:`DROPOUT_GAIN` of their median level; none when fewer than two frames would be left (no steady level
+    to compare with) or the median level is 0."""
+    ref = float(np.median(levels))
+    drop = levels < DROPOUT_GAIN * ref if ref > 0 else np.zeros(len(levels), dtype=bool)
+    return drop if len(levels) - int(drop.sum()) >= 2 else np.zeros(len(levels), dtype=bool)
 
 
 def frame_gains(frames: list[np.ndarray]) -> np.ndarray:

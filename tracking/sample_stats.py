@@ -20,7 +20,7 @@ import numpy.typing as npt
 
 from cageless.tracking.io.base import FrameSource
 from cageless.tracking.locate import background_frame
-from cageless.tracking.locate_motion import DROPOUT_GAIN, motion_map
+from cageless.tracking.locate_motion import dropout_frames, frame_level, motion_map
 
 __all__ = ["SampleStats", "kth_smallest", "sample_statistics", "sorting_network"]
 
@@ -162,22 +162,16 @@ def _band_stats(band, pad, pairs, drop, k_mid, k_low, even, med, low, s1, s2):  
                 low[r, c0 + t] = np.float32(buf[k_low, t])
 
 
-def _level(frame: np.ndarray, scratch: np.ndarray) -> float:
-    """:func:`~cageless.tracking.locate_motion.frame_level` of ``frame`` converted to float64, without converting
-    the pixels it skips: the same strided view of a float64 array of the frame's shape, so the same sum."""
-    scratch[::4, ::4] = frame[::4, ::4]
-    return float(np.mean(scratch[::4, ::4], dtype=np.float64))
-
-
 def _dropouts(frames: list[np.ndarray]) -> np.ndarray:
-    """Which sample frames :func:`~cageless.tracking.locate_motion.motion_map` leaves out (lighting dropouts)."""
+    """Which sample frames :func:`~cageless.tracking.locate_motion.motion_map` leaves out (lighting dropouts).
+    Each frame's level is taken as that function takes it, of the frame converted to float64 (the same strided
+    view, so the same sum), converting only the pixels the level reads."""
     scratch = np.empty(frames[0].shape, np.float64)
-    levels = np.array([_level(f, scratch) for f in frames])
-    ref = float(np.median(levels))
-    drop = levels < DROPOUT_GAIN * ref if ref > 0 else np.zeros(len(frames), dtype=bool)
-    if len(frames) - int(drop.sum()) < 2:  # no steady level to compare with: the frames as they are
-        drop[:] = False
-    return drop
+    levels = np.empty(len(frames))
+    for k, f in enumerate(frames):
+        scratch[::4, ::4] = f[::4, ::4]
+        levels[k] = frame_level(scratch)
+    return dropout_frames(levels)
 
 
 def sample_statistics(video: FrameSource, n_sample: int = 25, quantile: float = 0.25,

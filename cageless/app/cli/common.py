@@ -203,6 +203,12 @@ def _parameter_error_text(exc: Any, given: dict[str, Any], table: dict[str, Any]
     return f"{source}: {name}{shown}: {exc.rule}. {exc.hint}".rstrip()
 
 
+def check_window(window: int | None) -> None:
+    """Refuse a ``--window`` (the Savitzky-Golay speed window, frames) that is even or below 3; ``None``: not given."""
+    if window is not None and (window < 3 or window % 2 == 0):
+        raise UsageError(f"--window {window}: must be an odd number of frames >= 3.")
+
+
 def check_n_balls(n_balls: int | None, config: dict[str, Any]) -> None:
     """Refuse a ``--n-balls`` below 3 or above what fits on the configured bearing's pitch circle.
 

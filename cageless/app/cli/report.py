@@ -64,11 +64,11 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Run the workflow and print where the report is."""
     from cageless.conditions import find_videos
     from cageless.config import bearing_from_config
-    from cageless.errors import CagelessError, UsageError
+    from cageless.errors import CagelessError
     from cageless.app.lab import LabOptions, run_lab
     from cageless.comparison.compare import QC_FAILED
     from cageless.app.calibrate import describe_calibration
-    from cageless.app.cli.common import check_n_balls, failed_line, parameter_values
+    from cageless.app.cli.common import check_n_balls, check_window, failed_line, parameter_values
     from cageless.simulation.parameter_sets import DEFAULT_SET
 
     from cageless.app.lab import CACHE_NAME, REPORT_PRODUCTS
@@ -76,8 +76,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     from cageless.validate import check_options
 
     check_n_balls(args.n_balls, config)
-    if args.window is not None and (args.window < 3 or args.window % 2 == 0):
-        raise UsageError(f"--window {args.window}: must be an odd number of frames >= 3.")
+    check_window(args.window)
     values = parameter_values(args, config)  # [parameters] of --config, then --set; before any work starts
     check_options(args, ("duration", "settle", "revolutions", "rtol", "workers", "window"))
     check_output_dir(args.out, "-o")

@@ -11,6 +11,7 @@ changes an open model parameter (:class:`cageless.simulation.parameters.ModelPar
 from __future__ import annotations
 
 import argparse
+import math
 import re
 from typing import Any
 
@@ -246,15 +247,12 @@ def _run(args: argparse.Namespace, scene: Any, choices: Any, config: dict[str, A
 
 def _summary_line(trace: Any, sol: Any, out: str) -> str:
     from cageless.profiles import PEAK_SMOOTHING_DEG
-    from cageless.simulation.run import peak_unloaded_slip
+    from cageless.simulation.run import settled_peak_slip
 
     ev = trace.events
-    from cageless.kinematics import startup_duration
-
-    startup = startup_duration(trace.speed_rpm, trace.ball_diameter_m, trace.pitch_diameter_m)
-    if float(trace.time[-1]) > startup:
-        slip = (f"peak slip in the unloaded zone after {1e3 * startup:.0f} ms: "
-                f"{100 * peak_unloaded_slip(trace, settle_s=startup):.2f}% "
+    peak, startup = settled_peak_slip(trace)
+    if not math.isnan(peak):
+        slip = (f"peak slip in the unloaded zone after {1e3 * startup:.0f} ms: {100 * peak:.2f}% "
                 f"(mean profile smoothed over {PEAK_SMOOTHING_DEG:g} deg)")
     else:  # a start-up transient's peak is not a slip anyone should quote
         slip = (f"no settled slip: the run is within the {1e3 * startup:.0f} ms start-up that compare and report "

@@ -15,7 +15,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from cageless.bearing import Bearing
-from cageless.app.cli.common import check_n_balls, failed_line, finite_float
+from cageless.app.cli.common import check_n_balls, check_window, failed_line, finite_float
 from cageless.conditions import (
     IMAGE_SUFFIXES,
     LabEntry,
@@ -27,7 +27,7 @@ from cageless.conditions import (
     resolve_conditions,
 )
 from cageless.config import bearing_from_config
-from cageless.errors import CagelessError, MissingConditionsError, UsageError
+from cageless.errors import CagelessError, MissingConditionsError
 from cageless.outputs import check_output_dir, clean_stale_parts, output_lock
 from cageless.validate import check_options, plausible_entry
 
@@ -181,8 +181,7 @@ def _precision(info: dict[str, Any]) -> str:
 
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Track every input; print one summary line per video; return 1 if any failed."""
-    if args.window < 3 or args.window % 2 == 0:
-        raise UsageError(f"--window {args.window}: must be an odd number of frames >= 3.")
+    check_window(args.window)
     _validate(args)
     check_n_balls(args.n_balls, config)
     bearing = bearing_from_config(config)
