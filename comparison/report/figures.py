@@ -50,7 +50,7 @@ def _legend_below(fig: Any, ax: Any) -> None:
 def _profile(ax: Any, prof: Any, scale: float, label: str, colour: str) -> None:
     x, m, s = prof["angle_deg"].to_numpy(), prof["mean"].to_numpy() * scale, prof["std"].to_numpy() * scale
     ax.plot(x, m, color=colour, lw=1.0, label=label)
-    ax.fill_between(x, m - s, m + s, color=colour, alpha=0.2, lw=0)
+    ax.fill_between(x, m - s, m + s, color=colour, alpha=0.2, lw=0, label=f"{label}: mean ± 1 std of samples")
 
 
 def speed_figure(d: ConditionDescription) -> str:
@@ -64,7 +64,6 @@ def speed_figure(d: ConditionDescription) -> str:
         _profile(ax, c.simulated.speed, 30 / np.pi, "simulated", "C3")
         ax.set(xlabel="orbital angle (deg)", ylabel="revolution speed (r/min)", xlim=(0, 360))
         ax.axvspan(0, 180, color="0.9", zorder=0, label="unloaded zone")
-        ax.fill_between([], [], [], color="0.3", alpha=0.2, lw=0, label="band: mean ± 1 std of samples")
         _legend_below(fig, ax)
     return _svg(draw, size=(5.6, 3.4), layout="constrained")
 
@@ -82,7 +81,6 @@ def slip_figure(d: ConditionDescription, size: tuple[float, float] = (5.6, 3.4))
             ax.plot(prof["angle_deg"], 100.0 * smooth_profile(prof["mean"].to_numpy(), c.measured.bin_deg),
                     color=colour, lw=1.6, ls="--")
         ax.plot([], [], color="0.3", lw=1.6, ls="--", label=f"smoothed, sigma {PEAK_SMOOTHING_DEG:g} deg")
-        ax.fill_between([], [], [], color="0.3", alpha=0.2, lw=0, label="band: mean ± 1 std of samples")
         ax.set(xlabel="orbital angle (deg)", ylabel="slip rate (%)", xlim=(0, 360))
         _legend_below(fig, ax)
     return _svg(draw, size=size, layout="constrained")

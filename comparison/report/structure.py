@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 import math
+import platform
+import sys
 from collections.abc import Mapping, Sequence
 from datetime import datetime, timezone
 from typing import Any
@@ -12,7 +14,7 @@ from cageless import __version__
 from cageless.comparison.compare import SLIP_REFERENCES, ComparisonRow
 from cageless.comparison.metrics import SLIP_RATE_DEFINITION
 from cageless.profiles import PEAK_SMOOTHING_DEG
-from cageless.provenance import HASH_ALGORITHMS
+from cageless.provenance import HASH_ALGORITHMS, git_commit
 from cageless.comparison.report import figures
 from cageless.comparison.report.describe import ConditionDescription, tracking_verdict
 from cageless.comparison.table import number_cell, slip_reference_note, table_frame, to_html
@@ -115,7 +117,9 @@ def build_report(descriptions: Sequence[ConditionDescription], failed_rows: Sequ
                                                        d.row.label))  # the slip table's order
     rows = [d.row for d in descriptions] + list(failed_rows)
     frame = table_frame(rows)
-    repro = [("software version", __version__)] + [(k, v if isinstance(v, str) else json.dumps(v, sort_keys=True))
+    commit = git_commit()
+    repro = [("software version", __version__), *([("git commit", commit)] if commit else []),
+             ("Python", f"{sys.version.split()[0]} on {platform.platform()}")] + [(k, v if isinstance(v, str) else json.dumps(v, sort_keys=True))
                                                     for k, v in (reproduction or {}).items()]
     for d in descriptions:
         info = d.simulation_info

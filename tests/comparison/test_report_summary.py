@@ -32,3 +32,20 @@ def test_summary_card_precedes_the_table():
     assert "model 2.26 %, experiment 3.89 %; MAE 1.17 pp" in summary
     assert "fail</span>: 13 balls found, 14 expected" in summary
     assert "bad</h3><span class=\"fail\">failed</span>: 36 balls found, 14 expected" in summary
+
+
+def test_reproduction_names_version_commit_and_python(monkeypatch):
+    """The reproduction table says what produced the report: the software version, the git commit of the
+    source tree when there is one (a copy outside git shows none) and the Python it ran on."""
+    import sys
+
+    from cageless import __version__
+    from cageless.comparison.report import structure
+
+    monkeypatch.setattr(structure, "git_commit", lambda: "0123abc-dirty")
+    repro = dict(build_report([])["reproduction"])
+    assert repro["software version"] == __version__
+    assert repro["git commit"] == "0123abc-dirty"
+    assert repro["Python"].startswith(sys.version.split()[0] + " on ")
+    monkeypatch.setattr(structure, "git_commit", lambda: None)
+    assert "git commit" not in dict(build_report([])["reproduction"])
