@@ -41,6 +41,34 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
         "choice without solving.",
         epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter,
     )
+    _add_scene_arguments(p)
+    p.add_argument("--seed", type=int, default=0, help="seed that perturbs the initial gaps (default 0)")
+    p.add_argument("--level", help="force the model level: planar or spatial (default: the scene's; --explain "
+                   "says which and why)")
+    p.add_argument("--effect", action="append", default=[], metavar="NAME=on|off",
+                   help="force an effect on or off (repeatable; --explain lists the effects)")
+    p.add_argument("--force", action="store_true", help="allow forced choices that contradict the scene, and "
+                   "numbers outside their plausible ranges")
+    p.add_argument("--overwrite", action="store_true", help="allow -o to replace a file that is not a cageless trace")
+    p.add_argument("--explain", action="store_true", help="print the level and effects with reasons; do not solve")
+    p.add_argument("--json", action="store_true", help="with --explain: print JSON")
+    _add_solver_arguments(p)
+    add_parameter_set_option(p)
+    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", dest="set_values",
+                   help="change an open model parameter, e.g. --set cho_n_s_m=2500 (repeatable; "
+                   "simulation/parameters.py lists them with their sources)")
+    p.add_argument("--speed-ramp", type=finite_float, default=0.0,
+                   help="time for the ring to reach its speed from rest (s, default 0: at speed from the start)")
+    p.add_argument("--ensemble", type=int, default=1, metavar="N",
+                   help="run seeds 0..N-1 (N traces, both cores; default 1)")
+    p.add_argument("--scheduler", help="with --ensemble: address of a Dask scheduler to run the seeds on")
+    p.add_argument("--sample-rate", type=finite_float, default=10_000.0, help="samples per second (default 10000)")
+    p.add_argument("-o", "--out", help="trace file to write (default sim_<rpm>rpm_Fr<N>.trace.h5, with _Fa<N> "
+                   "under an axial load)")
+
+
+def _add_scene_arguments(p: argparse.ArgumentParser) -> None:
+    """``simulate``'s options that describe the scene: speed, loads, gravity, orientation, lubricant."""
     p.add_argument("--speed-rpm", type=finite_float, required=True, help="inner-ring speed (rpm)")
     p.add_argument("--radial-load-n", type=finite_float, default=0.0, help="radial load (N, default 0)")
     p.add_argument("--axial-load-n", type=finite_float, default=0.0, help="axial load (N, default 0)")
@@ -60,16 +88,10 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
                    help="diametral clearance (um), races moved apart symmetrically (default: the bearing's, 0 for "
                    "the paper's; ISO 5753-1 C4 for this size is 23-41 um)")
     p.add_argument("--dry", action="store_true", help="no lubricant")
-    p.add_argument("--seed", type=int, default=0, help="seed that perturbs the initial gaps (default 0)")
-    p.add_argument("--level", help="force the model level: planar or spatial (default: the scene's; --explain "
-                   "says which and why)")
-    p.add_argument("--effect", action="append", default=[], metavar="NAME=on|off",
-                   help="force an effect on or off (repeatable; --explain lists the effects)")
-    p.add_argument("--force", action="store_true", help="allow forced choices that contradict the scene, and "
-                   "numbers outside their plausible ranges")
-    p.add_argument("--overwrite", action="store_true", help="allow -o to replace a file that is not a cageless trace")
-    p.add_argument("--explain", action="store_true", help="print the level and effects with reasons; do not solve")
-    p.add_argument("--json", action="store_true", help="with --explain: print JSON")
+
+
+def _add_solver_arguments(p: argparse.ArgumentParser) -> None:
+    """``simulate``'s options that choose the integrator and its accuracy."""
     p.add_argument("--solver", default="auto", help="integrator: auto (default: compiled dp5, switching to CVODE "
                    "(BDF) or ark4 when stiffness makes that cheaper and ark4 refuses under 10 %% of its steps), "
                    "dp5, ark4 (compiled IMEX, the race normal forces "
@@ -81,19 +103,6 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--restitution", type=finite_float,
                    help="ball-ball coefficient of restitution R, 0 <= R <= 1, 0 perfectly plastic (same as --set "
                    "restitution=R)")
-    add_parameter_set_option(p)
-    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", dest="set_values",
-                   help="change an open model parameter, e.g. --set cho_n_s_m=2500 (repeatable; "
-                   "simulation/parameters.py lists them with their sources)")
-    p.add_argument("--speed-ramp", type=finite_float, default=0.0,
-                   help="time for the ring to reach its speed from rest (s, default 0: at speed from the start)")
-    p.add_argument("--ensemble", type=int, default=1, metavar="N",
-                   help="run seeds 0..N-1 (N traces, both cores; default 1)")
-    p.add_argument("--scheduler", help="with --ensemble: address of a Dask scheduler to run the seeds on")
-    p.add_argument("--sample-rate", type=finite_float, default=10_000.0, help="samples per second (default 10000)")
-    p.add_argument("-o", "--out", help="trace file to write (default sim_<rpm>rpm_Fr<N>.trace.h5, with _Fa<N> "
-                   "under an axial load)")
-
 
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Build the scene, choose the model, and explain it."""
