@@ -15,9 +15,18 @@ The app layer (:mod:`cageless.app.cli`) is the only place that imports
 from __future__ import annotations
 
 import importlib
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from cageless._version import __version__
+
+_HERE = Path(__file__).resolve().parent
+_SCIENCE = ("tracking", "simulation", "comparison")
+if not (_HERE / "tracking").is_dir() and all((_HERE.parent / n / "__init__.py").is_file() for n in _SCIENCE):
+    # Imported from a source checkout (Python run in the repository's folder puts its cageless/ first on the
+    # path, ahead of an installed copy): tracking/, simulation/ and comparison/ sit beside it there, and this
+    # makes them cageless.tracking and so on, as an install (pyproject.toml's package-dir) does.
+    __path__.append(str(_HERE.parent))
 
 if TYPE_CHECKING:  # pragma: no cover - for type checkers only
     from cageless.bearing import Bearing, Geometry, Lubricant, Masses, Material, default_bearing

@@ -20,7 +20,7 @@ from typing import Any
 from cageless.errors import GeometryError, ParameterError, suggest
 
 __all__ = ["Geometry", "Material", "Masses", "Lubricant", "Bearing", "default_bearing", "clearance_note",
-           "CLEARANCE_NAME"]
+           "CLEARANCE_NAME", "PITCH_NAME"]
 
 #: Clearances smaller than this (m) are round-off of the race diameters and are taken as 0.
 _CLEARANCE_ROUND_OFF_M = 1e-12
@@ -300,9 +300,13 @@ class Bearing:
     def with_overrides(self, overrides: Mapping[str, Any]) -> Bearing:
         """Return a copy with dotted-name overrides applied, e.g. ``{"geometry.n_balls": 13}``.
 
-        ``geometry.diametral_clearance_m`` (m, >= 0) is accepted too: after the other overrides, the races
-        move apart symmetrically to that clearance, the pitch diameter kept
-        (:meth:`Geometry.with_diametral_clearance`).
+        Two names set derived quantities rather than stored fields. ``geometry.pitch_diameter_m`` (m) puts the
+        pitch circle there. ``geometry.diametral_clearance_m`` (m, >= 0) moves the races apart symmetrically to
+        that clearance after the other overrides, the pitch diameter kept
+        (:meth:`Geometry.with_diametral_clearance`). A new ``geometry.ball_diameter_m`` or pitch diameter
+        without either race diameter moves the races with it, the clearance kept: they sit at
+        ``d_m -/+ (D + P_d / 2)``. A new ball diameter without ``masses.ball_mass_kg`` scales the ball's mass
+        as ``D^3`` (the same steel). Race diameters given are taken as they are.
 
         Raises
         ------
@@ -311,19 +315,21 @@ class Bearing:
             :class:`~cageless.errors.GeometryError` naming ``geometry.diametral_clearance_m``).
         """
         data = self.to_dict()
-        valid = sorted([*_dotted_names(data), CLEARANCE_NAME])
-        clearance = None
+        valid = sorted([*_dotted_names(data), *_DERIVED_NAMES])
+        derived: dict[str, Any] = {}
         for key, value in overrides.items():
             section, _, name = key.partition(".")
             if key not in valid:
                 if section == "lubricant" and data.get("lubricant") is None:
                     raise ParameterError(key, "the bearing is dry; set the whole lubricant section")
                 raise ParameterError(key, "is not a bearing parameter" + suggest(key, valid))
-            if key == CLEARANCE_NAME:
-                clearance = value
+            if key in _DERIVED_NAMES:
+                derived[key] = value
                 continue
             data[section][name] = value
+        _follow_the_ball(data, self, set(overrides), derived.get(PITCH_NAME))
         bearing = Bearing.from_dict(data)
+        clearance = derived.get(CLEARANCE_NAME)
         if clearance is None:
             return bearing
         if isinstance(clearance, bool) or not isinstance(clearance, int | float):
@@ -331,9 +337,42 @@ class Bearing:
         return dataclasses.replace(bearing, geometry=bearing.geometry.with_diametral_clearance(float(clearance)))
 
 
+def _follow_the_ball(data: dict[str, Any], base: Bearing, given: set[str], pitch_m: Any) -> None:
+    """Place the races of ``data`` about a new ball or pitch diameter, and scale the ball's mass (in place).
+
+    ``given`` holds the dotted names the overrides set; ``pitch_m`` is ``geometry.pitch_diameter_m`` or
+    ``None``. Nothing moves when neither the ball diameter nor the pitch diameter is given, or when a race
+    diameter is (then the races are as given).
+    """
+    races = {"geometry.inner_race_diameter_m", "geometry.outer_race_diameter_m"} & given
+    if pitch_m is not None:
+        _check_positive("geometry", "pitch_diameter_m", pitch_m)
+        if races:
+            raise ParameterError(PITCH_NAME, "give either the pitch diameter or the race diameters "
+                                 f"({', '.join(sorted(races))}), not both", pitch_m)
+    new_ball = "geometry.ball_diameter_m" in given
+    if races or not (new_ball or pitch_m is not None):
+        return
+    g0 = base.geometry
+    ball = data["geometry"]["ball_diameter_m"]
+    _check_positive("geometry", "ball_diameter_m", ball)
+    d_m = g0.pitch_diameter_m if pitch_m is None else float(pitch_m)
+    if ball >= d_m:
+        raise GeometryError("geometry.ball_diameter_m", f"must be smaller than the pitch diameter "
+                            f"{d_m * 1e3:.4g} mm (lengths are in metres: 8e-3 for an 8 mm ball)", ball)
+    half = ball + 0.5 * g0.diametral_clearance_m
+    data["geometry"]["inner_race_diameter_m"] = d_m - half
+    data["geometry"]["outer_race_diameter_m"] = d_m + half
+    if new_ball and "masses.ball_mass_kg" not in given:
+        data["masses"]["ball_mass_kg"] = base.masses.ball_mass_kg * (ball / g0.ball_diameter_m) ** 3
+
+
 #: The dotted name that sets the diametral clearance in overrides, ``--config`` and sweeps (not a stored field:
 #: the clearance follows from the race diameters).
 CLEARANCE_NAME = "geometry.diametral_clearance_m"
+#: The dotted name that sets the pitch diameter in overrides and ``--config`` (derived, like the clearance).
+PITCH_NAME = "geometry.pitch_diameter_m"
+_DERIVED_NAMES = (CLEARANCE_NAME, PITCH_NAME)
 
 
 _SECTIONS: dict[str, type] = {

@@ -34,7 +34,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from cageless.bearing import Bearing, Geometry
+from cageless.bearing import PITCH_NAME, Bearing
 from cageless.condition_sources import (
     BEARING_KEYS,
     CONDITION_KEYS,
@@ -319,23 +319,17 @@ def bearing_with_keys(bearing: Bearing, resolved: ResolvedConditions) -> Bearing
     keys = resolved.bearing_keys
     if not keys:
         return bearing
-    g = bearing.geometry
-    d = keys.get("ball_diameter_mm", g.ball_diameter_m * 1e3) * 1e-3
-    d_m = keys.get("pitch_diameter_mm", g.pitch_diameter_m * 1e3) * 1e-3
-    half = d + 0.5 * g.diametral_clearance_m
-    try:
-        geometry = Geometry(inner_race_diameter_m=d_m - half, outer_race_diameter_m=d_m + half, ball_diameter_m=d,
-                            inner_curvature_factor=g.inner_curvature_factor,
-                            outer_curvature_factor=g.outer_curvature_factor,
-                            n_balls=int(keys.get("n_balls", g.n_balls)))
+    names = {"ball_diameter_mm": "geometry.ball_diameter_m", "pitch_diameter_mm": PITCH_NAME}
+    overrides: dict[str, float | int] = {names[k]: v * 1e-3 for k, v in keys.items() if k in names}
+    if "n_balls" in keys:
+        overrides["geometry.n_balls"] = int(keys["n_balls"])
+    try:  # the races follow the ball and pitch diameters, the clearance kept; the ball's mass scales as D^3
+        described = bearing.with_overrides(overrides)
     except CagelessError as exc:
         raise ConditionsError(resolved.video, f"the bearing keys ({', '.join(sorted(keys))}) give an impossible "
                               f"bearing: {exc}") from exc
     label = ", ".join(f"{k} = {v:g}" for k, v in sorted(keys.items()))
-    # a ball of another diameter, of the same steel, has the mass of a homogeneous sphere scaled by (D/D0)^3
-    masses = dataclasses.replace(bearing.masses,
-                                 ball_mass_kg=bearing.masses.ball_mass_kg * (d / g.ball_diameter_m) ** 3)
-    return dataclasses.replace(bearing, geometry=geometry, masses=masses, name=f"{bearing.name} ({label})")
+    return dataclasses.replace(described, name=f"{bearing.name} ({label})")
 
 
 def _is_image_sequence(folder: Path) -> bool:

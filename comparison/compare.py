@@ -79,14 +79,19 @@ def compare(measured: Trace, simulated: Trace, bin_deg: float = 1.0, settle_s: f
     ------
     MismatchError
         When conditions or bearing differ and ``force`` is False (the message lists the differences).
+    ParameterError
+        When ``measured`` is a simulation trace and ``simulated`` a video trace (the arguments swapped).
     """
     if slip_reference not in SLIP_REFERENCES:
         raise ParameterError("slip_reference", f"must be one of {', '.join(SLIP_REFERENCES)}", slip_reference)
+    if (measured.source, simulated.source) == ("simulation", "video"):
+        raise ParameterError("measured", "is a simulation trace, and simulated a video trace",
+                             hint="Swap them: compare(video_trace, simulation_trace).")
     mismatches = check_compatible(measured, simulated)
     if mismatches and not force:
         raise MismatchError("the traces differ: " + "; ".join(mismatches)
-                            + ". Compare traces of the same condition, or pass --force to compare anyway "
-                            "(the report then shows the mismatch).")
+                            + ". Compare traces of the same condition, or pass --force (force=True in Python) to "
+                            "compare anyway (the report then shows the mismatch).")
     if settle_s is None:
         settle_s = simulation_settle_s(simulated)
     if slip_reference == "loaded-zone":

@@ -26,7 +26,7 @@ from cageless.errors import UsageError, suggest
 from cageless.simulation.scene import Scene
 
 __all__ = [
-    "EffectSpec", "EffectChoice", "ModelChoice", "EFFECTS", "LEVELS", "choose_model", "parse_effect_overrides",
+    "EffectSpec", "EffectChoice", "ModelChoice", "EFFECTS", "LEVELS", "LEVEL_DOF", "choose_model", "parse_effect_overrides",
     "describe_table", "check_lubricant", "parameter_slots", "effect_flags", "register_effect", "removable_effects",
 ]
 
@@ -176,6 +176,17 @@ class EffectChoice:
     forced: bool = False
 
 
+#: What each model level integrates, and what it leaves out (simulation/models/planar.py and spatial.py).
+LEVEL_DOF: dict[str, str] = {
+    "planar": "per ball the orbital radius and angle and the spin about the shaft (3 DOF), the inner ring's "
+              "y and z (2; its rotation is prescribed); the centrifugal force comes out of the polar equations; left out: the balls' axial "
+              "motion and spin about y and z, the ring's axial motion and tilt",
+    "spatial": "per ball the orbital radius, angle and axial position and the full spin vector (6 DOF), the inner "
+               "ring's x, y, z and tilt about y and z (5); centrifugal and gyroscopic effects come out of the "
+               "inertial-frame equations",
+}
+
+
 @dataclass(frozen=True)
 class ModelChoice:
     """The model level and the effects a scene uses, each with its reason."""
@@ -192,11 +203,14 @@ class ModelChoice:
     def to_json(self) -> str:
         """The choice as JSON (stored as ``effects_json`` in simulation traces)."""
         return json.dumps({"level": self.level, "level_reason": self.level_reason,
+                           "degrees_of_freedom": LEVEL_DOF.get(self.level, ""),
                            "effects": [asdict(e) for e in self.effects]}, sort_keys=True)
 
     def explain(self) -> str:
         """Human-readable lines: the level and each effect with its reason."""
         lines = [f"level: {self.level} ({self.level_reason})"]
+        if self.level in LEVEL_DOF:
+            lines.append(f"  degrees of freedom: {LEVEL_DOF[self.level]}")
         for e in self.effects:
             tag = "on " if e.on else "off"
             lines.append(f"  {tag} {e.name:<18} {e.reason}{' [forced]' if e.forced else ''}")

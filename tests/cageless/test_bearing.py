@@ -162,3 +162,43 @@ def test_geometry_is_frozen():
     with pytest.raises(dataclasses.FrozenInstanceError):
         g.n_balls = 3  # type: ignore[misc]
     assert isinstance(g, Geometry)
+
+
+def test_a_ball_diameter_override_moves_the_races_and_scales_the_mass():
+    """Another bearing by its ball and pitch diameters, as a lab folder's keys describe it
+    (:func:`cageless.conditions.bearing_with_keys`): the races sit at d_m -/+ (D + P_d/2)
+    (Harris & Kotzalas, *Rolling Bearing Analysis*, 5th ed., vol. 1, ch. 2) and a steel ball's mass
+    scales as D^3. Before, ``ball_diameter_m = 8e-3`` alone kept Table 1's races: a 3.05 mm clearance,
+    and the 9.525 mm ball's mass."""
+    b = default_bearing()
+    g = b.with_overrides({"geometry.ball_diameter_m": 8e-3, "geometry.n_balls": 12}).geometry
+    assert g.diametral_clearance_m == 0.0  # Table 1's, kept
+    assert g.pitch_diameter_m == pytest.approx(46.005e-3, rel=1e-12)
+    assert (g.inner_race_diameter_m, g.outer_race_diameter_m) == pytest.approx((38.005e-3, 54.005e-3), rel=1e-12)
+    small = b.with_overrides({"geometry.ball_diameter_m": 8e-3})
+    # 3.5519 g (Table 1) * (8 / 9.525)^3 = 2.10443 g
+    assert small.masses.ball_mass_kg == pytest.approx(3.5519e-3 * (8 / 9.525) ** 3, rel=1e-12)
+    assert small.masses.ball_mass_kg == pytest.approx(2.10443e-3, rel=1e-5)
+    given = b.with_overrides({"geometry.ball_diameter_m": 8e-3, "masses.ball_mass_kg": 2.09e-3})
+    assert given.masses.ball_mass_kg == 2.09e-3
+    other = b.with_overrides({"geometry.pitch_diameter_m": 40e-3, "geometry.ball_diameter_m": 8e-3,
+                              "geometry.n_balls": 12, "geometry.diametral_clearance_m": 20e-6})
+    assert other.geometry.pitch_diameter_m == pytest.approx(40e-3, rel=1e-12)
+    assert other.geometry.diametral_clearance_m == pytest.approx(20e-6, rel=1e-9)
+    # race diameters given: they are taken as they are (the clearance follows from them)
+    races = b.with_overrides({"geometry.ball_diameter_m": 9e-3})
+    literal = b.with_overrides({"geometry.ball_diameter_m": 9e-3, "geometry.inner_race_diameter_m": 36.48e-3})
+    assert literal.geometry.diametral_clearance_m == pytest.approx(55.53e-3 - 36.48e-3 - 18e-3, rel=1e-9)
+    assert races.geometry.diametral_clearance_m == 0.0
+
+
+@pytest.mark.parametrize("overrides, parameter, words", [
+    ({"geometry.ball_diameter_m": 8.0}, "geometry.ball_diameter_m", "metres"),  # 8 mm given as 8
+    ({"geometry.pitch_diameter_m": -1.0}, "geometry.pitch_diameter_m", "> 0"),
+    ({"geometry.pitch_diameter_m": 40e-3, "geometry.outer_race_diameter_m": 56e-3}, "geometry.pitch_diameter_m",
+     "race diameters"),
+])
+def test_a_ball_or_pitch_diameter_override_that_cannot_be_is_refused(overrides, parameter, words):
+    with pytest.raises(ParameterError, match=words) as err:
+        default_bearing().with_overrides(overrides)
+    assert err.value.parameter == parameter

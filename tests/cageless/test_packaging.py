@@ -93,3 +93,23 @@ def test_imports_point_down_only(layer):
             if target is not None and target not in ALLOWED[layer]:
                 bad.append(f"{path.relative_to(REPO_ROOT)} imports {module}")
     assert bad == []
+
+
+def test_the_science_packages_import_from_the_repository_folder_without_an_editable_install():
+    """Python started in the repository's folder (docs/api.md's tour says to run it from there) finds the source
+    ``cageless/`` first on its path, ahead of the installed copy. Before, ``cageless.tracking``,
+    ``cageless.simulation`` and ``cageless.comparison`` then failed to import after the README's ``pip install .``
+    (ModuleNotFoundError): they live beside ``cageless/`` in the checkout. Here no editable-install finder runs
+    (``-S`` skips the ``.pth`` files; the dependencies come through PYTHONPATH)."""
+    import os
+    import subprocess
+    import sys
+    import sysconfig
+
+    site = os.pathsep.join(dict.fromkeys(sysconfig.get_paths()[k] for k in ("purelib", "platlib")))
+    code = ("import cageless, cageless.comparison.align, cageless.simulation.scene, cageless.tracking.io; "
+            "print(cageless.simulation.scene.__file__)")
+    run = subprocess.run([sys.executable, "-S", "-c", code], cwd=REPO_ROOT, capture_output=True, text=True,
+                         env={**os.environ, "PYTHONPATH": site}, timeout=120)
+    assert run.returncode == 0, run.stderr
+    assert Path(run.stdout.strip()) == REPO_ROOT / "simulation" / "scene.py"

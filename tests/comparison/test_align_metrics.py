@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from cageless.errors import CagelessError
+from cageless.errors import CagelessError, ParameterError
 from cageless.trace import SimulationInfo, Trace, VideoInfo
 from cageless.comparison.align import MismatchError, align_time, check_compatible, profiles
 from cageless.comparison.compare import ComparisonRow, compare
@@ -84,8 +84,21 @@ def test_mismatched_traces_are_refused_unless_forced():
     assert check_compatible(a, b) == ["speed_rpm: measured 3000 rpm, simulated 1800 rpm"]
     with pytest.raises(MismatchError, match="--force"):
         compare(a, b)
+    with pytest.raises(MismatchError, match=r"force=True in Python"):  # compare() is also called from Python
+        compare(a, b)
     c = compare(a, b, settle_s=0.0, force=True)
     assert c.row.status == "mismatch" and "speed_rpm" in c.row.message
+
+
+def test_swapped_traces_are_named_as_swapped():
+    """compare(simulation, video) says the arguments are swapped; before, it failed with advice to simulate longer
+    ("no valid samples after the first ... s of the video trace"), as the simulation's start-up was cut from the
+    video. The command line swaps them back with a warning (cageless/app/cli/compare.py)."""
+    video = orbit_trace("video", bump(0.06), t_end=0.1)
+    sim = orbit_trace("simulation", bump(0.06), t_end=0.2)
+    with pytest.raises(ParameterError, match=r"Swap them: compare\(video_trace, simulation_trace\)") as err:
+        compare(sim, video)
+    assert err.value.parameter == "measured"
 
 
 def test_compare_row_and_table_formats(tmp_path):

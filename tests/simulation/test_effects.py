@@ -43,6 +43,19 @@ def test_scene_rules():
     assert choose_model(scene(orientation="vertical")).level == "spatial"
 
 
+def test_explain_names_the_degrees_of_freedom_of_the_level():
+    """--explain and a trace's effects_json say what each level integrates and leaves out, with the states of
+    simulation/models/planar.py (5 Z + 6: r, theta, their rates and the spin per ball; ring y, z) and spatial.py
+    (9 Z + 12: also x, its rate and the spin about y and z; ring x and tilt). Before, they named the level only."""
+    planar = choose_model(scene())
+    lines = planar.explain().splitlines()
+    assert lines[1].startswith("  degrees of freedom: per ball the orbital radius and angle and the spin about the "
+                               "shaft (3 DOF)") and "left out: the balls' axial motion" in lines[1]
+    spatial = choose_model(scene(conditions=OperatingConditions(6000.0, 500.0, 100.0)))
+    assert "full spin vector (6 DOF)" in spatial.explain().splitlines()[1]
+    assert "gyroscopic" in json.loads(spatial.to_json())["degrees_of_freedom"]
+
+
 def test_overrides():
     with pytest.raises(UsageError, match="Did you mean 'gravity'"):
         choose_model(scene(), effects={"gravty": False})

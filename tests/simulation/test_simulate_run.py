@@ -42,6 +42,8 @@ def test_full_model_run_writes_traction_and_films(tmp_path, capsys):
     loaded = c["inner_normal"] > 50
     # Hamrock-Dowson films of a few tenths of a micrometre where the balls carry the load.
     assert 0.05e-6 < np.nanmedian(c["inner_film"][loaded]) < 1e-6
+    for race in ("inner", "outer"):  # docs/traces.md: a film is NaN exactly where its contact is open
+        np.testing.assert_array_equal(np.isnan(c[f"{race}_film"]), c[f"{race}_normal"] == 0)
     assert tr.provenance["config"]["parameters"]["cho_n_s_m"] == 2500
 
 
