@@ -515,6 +515,9 @@ def _track_fit_frames(path: Path, times: np.ndarray, angle: np.ndarray, valid: n
                                 'Give "auto" or an odd number of frames of at least 5 (1: no track fit).')
         choice = choose_track_fit(times, angle, valid)
         return choice.frames, choice.to_dict()
+    if track_fit != 1 and (track_fit < 5 or track_fit % 2 == 0):
+        raise TrackingError(path, f"track_fit = {track_fit} is not a window.",
+                            'Give "auto" or an odd number of frames of at least 5 (1: no track fit).')
     return int(track_fit), None
 
 

@@ -90,3 +90,6 @@ def test_the_option_takes_auto_or_a_fixed_window():
     assert record is not None and frames == record["frames"] == 31
     with pytest.raises(TrackingError, match="track_fit = 'long' is not a window"):
         _track_fit_frames(Path("clip.cine"), t, noisy, ok, "long")
+    with pytest.raises(TrackingError, match="track_fit = 4 is not a window"):
+        _track_fit_frames(Path("clip.cine"), t, noisy, ok, 4)
+    assert _track_fit_frames(Path("clip.cine"), t, noisy, ok, 1) == (1, None)
