@@ -37,7 +37,8 @@ from cageless.tracking.detect import (DetectorParams, noise_sigma, spot_sigma, s
                                       static_pattern)
 from cageless.tracking.geometry import fit_orbit, orbital_angles
 from cageless.tracking.io import CineReader, FrameSource, open_video
-from cageless.tracking.kinematics import DEFAULT_TRACK_FIT, DEFAULT_WINDOW, revolution_speed, robust_track_fit
+from cageless.tracking.kinematics import DEFAULT_WINDOW, revolution_speed, robust_track_fit
+from cageless.tracking.track_window import choose_track_fit
 from cageless.tracking.link import BallCountWarning, TrackSetup, track_frames
 from cageless.tracking.lobes import relock_lobes
 from cageless.tracking.locate import BearingLocation, background_frame, locate_bearing
@@ -98,8 +99,11 @@ class TrackOptions:
     n_balls
         The ball count the video shows, when it differs from the bearing's (default: the bearing's).
     track_fit
-        Frames of the robust local quadratic each ball's angle is read from (1: the raw angles);
-        samples off the ball's path are dropped (:func:`~cageless.tracking.kinematics.robust_track_fit`).
+        Frames of the robust local quadratic each ball's angle is read from (1: the raw angles), or ``"auto"``
+        (default): the window of :data:`~cageless.tracking.track_window.LADDER` (7-41 frames) with the least
+        cross-validated error on the clip (:func:`~cageless.tracking.track_window.choose_track_fit`; 7 frames
+        was the fixed default before); samples off the ball's path are dropped
+        (:func:`~cageless.tracking.kinematics.robust_track_fit`).
     """
 
     detector: DetectorParams = field(default_factory=DetectorParams)
@@ -112,7 +116,7 @@ class TrackOptions:
     threads: int = 2
     allow_truncated: bool = False
     n_balls: int | None = None
-    track_fit: int = DEFAULT_TRACK_FIT
+    track_fit: int | str = "auto"
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready settings."""
@@ -501,6 +505,22 @@ def _check_tracks(path: Path, times: np.ndarray, angle: np.ndarray, valid: np.nd
                             f"{lo}-{hi}; no trace written.", "Check speed_rpm and the bearing description.")
 
 
+def _track_fit_frames(path: Path, times: np.ndarray, angle: np.ndarray, valid: np.ndarray,
+                      track_fit: int | str) -> tuple[int, dict[str, Any] | None]:
+    """The track fit's window (frames): ``track_fit`` itself, or for ``"auto"`` the cross-validated choice
+    (:func:`~cageless.tracking.track_window.choose_track_fit`) with its record for QC."""
+    if isinstance(track_fit, str):
+        if track_fit != "auto":
+            raise TrackingError(path, f"track_fit = {track_fit!r} is not a window.",
+                                'Give "auto" or an odd number of frames of at least 5 (1: no track fit).')
+        choice = choose_track_fit(times, angle, valid)
+        return choice.frames, choice.to_dict()
+    if track_fit != 1 and (track_fit < 5 or track_fit % 2 == 0):
+        raise TrackingError(path, f"track_fit = {track_fit} is not a window.",
+                            'Give "auto" or an odd number of frames of at least 5 (1: no track fit).')
+    return int(track_fit), None
+
+
 def _selection_summary(sel: Selection, du: int, dv: int) -> dict[str, Any]:
     """What the ball selection found, for the QC record (full-image pixels)."""
     t = sel.table
@@ -523,10 +543,11 @@ def _finish(path: Path, video: FrameSource, table: pd.DataFrame, loc: BearingLoc
     times = video.times
     angle, place = remove_place_bias(times, angle, valid, orbit.radius)
     omega_c = theoretical_cage_speed(g, conditions.speed_rad_s)
+    track_fit, fit_choice = _track_fit_frames(path, times, angle, valid, options.track_fit)
     precision = assess_table(table, order, times, angle, valid, orbit.centre, orbit.radius, omega_c, options.window,
-                             options.polyorder, options.track_fit)
+                             options.polyorder, track_fit)
     try:
-        angle, valid = robust_track_fit(times, angle, valid, options.track_fit)
+        angle, valid = robust_track_fit(times, angle, valid, track_fit)
     except ParameterError as exc:
         raise TrackingError(path, str(exc)) from exc
     try:
@@ -541,6 +562,7 @@ def _finish(path: Path, video: FrameSource, table: pd.DataFrame, loc: BearingLoc
     qc.selection = selection or {}
     qc.place_bias = place.to_dict()
     qc.precision = {} if precision is None else precision.to_dict()
+    qc.track_fit = fit_choice or {"frames": track_fit}
     low = precision_warning(precision, QC_LIMITS)
     if low is not None:
         log.warning("%s: %s", path.name, low)

@@ -80,6 +80,8 @@ class QCReport:
     selection: dict[str, Any] = field(default_factory=dict)
     place_bias: dict[str, Any] = field(default_factory=dict)
     precision: dict[str, Any] = field(default_factory=dict)
+    #: The track fit's window (``frames``) and, when chosen from the data, the cross-validation behind it.
+    track_fit: dict[str, Any] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready summary."""
