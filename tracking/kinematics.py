@@ -10,7 +10,8 @@ the median frame period, differentiated there and sampled back.
 
 from __future__ import annotations
 
-from typing import Any
+import math
+from concurrent.futures import ThreadPoolExecutor
 
 import numba
 import numpy as np
@@ -33,13 +34,65 @@ _SCALE_FLOOR_RAD = 1e-5
 _UNIFORM_TOL = 1e-3
 
 
-def _savgol_filter(*args: Any, **kwargs: Any) -> npt.NDArray[np.float64]:
-    """:func:`scipy.signal.savgol_filter`, imported on first use: ``scipy.signal`` takes 1.4-1.6 s of CPU to
-    import (it imports ``scipy.stats``), which a cold ``cageless track`` would otherwise spend before its first
-    frame; :func:`cageless.tracking.pipeline.track_video` imports it in a thread while the frames are tracked."""
-    from scipy.signal import savgol_filter
+def _savgol_coeffs(window: int, polyorder: int, deriv: int, delta: float) -> npt.NDArray[np.float64]:
+    """The convolution coefficients of :func:`scipy.signal.savgol_coeffs` (centred window, ``use="conv"``), by
+    the same operations: the least-squares solution (:func:`scipy.linalg.lstsq`, its ``cond``) of the reversed
+    Vandermonde system."""
+    from scipy.linalg import lstsq
 
-    return savgol_filter(*args, **kwargs)  # type: ignore[no-any-return]
+    if deriv > polyorder:
+        return np.zeros(window, dtype=np.float64)
+    pos = window // 2
+    x = np.flip(np.arange(-pos, window - pos, dtype=np.float64))
+    a = x ** np.reshape(np.arange(polyorder + 1, dtype=np.float64), (-1, 1))
+    y = np.zeros(polyorder + 1, dtype=np.float64)
+    y[deriv] = float(math.factorial(deriv)) / (delta ** deriv)
+    return lstsq(a, y, cond=np.finfo(np.float64).eps * max(a.shape))[0]  # type: ignore[no-any-return]
+
+
+def _fit_edge(x: npt.NDArray[np.float64], start: int, stop: int, first: int, last: int, polyorder: int,
+              deriv: int, delta: float, out: npt.NDArray[np.float64]) -> None:
+    """``out[first:last]``: the ``deriv``-th derivative of the polynomial fitted to ``x[start:stop]`` (axis 0),
+    as :func:`scipy.signal.savgol_filter` fills its edges in ``mode="interp"``: a column-scaled least-squares
+    fit (its ``polyfit``), differentiated, evaluated by Horner's rule and divided by ``delta ** deriv``."""
+    from scipy.linalg import lstsq
+
+    edge = np.reshape(x[start:stop], (stop - start, -1))
+    t = np.arange(0, stop - start, dtype=x.dtype)
+    powers = np.flip(np.arange(polyorder + 1, dtype=t.dtype))
+    lhs = t[:, None] ** powers[None, :]
+    scale = np.sqrt(np.sum(lhs * lhs, axis=0))
+    lhs /= scale
+    c = (lstsq(lhs, edge, cond=t.shape[0] * np.finfo(t.dtype).eps)[0].T / scale).T
+    n = c.shape[0]
+    if n <= deriv:
+        c = np.zeros_like(c[:1])
+    elif deriv:
+        c = c[:-deriv].copy()
+        for k in range(deriv):
+            c *= np.reshape(np.arange(n - k - 1, deriv - k - 1, -1, dtype=c.dtype), (n - deriv, 1))
+    at = np.reshape(np.arange(first - start, last - start, dtype=c.dtype), (-1, 1))
+    values = np.zeros_like(at)
+    for j in range(c.shape[0]):
+        values = values * at + c[j, ...]
+    out[first:last] = np.reshape(values / (delta ** deriv), (last - first, *out.shape[1:]))
+
+
+def _savgol_filter(x: npt.NDArray[np.float64], window: int, polyorder: int, deriv: int,
+                   delta: float) -> npt.NDArray[np.float64]:
+    """:func:`scipy.signal.savgol_filter` along axis 0 in ``mode="interp"``, the same values bit for bit (tested)
+    without importing ``scipy.signal``: that takes 0.4-0.5 s of CPU beyond ``scipy.optimize`` (it imports
+    ``scipy.stats``), on the interpreter lock a cold ``cageless track`` shares with its set-up. The interior is
+    :func:`scipy.ndimage.convolve1d` with the filter's coefficients, the ``window // 2`` samples at each end
+    come from a polynomial fitted to the first and last ``window`` samples, as SciPy computes them."""
+    from scipy.ndimage import convolve1d
+
+    x = np.asarray(x, dtype=np.float64)
+    out = convolve1d(x, _savgol_coeffs(window, polyorder, deriv, delta), axis=0, mode="constant")
+    half, n = window // 2, x.shape[0]
+    _fit_edge(x, 0, window, 0, half, polyorder, deriv, delta, out)
+    _fit_edge(x, n - window, n, n - half, n, polyorder, deriv, delta, out)
+    return out  # type: ignore[no-any-return]
 
 
 def revolution_speed(time_s: npt.ArrayLike, angle: npt.ArrayLike, window: int = DEFAULT_WINDOW,
@@ -66,17 +119,18 @@ def revolution_speed(time_s: npt.ArrayLike, angle: npt.ArrayLike, window: int = 
     dt = np.diff(t)
     step = float(np.median(dt))
     if np.all(np.abs(dt - step) <= _UNIFORM_TOL * step):
-        return _savgol_filter(a, window, polyorder, deriv=1, delta=step, axis=0, mode="interp")
+        return _savgol_filter(a, window, polyorder, 1, step)
     grid = np.arange(t[0], t[-1] + 0.5 * step, step)
     flat = a.reshape(len(t), -1)
     resampled = np.column_stack([np.interp(grid, t, flat[:, j]) for j in range(flat.shape[1])])
-    d = _savgol_filter(resampled, window, polyorder, deriv=1, delta=step, axis=0, mode="interp")
+    d = _savgol_filter(resampled, window, polyorder, 1, step)
     back = np.column_stack([np.interp(t, grid, d[:, j]) for j in range(d.shape[1])])
     return back.reshape(a.shape)
 
 
 def robust_track_fit(time_s: npt.ArrayLike, angle: npt.ArrayLike, valid: npt.ArrayLike, frames: int = 7,
-                     passes: int = 3, exact: bool = True) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_]]:
+                     passes: int = 3, exact: bool = True, workers: int = 2
+                     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_]]:
     """Each ball's angle from a robust local quadratic over ``frames`` frames around each sample.
 
     Over a few frames a ball moves along its circle at nearly constant speed, so its angle is a
@@ -104,6 +158,9 @@ def robust_track_fit(time_s: npt.ArrayLike, angle: npt.ArrayLike, valid: npt.Arr
         True: compiled (:func:`_robust_columns`, each row's 3 x 3 normal equations solved by hand); False: the
         same fit by numpy's matrix products and LAPACK's solve, column by column (kept as the reference the
         compiled form is tested against: the same fit to rounding, the same samples dropped).
+    workers
+        Threads the compiled fits of the columns are shared among (each column's fit is independent: the same
+        values with any number); used from :data:`_SPLIT_SAMPLES` samples on.
 
     Returns
     -------
@@ -127,8 +184,40 @@ def robust_track_fit(time_s: npt.ArrayLike, angle: npt.ArrayLike, valid: npt.Arr
     design = np.stack([np.ones_like(x), x, x * x], axis=-1)  # (T, frames, 3)
     out = a.copy()
     keep = ok.copy()
-    (_robust_columns if exact else _robust_columns_numpy)(design, a, ok, start, idx, passes, out, keep)
+    if exact:
+        _robust_columns_split(design, a, ok, start, idx, passes, out, keep, workers)
+    else:
+        _robust_columns_numpy(design, a, ok, start, idx, passes, out, keep)
     return out, keep
+
+
+#: Samples (rows x columns) from which :func:`robust_track_fit` shares its columns among threads (a thread's
+#: start costs about 0.1 ms; the fits about 0.4 us a sample).
+_SPLIT_SAMPLES = 20_000
+
+
+def _robust_columns_split(design: np.ndarray, a: np.ndarray, ok: np.ndarray, start: np.ndarray, idx: np.ndarray,
+                          passes: int, out: np.ndarray, keep: np.ndarray, workers: int) -> None:
+    """:func:`_robust_columns` on ``workers`` threads, each on a contiguous copy of its share of the columns (the
+    compiled kernel releases the GIL; the copies keep its one compiled signature), written back in place."""
+    k = max(1, min(workers, a.shape[1], a.size // _SPLIT_SAMPLES))
+    if k == 1:
+        _robust_columns(design, a, ok, start, idx, passes, out, keep)
+        return
+    bounds = np.linspace(0, a.shape[1], k + 1).astype(int)
+
+    def part(span: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+        cols = slice(*span)
+        o, kp = np.ascontiguousarray(out[:, cols]), np.ascontiguousarray(keep[:, cols])
+        _robust_columns(design, np.ascontiguousarray(a[:, cols]), np.ascontiguousarray(ok[:, cols]), start, idx,
+                        passes, o, kp)
+        return o, kp
+
+    spans = list(zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True))
+    with ThreadPoolExecutor(max_workers=k) as pool:
+        for (j0, j1), (o, kp) in zip(spans, pool.map(part, spans), strict=True):
+            out[:, j0:j1] = o
+            keep[:, j0:j1] = kp
 
 
 def _robust_columns_numpy(design: np.ndarray, a: np.ndarray, ok: np.ndarray, start: np.ndarray, idx: np.ndarray,

@@ -360,12 +360,12 @@ def _select_in(video: FrameSource, loc: BearingLocation, background: np.ndarray,
 def _import_late_modules() -> None:
     """Import what later stages use, so that a cold process does it beside the first stages rather than before
     them: ``scipy.optimize`` (the circle fits of the localisation and the selection's assignments, first needed
-    after the median background) and ``scipy.signal`` (the speed, see
-    :func:`cageless.tracking.kinematics._savgol_filter`). A stage that needs a module before it is in waits on
-    Python's import lock, so nothing is imported twice."""
+    after the median background) and ``scipy.ndimage`` (the speed's Savitzky-Golay filter, see
+    :func:`cageless.tracking.kinematics._savgol_filter`; ``scipy.signal`` is not imported). A stage that needs a
+    module before it is in waits on Python's import lock, so nothing is imported twice."""
     try:
+        import scipy.ndimage  # noqa: F401
         import scipy.optimize  # noqa: F401
-        import scipy.signal  # noqa: F401
     except ImportError:  # reported where it is used
         pass
 
@@ -374,7 +374,7 @@ _LATE_IMPORTS: list[threading.Thread] = []
 
 
 def _start_late_imports() -> None:
-    if not _LATE_IMPORTS and not {"scipy.optimize", "scipy.signal"} <= sys.modules.keys():
+    if not _LATE_IMPORTS and not {"scipy.optimize", "scipy.ndimage"} <= sys.modules.keys():
         _LATE_IMPORTS.append(threading.Thread(target=_import_late_modules, name="cageless-imports", daemon=True))
         _LATE_IMPORTS[0].start()
 

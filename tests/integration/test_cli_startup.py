@@ -94,3 +94,21 @@ def test_the_tracking_pipeline_leaves_the_later_scipy_modules_to_a_thread():
     loaded = _modules_after("import cageless.tracking.pipeline")
     assert "cageless.tracking.pipeline" in loaded
     assert not {"scipy.optimize", "scipy.signal"} & loaded
+
+
+def test_track_never_imports_scipy_signal(tmp_path):
+    """The speed's Savitzky-Golay filter is computed without ``scipy.signal`` (0.4-0.5 s of CPU to import with
+    the ``scipy.stats`` it brings in, beyond ``scipy.optimize``): a whole ``cageless track`` run must not load
+    it (:func:`cageless.tracking.kinematics._savgol_filter`)."""
+    from pathlib import Path
+
+    clip = Path(__file__).resolve().parents[2] / "sample_data" / "lab" / "clip_3000rpm.mkv"
+    probe = (
+        "import sys, json\n"
+        "from cageless.app.cli import main\n"
+        f"rc = main(['track', {str(clip)!r}, '--speed-rpm', '3000', '-o', {str(tmp_path / 'out')!r}, '-q'])\n"
+        "print(json.dumps([rc, sorted(m for m in ('scipy.signal', 'scipy.stats') if m in sys.modules)]))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert json.loads(out.stdout.strip().splitlines()[-1]) == [0, []]
