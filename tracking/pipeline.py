@@ -364,8 +364,8 @@ def _import_late_modules() -> None:
     :func:`cageless.tracking.kinematics._savgol_filter`; ``scipy.signal`` is not imported). A stage that needs a
     module before it is in waits on Python's import lock, so nothing is imported twice."""
     try:
+        import scipy.optimize  # noqa: F401 - first: the localisation needs it soonest
         import scipy.ndimage  # noqa: F401
-        import scipy.optimize  # noqa: F401
     except ImportError:  # reported where it is used
         pass
 
