@@ -13,8 +13,8 @@ With ``--speed`` it renders one full-size clip (1280 x 800 px, 16-bit cine words
 lengths from its start, and for each length measures, each in a fresh process:
 
 * **pipeline frames/s**: :func:`cageless.tracking.pipeline.track_video` in process, input hash cached
-  and imports done, ``scipy.signal`` included (which the tracker imports while it tracks; what the tracker
-  itself sustains on both cores);
+  and imports done, ``scipy.optimize``, ``scipy.ndimage`` and ``scipy.signal`` included (which a tree imports
+  while it tracks; what the tracker itself sustains on both cores);
 * **loop frames/s**: the part of that run spent tracking every frame after the set-up (localisation,
   ball selection) and before the kinematics, i.e. the per-frame cost alone;
 * **end to end, cold**: ``cageless track clip.cine --speed-rpm 3000`` from a new interpreter
@@ -74,7 +74,7 @@ _PRELUDE = (
 _PIPELINE = _PRELUDE + (
     "import time, json; from cageless.bearing import default_bearing; "
     "from cageless.conditions import OperatingConditions; import cageless.tracking.pipeline as p; "
-    "import cageless.provenance as pv; import scipy.signal; "
+    "import cageless.provenance as pv; import scipy.signal, scipy.ndimage, scipy.optimize; "
     "h = pv.hash_file({clip!r}, getattr(p, 'INPUT_HASH', 'sha256')) if hasattr(pv, 'hash_file') "
     "else pv.sha256_file({clip!r}); "
     # The tracking loop alone (every frame after the set-up), timed around the pipeline's _track_all.

@@ -70,3 +70,20 @@ def test_matrix_product_form_equals_the_exact_one_to_rounding(frames):
     fast, keep_fast = robust_track_fit(t, noisy, valid, frames, exact=False)
     assert np.max(np.abs(fast - exact)) < 1e-11
     assert np.array_equal(keep, keep_fast) and not keep[500, 2]
+
+
+@pytest.mark.parametrize("layout", ["C", "F"])
+def test_columns_shared_among_threads_give_the_same_bits(layout):
+    """Each ball's fit is independent of the others', so sharing the columns among threads (from
+    ``_SPLIT_SAMPLES`` samples on) changes no bit of the angles or of the samples kept."""
+    rng = np.random.default_rng(5)
+    t = np.arange(5000) * 1e-4  # 70,000 samples: up to 3 threads
+    angle = 95.0 * t[:, None] + rng.normal(0.0, 2e-4, (5000, 14)) + np.arange(14)[None, :]
+    angle[rng.random(angle.shape) < 0.003] += 0.05  # samples off the path, which the fit drops
+    valid = rng.random(angle.shape) > 0.02
+    angle, valid = np.asarray(angle, order=layout), np.asarray(valid, order=layout)
+    one = robust_track_fit(t, angle, valid, 7, workers=1)
+    for workers in (2, 3, 14):
+        many = robust_track_fit(t, angle, valid, 7, workers=workers)
+        assert np.array_equal(many[0], one[0]) and np.array_equal(many[1], one[1])
+    assert (~one[1] & valid).sum() > 0  # the dropping was exercised
