@@ -21,7 +21,9 @@ switch makes the next one wait twice as many chunks as the last (:data:`PROBE_BA
 a run where CVODE never pays spends a handful of chunks on probes, and one where it pays once the violent
 start is over (a BDF restarting from order 1 costs 2-2.7 times DP5 over the first 1.2 ms of a 30 ms run at
 3000 rpm, 0.2-0.4 times after) still finds it. Before the first chunk, a pilot over a tenth of it
-(:data:`PILOT_FRACTION`) starts the run on CVODE where DP5 is held by stability from the first step.
+(:data:`PILOT_FRACTION`) starts the run on CVODE where DP5 is held by stability from the first step. At the planar
+level the pilot first compares ark4's probe with DP5's cost at its stability edge, a closed form
+(:func:`_edge_pilot`), and starts the run on ark4 without running DP5 where that already decides it.
 
 The decision must not depend on timing, or the same scene would give different traces on a busy
 machine (the determinism rule of the project). It compares a cost model instead: each solver's
