@@ -21,7 +21,9 @@ switch makes the next one wait twice as many chunks as the last (:data:`PROBE_BA
 a run where CVODE never pays spends a handful of chunks on probes, and one where it pays once the violent
 start is over (a BDF restarting from order 1 costs 2-2.7 times DP5 over the first 1.2 ms of a 30 ms run at
 3000 rpm, 0.2-0.4 times after) still finds it. Before the first chunk, a pilot over a tenth of it
-(:data:`PILOT_FRACTION`) starts the run on CVODE where DP5 is held by stability from the first step.
+(:data:`PILOT_FRACTION`) starts the run on CVODE where DP5 is held by stability from the first step. At the planar
+level the pilot first compares ark4's probe with DP5's cost at its stability edge, a closed form
+(:func:`_edge_pilot`), and starts the run on ark4 without running DP5 where that already decides it.
 
 The decision must not depend on timing, or the same scene would give different traces on a busy
 machine (the determinism rule of the project). It compares a cost model instead: each solver's
@@ -67,7 +69,9 @@ import numpy.typing as npt
 from tqdm.auto import tqdm
 
 from cageless.simulation._cache import compile_notice
-from cageless.simulation.kernels import PLANAR, SPATIAL
+from cageless.simulation.kernels import PLANAR, SPATIAL, model_gaps
+from cageless.simulation.models import base as B
+from cageless.simulation.models.strip_damping import P_F_STRIP
 from cageless.simulation.problem import Problem
 from cageless.simulation.integrators.dp5 import STATUS_MAX_STEPS, STATUS_OK
 from cageless.simulation.solve import ARK_MAX_STEP_S, ArkSession, CvodeSession, Solution, solve, step_ark, step_cvode
@@ -199,6 +203,10 @@ PROBE_CHUNKS: tuple[int, ...] = (0,)
 #: where DP5 is not held by stability at the start (the balls spread: 500 N scenes, stiff fraction 0.1-0.24
 #: on the first chunk) the pilot costs a tenth of a DP5 chunk and nothing else.
 PILOT_FRACTION: float | None = 0.1
+#: DP5's stability boundary on the negative real axis, h |lambda|: the root of |R(x)| = 1 of its stability function
+#: R(z) = sum_{k<=5} z^k / k! + z^6 / 600 (Hairer & Wanner, Solving ODEs II, sect. IV.2), -3.3066. Where the race
+#: damping holds DP5's step there, its cost over a pilot follows in closed form (:func:`_dp5_edge_cost`).
+DP5_EDGE = 3.3066
 #: After a probe that does not switch, or a way back to DP5, the next probe waits this many times as many
 #: chunks as the last wait (1, 2, 4, ... chunks: at most about log2 of the chunk count of probes). None:
 #: probe only at :data:`PROBE_CHUNKS`, and a way back is for good (the switch before).
@@ -251,8 +259,9 @@ class _ArkProbe:
             self.wall += sol.wall_s
             self.done = sol.success
             self.failed = not sol.success and sol.status != STATUS_MAX_STEPS  # out of its budget: may go on
-        if not self.done or _ark_refusing(self.run_counts[0] + self.steps, self.run_counts[1] + self.refused,
-                                          self.part.model_id):
+        if not self.done or self.trials > budget or _ark_refusing(self.run_counts[0] + self.steps,
+                                                                   self.run_counts[1] + self.refused,
+                                                                   self.part.model_id):
             return np.inf
         cost = self.rhs * RHS_COST_US.get(self.part.model_id, 1.0) + self.trials * STEP_COST_US.get(
             ("ark4", self.part.model_id), 30.0)
@@ -268,7 +277,7 @@ def _cvode_floor(part: Problem, t: npt.NDArray[np.float64], kw: dict[str, Any], 
 
 
 def _probe(part: Problem, t: npt.NDArray[np.float64], sol: Solution, time_s: float,
-           kw: dict[str, Any], run_counts: tuple[int, int] = (0, 0)) -> dict[str, Any]:
+           kw: dict[str, Any], run_counts: tuple[int, int] = (0, 0), ark: _ArkProbe | None = None) -> dict[str, Any]:
     """Run each stiff backend (:data:`STIFF_METHODS`, in order) over the chunk ``sol`` covered and say whether
     the chosen one pays. A later backend replaces the one chosen so far only when it costs below
     :data:`SWITCH_GAIN` of it, as a switch from DP5 needs: the cost model is off by up to 0.06 of the ratio, and
@@ -279,10 +288,13 @@ def _probe(part: Problem, t: npt.NDArray[np.float64], sol: Solution, time_s: flo
     against :data:`SWITCH_GAIN` of CVODE's least possible cost (:func:`_cvode_floor`): below it, the rule above
     chooses ark4 whatever CVODE's probe would give, so CVODE is not probed (``skipped`` records its bound); else
     the probes run as above, ark4's resumed where the first stopped. The record names the choice (``to``), its
-    cost ratio to DP5 and every probed candidate's (``costs``), and ark4's refused share (``ark4_refused``)."""
+    cost ratio to DP5 and every probed candidate's (``costs``), and ark4's refused share (``ark4_refused``). ``ark``:
+    an ark4 probe of the same chunk already run (by :func:`_edge_pilot`), resumed here."""
     dp5_cost = max(_cost(sol, part.model_id), 1.0)
-    ark = (_ArkProbe(part, t, kw, dp5_cost, run_counts)
-           if "ark4" in STIFF_METHODS and part.model_id in ARK_MODELS else None)
+    if ark is not None:
+        ark.dp5_cost = dp5_cost
+    elif "ark4" in STIFF_METHODS and part.model_id in ARK_MODELS:
+        ark = _ArkProbe(part, t, kw, dp5_cost, run_counts)
     costs: dict[str, float] = {}
     skipped: dict[str, float] = {}
     best, wall = STIFF_METHODS[0], 0.0
@@ -310,16 +322,64 @@ def _probe(part: Problem, t: npt.NDArray[np.float64], sol: Solution, time_s: flo
             "wall_s": wall + (ark.wall if ark is not None else 0.0), "ark4_refused": refused}
 
 
+def _dp5_edge_cost(pr: Problem, span: float) -> float | None:
+    """DP5's modelled cost (us, see :func:`_cost`) over ``span`` seconds from ``pr``'s start if every step sat at its
+    stability edge, :data:`DP5_EDGE` / |lambda|, with |lambda| = n C_ho / m the race lubricant damping of a ball with
+    n closed race contacts (the most of any ball at the start; the Hertz spring moves the overdamped mode by
+    k / (n C_ho), about 1 %), six right-hand sides a step. A bound DP5 cannot beat for long: its stiffness test
+    flags steps past 3.25 / |lambda|. Over the settled 0.2 ms pilot at 3000 rpm, 500 N (planar) it gives 171
+    steps where DP5 takes 170 (and 1027 right-hand sides against 1026 = 6 x 171). None where the closed form does not
+    apply: not the planar level, no race contacts or lubricant damping, or the paper's strips."""
+    p = pr.params
+    if pr.model_id != PLANAR or p[B.P_F_RACE] < 0.5 or p[B.P_F_LUB] < 0.5 or p[P_F_STRIP] > 0.5:
+        return None
+    z = int(p[B.P_Z])
+    gaps = np.zeros(3 * z)
+    model_gaps(pr.model_id, pr.y0, p, gaps)
+    closed = int(np.max((gaps[:z] > 0.0).astype(int) + (gaps[z:2 * z] > 0.0)))
+    if closed == 0:
+        return None
+    rate = closed * p[B.P_CHO] / p[B.P_M]
+    return span * rate / DP5_EDGE * 6 * RHS_COST_US.get(pr.model_id, 1.0)
+
+
+def _edge_pilot(pr: Problem, t_end: npt.NDArray[np.float64], kw: dict[str, Any]) -> tuple[dict[str, Any] | None,
+                                                                                             _ArkProbe | None]:
+    """The pilot's decision without DP5, on :data:`ARK_FIRST_MODELS`: ``ark4``'s probe over the pilot against DP5's
+    cost at its stability edge (:func:`_dp5_edge_cost`), a cost DP5 does not beat. Where ark4 costs below
+    :data:`SWITCH_GAIN` of it and of CVODE's least possible cost (:func:`_cvode_floor`), :func:`_probe` on DP5's
+    pilot would choose ark4 too (DP5 held by stability there, CVODE skipped), so the run starts on ark4 without
+    the DP5 pilot (0.2 ms of DP5 at 1.1 us steps, 2.5 % of a settled planar run's time): (the probe record, None).
+    Else (None, the probe to resume in :func:`_probe`), or (None, None) where the closed form does not apply."""
+    span = float(t_end[0] - pr.t0)
+    edge = _dp5_edge_cost(pr, span) if pr.model_id in ARK_FIRST_MODELS and "CVODE" in STIFF_METHODS else None
+    if edge is None or "ark4" not in STIFF_METHODS or pr.model_id not in ARK_MODELS:
+        return None, None
+    ark = _ArkProbe(pr, t_end, kw, edge, (0, 0))
+    gate = SWITCH_GAIN * min(_cvode_floor(pr, t_end, kw, edge), 1.0)
+    ratio = ark.ratio(gate * edge)
+    if not ratio < gate:
+        return None, ark
+    refused = ark.refused / max(ark.steps, 1)
+    return {"time_s": float(pr.t0), "stiff_fraction": None, "cost_ratio": ratio, "switch": True, "to": "ark4",
+            "costs": {"ark4": ratio}, "skipped": {"CVODE": gate / SWITCH_GAIN}, "wall_s": ark.wall,
+            "ark4_refused": refused, "dp5_edge": True, "pilot_s": span, "dp5_rate": edge / span}, None
+
+
 def _pilot(pr: Problem, t_first: float, kw: dict[str, Any]) -> dict[str, Any] | None:
-    """A DP5 pilot over :data:`PILOT_FRACTION` of the first chunk (ending at ``t_first``) and, where DP5 is held by
-    stability there, the stiff backend's probe on it; None when no probe ran."""
+    """A pilot over :data:`PILOT_FRACTION` of the first chunk (ending at ``t_first``): the decision without DP5 where
+    it is certain (:func:`_edge_pilot`), else DP5 over it and, where DP5 is held by stability there, the stiff
+    backends' probe on it; None when no probe ran."""
     if not PILOT_FRACTION or not _may_switch(pr):
         return None
     t_end = np.array([pr.t0 + PILOT_FRACTION * (t_first - pr.t0)])
+    quick, ark = _edge_pilot(pr, t_end, kw)
+    if quick is not None:
+        return quick
     sol = solve(pr, t_end, method="dp5", **_settings("dp5", kw))
     if not sol.success or sol.n_stiff_steps < STIFF_FRACTION * max(sol.n_steps, 1):
         return None
-    probe = _probe(pr, t_end, sol, float(pr.t0), kw)
+    probe = _probe(pr, t_end, sol, float(pr.t0), kw, ark=ark)
     probe["wall_s"] += sol.wall_s
     probe["pilot_s"] = float(t_end[0] - pr.t0)
     probe["dp5_rate"] = _cost(sol, pr.model_id) / probe["pilot_s"]

@@ -64,8 +64,9 @@ from cageless.simulation.models.planar_layout import PlanarLayout
 from cageless.simulation.models.contact_log import (EVENT_FIELDS, ONSET_RESOLUTION, RUBBING_FACTOR, contact_events,
                                                      empty_log, log_size, planar_post)
 from cageless.simulation.models.contact_laws import RACE_LAWS, ball_churning, ball_drag, race_extra, tangential
-from cageless.simulation.models.regime import oil_viscosity as par_viscosity, race_tangential, regime_slots
-from cageless.simulation.models.rolling import race_rolling, rolling_slots
+from cageless.simulation.models.regime import (film_logs, oil_viscosity as par_viscosity, race_tangential,
+                                               race_tangential_logs, regime_slots)
+from cageless.simulation.models.rolling import race_rolling_logs, rolling_slots
 from cageless.simulation.models.strip_damping import P_F_STRIP, strip_normal, strip_slots
 
 __all__ = [
@@ -114,10 +115,14 @@ def _outer_race(y, p, j, z, c, s, obs):  # pragma: no cover - compiled
             p_diss += f_x * rd
             q += f_x
         f_t = 0.0
+        u_e = 0.5 * (r * thd + half * om - p[P_DO] * thd)  # entraining speed along e_theta: film, rolling losses
+        lu = lq = 0.0
+        if trac or p[P_F_ROLL] > 0.5:
+            lu, lq = film_logs(abs(u_e), q, p)
         if trac:
             u = r * thd + half * om  # ball surface against the fixed outer race, along e_theta
-            u_r = 0.5 * abs(r * thd + half * om - p[P_DO] * thd)
-            f_t = -race_tangential(u, u_r, q, False, p)
+            u_r = abs(u_e)
+            f_t = -race_tangential_logs(u, u_r, q, lu, lq, False, p)
             if obs is not None:  # the law on the elastic normal force
                 obs[OBS_OUTER_TRACTION] = -race_tangential(u, u_r, obs[OBS_OUTER_NORMAL], False, p)
                 obs[OBS_OUTER_ENTRAIN] = u_r
@@ -125,7 +130,7 @@ def _outer_race(y, p, j, z, c, s, obs):  # pragma: no cover - compiled
             p_diss -= f_t * u
             torque += half * f_t
         if p[P_F_ROLL] > 0.5:  # rolling losses (models/rolling.py): pressure on the centre, shear at the surface
-            f_p, f_s = race_rolling(0.5 * (r * thd + half * om - p[P_DO] * thd), q, False, p)
+            f_p, f_s = race_rolling_logs(u_e, q, lu, lq, False, p)
             torque += half * f_s
             p_diss -= f_p * r * thd + f_s * (r * thd + half * om)
             f_t += f_p + f_s
@@ -170,12 +175,15 @@ def _inner_race(y, p, j, z, w_i, c, s, fy, fz, torque, p_diss, obs):  # pragma: 
             p_diss += f_x * ddot
             q += f_x
         f_t = 0.0
+        r_i, vt = 0.5 * p[P_DI], vx * tx + vz * tz
+        u_e = 0.5 * (vt * (1.0 - 2.0 * r_i / ln) - half * om + w_i * r_i)  # entraining speed along t
+        lu = lq = 0.0
+        if trac or p[P_F_ROLL] > 0.5:
+            lu, lq = film_logs(abs(u_e), q, p)
         if trac:
-            r_i = 0.5 * p[P_DI]
-            vt = vx * tx + vz * tz
             u = vt - half * om - w_i * r_i  # ball surface against the ring surface, along t
-            u_r = 0.5 * abs(vt * (1.0 - 2.0 * r_i / ln) - half * om + w_i * r_i)
-            f_t = -race_tangential(u, u_r, q, True, p)
+            u_r = abs(u_e)
+            f_t = -race_tangential_logs(u, u_r, q, lu, lq, True, p)
             if obs is not None:  # the law on the elastic normal force
                 obs[OBS_INNER_TRACTION] = -race_tangential(u, u_r, obs[OBS_INNER_NORMAL], True, p)
                 obs[OBS_INNER_ENTRAIN] = u_r
@@ -184,8 +192,7 @@ def _inner_race(y, p, j, z, w_i, c, s, fy, fz, torque, p_diss, obs):  # pragma: 
             p_in += w_i * r_i * f_t
             torque -= half * f_t
         if p[P_F_ROLL] > 0.5:
-            r_i, vt = 0.5 * p[P_DI], vx * tx + vz * tz
-            f_p, f_s = race_rolling(0.5 * (vt * (1.0 - 2.0 * r_i / ln) - half * om + w_i * r_i), q, True, p)
+            f_p, f_s = race_rolling_logs(u_e, q, lu, lq, True, p)
             torque -= half * f_s
             p_diss -= f_p * vt + f_s * (vt - half * om - w_i * r_i)
             p_in += w_i * r_i * f_s

@@ -21,6 +21,11 @@ At a race contact of normal force Q with entraining speed u_r (the mean surface 
   computed once per contact (:func:`race_regime`); the force of a sliding speed u_s (a whole contact, or
   one strip of the spatial model's ellipse with its share of Q) is :func:`regime_force`.
 
+A contact's law costs two logarithms (ln u_r, ln Q: :func:`film_logs`, shared with the rolling losses' film in the
+planar model), three exponentials (h_min, Roelands' power as exp(Z ln(1 + p / p_0)), and h_c / eta_e as one) and a
+cube root; Roelands' power was ``**`` (glibc's pow) and h_c and eta_e two exponentials, 14 % of the CPU time of a
+settled planar ``ark4`` run in pow alone (perf; docs/imex.md, the tenth step).
+
 It replaces the traction curve mu(slide-to-roll) at the race contacts (the ball-ball contacts keep the
 curve). The force acts where the curve's acted and is booked the same way (the models' traction power), so the
 energy balance is unchanged in form.
@@ -38,8 +43,8 @@ from cageless.simulation.models.base import LAYOUT, P_F_FILM, P_H0
 from cageless.simulation.models.contact_laws import tangential
 from cageless.simulation.physics.viscosity import ROELANDS_LN_POLE, ROELANDS_P0_PA
 
-__all__ = ["race_regime", "regime_force", "race_tangential", "strip_tangential", "regime_slots",
-           "oil_viscosity", "race_tangential_array"]
+__all__ = ["race_regime", "race_regime_logs", "film_logs", "regime_force", "race_tangential", "race_tangential_logs",
+           "strip_tangential", "regime_slots", "oil_viscosity", "race_tangential_array"]
 
 (P_F_FTRAC, P_SIGMA, P_LSS, P_MU_B, P_V_REG_B, P_U_MIN, P_LAM_B, P_LAM_F, P_ETA_T, P_ROE_LN, P_ROE_Z,
  P_LHC_I, P_LHM_I, P_AB_I, P_LHC_O, P_LHM_O, P_AB_O) = LAYOUT.slots(
@@ -48,9 +53,29 @@ __all__ = ["race_regime", "regime_force", "race_tangential", "strip_tangential",
 
 
 @numba.njit(cache=True, fastmath=FASTMATH, inline="always")
+def film_logs(u, q, p):  # pragma: no cover - compiled
+    """(ln u, ln q) of a race contact's entraining speed ``u`` (m/s, >= 0) and normal force ``q`` (N) where the
+    ``ehl_film`` effect computes the film from them (on, u > 0, q > 0), else (0, 0), which are then not used: the
+    film of :func:`race_regime_logs` and the rolling losses' (:func:`cageless.simulation.models.rolling.
+    race_rolling_logs`) from one pair of logarithms per contact."""
+    if p[P_F_FILM] > 0.5 and u > 0.0 and q > 0.0:
+        return math.log(u), math.log(q)
+    return 0.0, 0.0
+
+
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
 def race_regime(u_r, q, inner, p):  # pragma: no cover - compiled
     """(w, u_L) at a race contact: the full film's share w in [0, 1] and its limiting sliding speed (m/s);
     (-1, 0) when the ``film_traction`` effect is off (the traction curve applies)."""
+    if p[P_F_FTRAC] < 0.5:
+        return -1.0, 0.0
+    lu, lq = film_logs(u_r, q, p)
+    return race_regime_logs(u_r, q, lu, lq, inner, p)
+
+
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
+def race_regime_logs(u_r, q, lu, lq, inner, p):  # pragma: no cover - compiled
+    """:func:`race_regime` with the contact's :func:`film_logs` (``lu``, ``lq``) given."""
     if p[P_F_FTRAC] < 0.5:
         return -1.0, 0.0
     if q <= 0.0:
@@ -62,18 +87,20 @@ def race_regime(u_r, q, inner, p):  # pragma: no cover - compiled
     if p[P_F_FILM] > 0.5:
         if u_r <= 0.0:
             return 0.0, 1.0  # no entrainment, no film: boundary friction
-        lu, lq = math.log(u_r), math.log(q)
-        h_c = math.exp(lhc + 0.67 * lu - 0.067 * lq)
+        ln_hc = lhc + 0.67 * lu - 0.067 * lq
         h_m = math.exp(lhm + 0.68 * lu - 0.073 * lq)
     else:
-        h_c = h_m = p[P_H0]
+        h_m = p[P_H0]
+        ln_hc = math.log(h_m)
     x = (h_m / p[P_SIGMA] - p[P_LAM_B]) / (p[P_LAM_F] - p[P_LAM_B])
     if x <= 0.0:
         return 0.0, 1.0
     w = 1.0 if x >= 1.0 else x * x * (3.0 - 2.0 * x)  # regime_weight
     pm = np.cbrt(q) / ab  # mean Hertz pressure Q / (pi a b)
-    eta_e = p[P_ETA_T] * math.exp(p[P_ROE_LN] * ((1.0 + pm / ROELANDS_P0_PA) ** p[P_ROE_Z] - 1.0))  # roelands
-    return w, max(p[P_LSS] * pm * h_c / eta_e, p[P_U_MIN])
+    # Roelands, ln(eta_e / eta_T) = ln(eta_T / eta_pole) ((1 + p / p_0)^Z - 1), its power as exp(Z ln(.)), and
+    # h_c / eta_e in one exponential: u_L = L_SS p_m h_c / eta_e
+    ln_roe = p[P_ROE_LN] * (math.exp(p[P_ROE_Z] * math.log(1.0 + pm / ROELANDS_P0_PA)) - 1.0)
+    return w, max(p[P_LSS] * pm / p[P_ETA_T] * math.exp(ln_hc - ln_roe), p[P_U_MIN])
 
 
 @numba.njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -95,6 +122,15 @@ def race_tangential(u_s, u_r, q, inner, p):  # pragma: no cover - compiled
     """Signed tangential force (N) at a race contact: the regime law when ``film_traction`` is on, else the
     models' :func:`~cageless.simulation.models.contact_laws.tangential` (traction curve or dry friction)."""
     w, u_l = race_regime(u_r, q, inner, p)
+    if w < 0.0:
+        return tangential(u_s, u_r, q, p)
+    return regime_force(u_s, q, w, u_l, p)
+
+
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
+def race_tangential_logs(u_s, u_r, q, lu, lq, inner, p):  # pragma: no cover - compiled
+    """:func:`race_tangential` with the contact's :func:`film_logs` (``lu``, ``lq``) given."""
+    w, u_l = race_regime_logs(u_r, q, lu, lq, inner, p)
     if w < 0.0:
         return tangential(u_s, u_r, q, p)
     return regime_force(u_s, q, w, u_l, p)

@@ -27,10 +27,11 @@ import math
 import numba
 
 from cageless.simulation.forces import FASTMATH
+from cageless.simulation.models.regime import film_logs
 from cageless.simulation.models.base import (P_D, P_ETA0, P_F_FILM, P_LT_FILM_I, P_LT_FILM_O, P_LT_FIX_I, P_LT_FIX_O,
                                              P_RC_I, P_RC_O, P_RH_I, P_RH_O)
 
-__all__ = ["race_rolling", "spatial_rolling", "rolling_slots"]
+__all__ = ["race_rolling", "race_rolling_logs", "spatial_rolling", "rolling_slots"]
 
 
 @numba.njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -40,9 +41,18 @@ def race_rolling(u_e, q, inner, p):  # pragma: no cover - compiled
 
     :func:`cageless.simulation.physics.rolling_force.rolling_force_along` with u_eta = 0, its film from
     :func:`cageless.simulation.physics.film_traction.hd_central_film`, written in logarithms so that a call costs
-    two logarithms (the contact's constants are in the slots, :func:`rolling_slots`):
+    two logarithms, ln |u| and ln Q, which the planar model shares with the traction's film
+    (:func:`race_rolling_logs`; the contact's constants are in the slots, :func:`rolling_slots`):
     h = C |u|^0.67 Q^-0.067, ln t = ln r_s - ln(2 R_x h) / 2, C_0 = eta |u| sqrt(R_x R_y) / (3 + 2k).
     """
+    lu, lq = film_logs(abs(u_e), q, p)
+    return race_rolling_logs(u_e, q, lu, lq, inner, p)
+
+
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
+def race_rolling_logs(u_e, q, lu, lq, inner, p):  # pragma: no cover - compiled
+    """:func:`race_rolling` with the contact's :func:`cageless.simulation.models.regime.film_logs` of |u_e| and q
+    (``lu``, ``lq``) given: the traction's film and this one from the same two logarithms."""
     if q <= 0.0 or u_e == 0.0:
         return 0.0, 0.0
     if inner:
@@ -51,7 +61,7 @@ def race_rolling(u_e, q, inner, p):  # pragma: no cover - compiled
         rc, rh, lt_film, lt_fix = p[P_RC_O], p[P_RH_O], p[P_LT_FILM_O], p[P_LT_FIX_O]
     au = abs(u_e)
     if p[P_F_FILM] > 0.5:
-        ln_t = lt_film - 0.5 * (0.67 * math.log(au) - 0.067 * math.log(q))
+        ln_t = lt_film - 0.5 * (0.67 * lu - 0.067 * lq)
     else:
         ln_t = lt_fix
     fbar = max(28.59 * ln_t - 10.10, 36.57 * ln_t - 22.85, 0.0)  # chiu_coefficient

@@ -90,3 +90,36 @@ def test_auto_runs_one_ark4_session_and_skips_the_cvode_probe_it_cannot_need(set
     assert np.array_equal(sol.y[1:], rest.y)
     again = solve(pr, t, method="auto")
     assert np.array_equal(sol.y, again.y) and again.method == sol.method
+
+
+def test_auto_decides_on_ark4_without_a_dp5_pilot_where_the_race_damping_holds_dp5(settled, monkeypatch):
+    """Where the race damping holds DP5 at its stability edge, its cost over the pilot is a closed form
+    (simulation.auto_switch._dp5_edge_cost: steps of DP5_EDGE / |lambda|, |lambda| = 2 C_ho / m for a ball between
+    both races, six right-hand sides each), within 2 % of DP5's own pilot (measured 1.003 times it over the 0.2 ms
+    pilot of the settled window of benchmarks/ark_speed.py). DP5_EDGE is the negative real root of |R(x)| = 1 for DP5's
+    stability function R(z) = sum_{k<=5} z^k / k! + z^6 / 600 (Hairer & Wanner, Solving ODEs II, sect. IV.2). ark4's
+    probe below SWITCH_GAIN of that and of CVODE's least cost starts the run on ark4 without the DP5 pilot, the
+    same choice and the same samples, bit for bit, as the run that pays the pilot (the closed form switched off)."""
+    import math
+
+    import cageless.simulation.auto_switch as auto_switch
+
+    coeffs = [1.0 / 600.0] + [1.0 / math.factorial(k) for k in range(5, -1, -1)]
+    coeffs[-1] -= 1.0  # R(x) - 1 = 0 (R > 0 there)
+    roots = [r.real for r in np.roots(coeffs) if abs(r.imag) < 1e-9 and r.real < -1.0]
+    assert roots and auto_switch.DP5_EDGE == pytest.approx(-roots[0], abs=1e-4)
+    pr, _ = settled
+    t = np.linspace(0.0, 4e-3, 3)  # a 2 ms first chunk: a 0.2 ms pilot
+    pilot_s = auto_switch.PILOT_FRACTION * 2e-3
+    dp5 = solve(pr, np.array([pilot_s]), method="dp5", max_step=auto_switch.CONTACT_MAX_STEP_S)
+    assert dp5.n_stiff_steps > 0.8 * dp5.n_steps  # DP5 held by stability there
+    edge = auto_switch._dp5_edge_cost(pr, pilot_s)
+    assert edge == pytest.approx(auto_switch._cost(dp5, pr.model_id), rel=0.02)
+    sol = solve(pr, t, method="auto")
+    pilot = sol.extra["switches"][0]
+    assert sol.method == "auto: dp5 -> ark4 at 0 s" and pilot["dp5_edge"] and pilot["stiff_fraction"] is None
+    assert pilot["pilot_s"] == pytest.approx(pilot_s) and pilot["cost_ratio"] < SWITCH_GAIN * pilot["skipped"]["CVODE"]
+    monkeypatch.setattr(auto_switch, "_dp5_edge_cost", lambda *_: None)
+    paid = solve(pr, t, method="auto")
+    assert paid.method == sol.method and "dp5_edge" not in paid.extra["switches"][0]
+    assert np.array_equal(paid.y, sol.y) and paid.n_rhs == sol.n_rhs
