@@ -77,6 +77,7 @@ CANDIDATES = {
     "rosw3e-7": ("rosw, rtol 3e-7 (cap 10 us)", "rosw", 3e-7, None),
     "rosw8": ("rosw, rtol 1e-8 (cap 10 us)", "rosw", 1e-8, None),
     "ark4": ("ark4 (IMEX), rtol 1e-6 (error test at 0.2 x rtol, cap 50 us)", "ark4", 1e-6, None),
+    "ark4-3e-7": ("ark4 (IMEX), rtol 3e-7 (error test at 0.2 x rtol, cap 50 us)", "ark4", 3e-7, None),
     "ark4-7": ("ark4 (IMEX), rtol 1e-7 (error test at 0.2 x rtol, cap 50 us)", "ark4", 1e-7, None),
 }
 DEFAULT_CANDIDATES = "auto,dp5,rosw6,rosw7,rosw3e-7,rosw8"
@@ -167,9 +168,10 @@ def _run(pr: Any, t: np.ndarray, method: str, rtol: float, cap: float | None) ->
 
 
 def measure(case: str, pr: Any, cage: float, t: np.ndarray, repeats: int,
-            keys: list[str] | None = None) -> list[dict[str, Any]]:
+            keys: list[str] | None = None, keep: dict[str, Any] | None = None) -> list[dict[str, Any]]:
     """The candidates ``keys`` (the first is the base of the ratios) on one case, interleaved, best of
-    ``repeats``."""
+    ``repeats``; into ``keep`` (if given) the tight reference (key ``"reference"``) and each candidate's last
+    solution (by label)."""
     chosen = [CANDIDATES[k] for k in (keys or DEFAULT_CANDIDATES.split(","))]
     ref = solve(pr, t, rtol=1e-10, max_step=2.5e-7)
     z = pr.n_balls
@@ -185,6 +187,8 @@ def measure(case: str, pr: Any, cage: float, t: np.ndarray, repeats: int,
             cpu[label] = min(cpu.get(label, np.inf), time.process_time() - start)
             sols[label] = sol
             best[label] = min(best.get(label, np.inf), time.perf_counter() - wall)
+    if keep is not None:
+        keep.update(sols, reference=ref)
     rows = []
     span = float(t[-1] - t[0])
     for label, *_ in chosen:
