@@ -10,9 +10,10 @@ ring is chaotic, so that state moves with any round-off change, and the error of
 moves with it. This settles the ``--case`` (``planar``: 3000 rpm, 500 N; ``spatial``: 3000 rpm, 500 N radial +
 400 N axial, 5 strips) for ``--first``, ``--first + --spacing``, ... seconds from the start (``--states`` of them,
 each from the start as ``ark_speed.py``'s state is: :func:`cageless.simulation.bench._settled_problem`) and on each
-runs :func:`solver_speed.measure` over ``--window`` (``--samples`` samples, 51 as there): the same tight reference (DP5, rtol 1e-10,
-0.25 us cap), the same error (largest difference of the balls' orbital speed over all balls and samples, in
-percentage points of the cage speed) and the same interleaved best-of-``--repeats`` CPU time.
+runs :func:`solver_speed.measure` over ``--window`` (``--samples`` samples, 51 as there): the same tight
+reference (DP5, rtol 1e-10, 0.25 us cap), the same error (largest difference of the balls' orbital speed over all
+balls and samples, in percentage points of the cage speed) and the same interleaved best-of-``--repeats`` CPU
+time.
 
 It prints a table of each candidate's error per state, their largest and median, and its CPU seconds per simulated
 second (median over the states; the ratio to the first candidate is the median of the per-state ratios, each from
@@ -90,7 +91,8 @@ def diagnose(pr: Any, cage: float, t: np.ndarray, sol: Any, ref: Any) -> dict[st
     dict
         ``peak_t_ms``, ``peak_ball``: the sample and ball of the largest error; ``half_t_ms``: the first sample past
         half of it; ``episodes``, ``impacts``, ``largest_peak_n``: the reference's ball-ball contact episodes that
-        began in the window (not in the settling's log, nor open at the start); ``onset_before_half_ms``: the last onset at or before ``half_t_ms`` (NaN if none);
+        began in the window (not in the settling's log, nor open at the start); ``onset_before_half_ms``: the last
+        onset at or before ``half_t_ms`` (NaN if none);
         ``steps``, ``refused``, ``onset_retries``, ``jump_retries``: the candidate's step counts.
     """
     z = pr.n_balls
