@@ -16,6 +16,10 @@ Jacobian of the whole right-hand side and of its explicit part (the whole minus 
 forces and radial kinematics of :mod:`cageless.simulation.models.implicit_normal`), which set DP5's and
 ark4's stability limits.
 
+The slip error here is that of ONE settled state, which moves with round-off (the ring is chaotic);
+``benchmarks/ark_accuracy_states.py`` measures it over several (settled 30, 35, ... ms), with the reference's own
+error on each.
+
 ``--speed-window S`` measures speed only, over S simulated seconds from the settled states of the ``planar`` and
 ``spatial`` cases (51 samples, as a report's run writes them: ``auto``'s pilot, probes and chunks amortised as
 there), with no reference (a 5 ms step of the window would be a 10 ms call, inside the machine's noise; the
