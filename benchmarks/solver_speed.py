@@ -79,6 +79,7 @@ CANDIDATES = {
     "ark4": ("ark4 (IMEX), rtol 1e-6 (error test at 0.2 x rtol, cap 50 us)", "ark4", 1e-6, None),
     "ark4-3e-7": ("ark4 (IMEX), rtol 3e-7 (error test at 0.2 x rtol, cap 50 us)", "ark4", 3e-7, None),
     "ark4-7": ("ark4 (IMEX), rtol 1e-7 (error test at 0.2 x rtol, cap 50 us)", "ark4", 1e-7, None),
+    "ark4-8": ("ark4 (IMEX), rtol 1e-8 (error test at 0.2 x rtol, cap 50 us)", "ark4", 1e-8, None),
 }
 DEFAULT_CANDIDATES = "auto,dp5,rosw6,rosw7,rosw3e-7,rosw8"
 
