@@ -169,13 +169,15 @@ def run_states(case: str, times: list[float], window: float, repeats: int, keys:
     return rows
 
 
-def format_table(rows: list[dict[str, Any]], keys: list[str]) -> str:
-    """Per candidate: the error on each state, its largest and median, CPU s per simulated s and the ratio to
-    the first candidate (medians over the states)."""
+def format_table(rows: list[dict[str, Any]], keys: list[str], bar: float = 0.01) -> str:
+    """Per candidate: the error on each state, its largest and median, on how many states it is within ``bar``
+    (pp; in brackets, of the states whose reference's own error, if checked, is within a tenth of it), CPU s per
+    simulated s and the ratio to the first candidate (medians over the states)."""
     times = sorted({r["settle_s"] for r in rows})
-    head = ("| solver | " + " | ".join(f"{1e3 * s:g} ms" for s in times) + " | max (pp) | median (pp) | "
-            "CPU s / sim s (median) | CPU vs first (median) | steps (median) |")
-    lines = [head, "|---" * (len(times) + 6) + "|"]
+    resolved = {r["settle_s"] for r in rows if r.get("why", {}).get("reference_pp", np.inf) <= 0.1 * bar}
+    head = ("| solver | " + " | ".join(f"{1e3 * s:g} ms" for s in times) + f" | max (pp) | median (pp) | "
+            f"states <= {bar:g} pp (resolved) | CPU s / sim s (median) | CPU vs first (median) | steps (median) |")
+    lines = [head, "|---" * (len(times) + 7) + "|"]
     labels = [CANDIDATES[k][0] for k in keys]
     base = {r["settle_s"]: r["cpu_s_per_sim_s"] for r in rows if r["solver"] == labels[0]}
     for key, label in zip(keys, labels):
@@ -184,8 +186,11 @@ def format_table(rows: list[dict[str, Any]], keys: list[str]) -> str:
         cpu = np.array([r["cpu_s_per_sim_s"] for r in mine])
         ratio = np.array([r["cpu_s_per_sim_s"] / base[r["settle_s"]] for r in mine])
         flags = ["" if r["ok"] else "!" for r in mine]
+        within = sum(e <= bar for e in err)
+        within_resolved = sum(e <= bar for e, r in zip(err, mine) if r["settle_s"] in resolved)
         lines.append(f"| {key} | " + " | ".join(f"{e:.2g}{f}" for e, f in zip(err, flags)) +
-                     f" | {err.max():.2g} | {np.median(err):.2g} | {np.median(cpu):.2f} | "
+                     f" | {err.max():.2g} | {np.median(err):.2g} | {within} of {len(err)} "
+                     f"({within_resolved} of {len(resolved)}) | {np.median(cpu):.2f} | "
                      f"{np.median(ratio):.2f} | {int(np.median([r['steps'] for r in mine]))} |")
     return "\n".join(lines)
 
@@ -199,11 +204,12 @@ def format_why(rows: list[dict[str, Any]]) -> str:
         if "why" not in r:
             continue
         w = r["why"]
+        own = f"{w['reference_pp']:.2g}" if "reference_pp" in w else "not checked"
         lines.append(f"| {1e3 * r['settle_s']:g} ms | {r['slip_error_pp']:.2g} | {w['peak_t_ms']:.1f}, "
                      f"{w['peak_ball']} | {w['half_t_ms']:.1f} | {w['episodes']} ({w['impacts']}) | "
                      f"{w['largest_peak_n']:.3g} | {w['onset_before_half_ms']:.2f} | {w['steps']} | "
                      f"{w['refused']} ({w['onset_retries']}, {w['jump_retries']}) | "
-                     f"{w.get('reference_pp', float('nan')):.2g} |")
+                     f"{own} |")
     return "\n".join(lines)
 
 
@@ -221,6 +227,7 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=1)
     ap.add_argument("--candidates", default="ark4,ark4-3e-7,ark4-7,auto,dp5",
                     help="keys of solver_speed.CANDIDATES; the first is the base of the ratios")
+    ap.add_argument("--bar", type=float, default=0.01, help="the slip error bar (pp) the table counts states against")
     ap.add_argument("--json", type=Path)
     args = ap.parse_args()
     logging.basicConfig(level=logging.INFO, format="%(message)s", stream=sys.stderr)
@@ -228,7 +235,7 @@ def main() -> None:
     rows = run_states(args.case, settle_times(args.first, args.spacing, args.states), args.window, args.repeats,
                       keys, args.samples, args.check_reference)
     print(f"{args.case}, window {args.window:g} s, {args.samples} samples, {args.states} settled states\n")
-    print(format_table(rows, keys) + "\n\n" + format_why(rows))
+    print(format_table(rows, keys, args.bar) + "\n\n" + format_why(rows))
     if args.json:
         atomic_write_text(args.json, json.dumps(rows, indent=1, default=str))
 

@@ -35,9 +35,11 @@ def test_table_max_median_and_ratio(mod) -> None:  # noqa: ANN001
     cpu = {labels[0]: [2.0, 2.0, 4.0], labels[1]: [20.0, 30.0, 40.0]}
     rows = [{"solver": lab, "settle_s": s, "slip_error_pp": errors[lab][i], "cpu_s_per_sim_s": cpu[lab][i],
              "ok": True, "steps": 100 * (i + 1)} for lab in labels for i, s in enumerate([0.03, 0.035, 0.04])]
-    lines = mod.format_table(rows, keys).splitlines()
-    assert lines[0].startswith("| solver | 30 ms | 35 ms | 40 ms | max (pp) | median (pp)")
+    rows[0]["why"] = {"reference_pp": 1e-4}  # resolved: the reference within a tenth of the bar
+    rows[1]["why"] = {"reference_pp": 0.005}  # not resolved
+    lines = mod.format_table(rows, keys, bar=0.01).splitlines()
+    assert lines[0].startswith("| solver | 30 ms | 35 ms | 40 ms | max (pp) | median (pp) | states <= 0.01 pp")
     first = [c.strip() for c in lines[2].split("|")[1:-1]]
-    assert first == ["ark4", "0.03", "0.001", "0.002", "0.03", "0.002", "2.00", "1.00", "200"]
+    assert first == ["ark4", "0.03", "0.001", "0.002", "0.03", "0.002", "2 of 3 (0 of 1)", "2.00", "1.00", "200"]
     second = [c.strip() for c in lines[3].split("|")[1:-1]]
-    assert second[4:8] == ["0.006", "0.005", "30.00", "10.00"]  # ratios 10, 15, 10: median 10
+    assert second[4:9] == ["0.006", "0.005", "3 of 3 (1 of 1)", "30.00", "10.00"]  # ratios 10, 15, 10: median 10
