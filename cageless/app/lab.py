@@ -86,6 +86,8 @@ class LabOptions:
     allow_truncated: bool = False
     #: Savitzky-Golay speed window of the tracking (frames, odd; ``None``: the tracker's default, 21).
     window: int | None = None
+    #: The tracking's angle smoothing window (frames, or ``"auto"``; ``None``: the tracker's default, ``"auto"``).
+    track_fit: int | str | None = None
     #: What slip is referred to in the comparison (a key of ``cageless.comparison.compare.SLIP_REFERENCES``).
     slip_reference: str = "cage"
 
@@ -98,7 +100,8 @@ class LabOptions:
                 "slip_reference": self.slip_reference, "peak_estimator": peak_estimator(),
                 **({"calibration": self.calibration} if self.calibration else {}),
                 **({"allow_truncated": True} if self.allow_truncated else {}),
-                **({"window": self.window} if self.window is not None else {})}
+                **({"window": self.window} if self.window is not None else {}),
+                **({"track_fit": self.track_fit} if self.track_fit is not None else {})}
 
 
 @dataclass
@@ -129,12 +132,14 @@ def say_if_compiling(package: str) -> None:
 
 def _track_job(video: str, conditions: OperatingConditions, bearing: Bearing, out_dir: str,
                n_balls: int | None = None, allow_truncated: bool = False,
-               window: int | None = None) -> tuple[str, str]:
+               window: int | None = None, track_fit: int | str | None = None) -> tuple[str, str]:
     from cageless.tracking.pipeline import TrackOptions, track_video
 
     options = TrackOptions(n_balls=n_balls, allow_truncated=allow_truncated)
     if window is not None:
         options = replace(options, window=window)
+    if track_fit is not None:
+        options = replace(options, track_fit=track_fit)
     try:
         res = track_video(video, conditions, bearing, options, out_dir=out_dir, progress=False,
                           config={"command": "report"})
@@ -483,6 +488,8 @@ def _track_all(pool: Any, entries: list[LabEntry], bearings: dict[Path, Bearing]
     n_balls, cut = options.n_balls, {"allow_truncated": True} if options.allow_truncated else {}
     if options.window is not None:  # keys of runs with the default window stay as they were
         cut["window"] = options.window
+    if options.track_fit is not None:
+        cut["track_fit"] = options.track_fit
     first_of: dict[str, Path] = {}
     for e in entries:
         digest = hash_file(e.video, VIDEO_HASH)
@@ -498,7 +505,7 @@ def _track_all(pool: Any, entries: list[LabEntry], bearings: dict[Path, Bearing]
             traces[e.video] = hit
             continue
         jobs.append((_track_job, (str(e.video), e.resolved.conditions, bearings[e.video], str(out / "traces"),
-                                  n_balls, options.allow_truncated, options.window)))
+                                  n_balls, options.allow_truncated, options.window, options.track_fit)))
         keys.append(key)
         pending.append(e.video)
     if jobs and progress:

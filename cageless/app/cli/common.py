@@ -47,6 +47,28 @@ def finite_float(text: str) -> float:
     return value
 
 
+def track_fit_value(text: str) -> int | str:
+    """argparse type for ``--track-fit``: ``auto``, 1 (no track fit) or an odd number of frames >= 5."""
+    if text.strip().lower() == "auto":
+        return "auto"
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be 'auto' or an odd number of frames, got {text!r}") from None
+    if value != 1 and (value < 5 or value % 2 == 0):
+        raise argparse.ArgumentTypeError(f"must be 'auto', 1 (no track fit) or an odd number of frames >= 5, "
+                                         f"got {value}")
+    return value
+
+
+def add_track_fit_option(parser: argparse.ArgumentParser, default: str | None) -> None:
+    """Add ``--track-fit`` (each ball's angle smoothing window) to a subcommand that tracks videos."""
+    parser.add_argument("--track-fit", type=track_fit_value, default=default, metavar="auto|FRAMES",
+                        help="frames of the robust local quadratic each ball's angle is read from: 'auto' (default) "
+                        "picks 7-41 frames per clip by cross-validation; a number fixes it (odd, >= 5; 1: raw "
+                        "angles). Longer windows cut noise but blur sharp speed changes at impacts")
+
+
 def common_options() -> ArgumentParser:
     """Return a parent parser with the options every subcommand has."""
     parent = ArgumentParser(add_help=False)

@@ -6,7 +6,7 @@ import argparse
 import sys
 from typing import Any
 
-from cageless.app.cli.common import add_parameter_set_option, finite_float
+from cageless.app.cli.common import add_parameter_set_option, add_track_fit_option, finite_float
 
 __all__ = ["register", "run"]
 
@@ -56,6 +56,7 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--window", type=int, metavar="FRAMES",
                    help="Savitzky-Golay speed window of the tracking, in frames, odd, >= 3 (default 21); a shorter "
                    "one tracks shorter clips, with noisier speeds")
+    add_track_fit_option(p, None)
     p.add_argument("--allow-truncated", action="store_true",
                    help="track the complete frames of a cut-off .cine instead of failing its row")
 
@@ -86,6 +87,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
                          rtol=args.rtol, workers=args.workers,
                          scheduler=args.scheduler, force=args.force, parameters=values, calibration=note,
                          n_balls=args.n_balls, allow_truncated=args.allow_truncated, window=args.window,
+                         track_fit=args.track_fit,
                          slip_reference=args.slip_reference,
                          parameter_set=args.parameter_set or DEFAULT_SET)
     if not find_videos(args.lab):  # find_videos names a missing folder; say so before any output

@@ -15,7 +15,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from cageless.bearing import Bearing
-from cageless.app.cli.common import check_n_balls, check_window, failed_line, finite_float
+from cageless.app.cli.common import add_track_fit_option, check_n_balls, check_window, failed_line, finite_float
 from cageless.conditions import (
     IMAGE_SUFFIXES,
     LabEntry,
@@ -76,6 +76,7 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
                    help=f"Savitzky-Golay speed window in frames, odd (default {DEFAULT_WINDOW})")
     p.add_argument("--detector", choices=DETECTORS, default="window",
                    help="centroid method: window refinement (default), weighted, or binary mask")
+    add_track_fit_option(p, "auto")
     p.add_argument("--n-balls", type=int, metavar="N",
                    help="ball count the video shows, when it differs from the bearing's; otherwise a video that "
                    "does not show the bearing's count is an error (no trace; the QC image shows what was found)")
@@ -193,7 +194,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
 
     options = TrackOptions(detector=replace(DetectorParams(), method=args.detector), window=args.window,
                            strict=args.strict, fps=args.fps, allow_truncated=args.allow_truncated,
-                           n_balls=args.n_balls)
+                           n_balls=args.n_balls, track_fit=args.track_fit)
     out = Path(args.out)
     with output_lock(out):
         clean_stale_parts(out)
