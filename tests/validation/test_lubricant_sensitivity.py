@@ -49,19 +49,28 @@ def test_viscosity_moves_the_1800_rpm_slip_by_more_than_15_percent():
 
 
 @pytest.mark.slow
-def test_a_hotter_oil_lowers_the_slip():
-    """20 -> 60 degC at 1800 rpm, 4 seeds x 0.2 s: 9.55 % (s.d. 0.27) -> 8.86 % (s.d. 0.51), a fall of 2.4 standard
-    errors. Not monotonic: 40 degC reads 7.48 % (s.d. 0.24). Thinning the oil lowers the rolling loss (eta u), but
-    also the film: towards 60 degC the lightly loaded unloaded-zone contacts approach mixed lubrication, where
-    the traction rises again. With 2 seeds x 0.1 s the 20/60 degC pair read 9.49 / 9.99 %, within the chaotic
-    spread of the 1800 rpm ring (about 1 pp between seeds)."""
-    vary = parse_vary(["oil_temperature_c=20,60"])
+def test_the_oil_temperature_acts_through_a_dip_at_40_degc():
+    """20 / 40 / 60 degC at 1800 rpm, 500 N, 4 seeds x 0.2 s: 9.46 / 7.36 / 9.27 % (s.d. 0.40 / 0.34 / 0.15),
+    so 40 degC lies 8.0 and 10.3 standard errors below its neighbours. With 12 seeds x 0.2 s (2026-11-28, the
+    traction law with Roelands' power as exp(Z ln(1 + p/p0))): 9.39 / 7.37 / 9.25 % (s.d. 0.49 / 0.41 / 0.45),
+    11.0 and 10.7 standard errors. The temperature reaches the slip only through the viscosity (60 degC thins
+    the oil to exp(-0.027 x 40) = 0.34 of its 20 degC value, the paper's Table 1 coefficient; the paper itself
+    varies the viscosity, not the temperature). Thinning the oil lowers the rolling loss (eta u), but also the
+    film: towards 60 degC the lightly loaded unloaded-zone contacts approach mixed lubrication and the slip rises
+    again. An earlier claim, that 60 degC reads lower than 20 degC (9.55 -> 8.86 % with 4 seeds, 2.4 standard
+    errors), did not survive a round-off change of the traction law: with 12 seeds the two differ by 0.14 pp,
+    0.7 standard errors."""
+    vary = parse_vary(["oil_temperature_c=20,40,60"])
     runs = run_sweep(vary, 4, 1800.0, 500.0, duration_s=0.2, workers=2, progress=False)
     assert (runs.status == "ok").all(), runs
     summ = summarise(runs, list(vary)).reset_index(drop=True)
     mean, sd, n = summ.peak_slip_mean_pct, summ.peak_slip_std_pct, summ.runs
-    standard_error = math.hypot(sd.iloc[0] / math.sqrt(n.iloc[0]), sd.iloc[-1] / math.sqrt(n.iloc[-1]))
-    assert mean.iloc[0] - mean.iloc[-1] > 2.0 * standard_error, summ
+
+    def standard_error(i: int, j: int) -> float:
+        return math.hypot(sd.iloc[i] / math.sqrt(n.iloc[i]), sd.iloc[j] / math.sqrt(n.iloc[j]))
+
+    assert mean.iloc[0] - mean.iloc[1] > 4.0 * standard_error(0, 1), summ
+    assert mean.iloc[2] - mean.iloc[1] > 4.0 * standard_error(2, 1), summ
 
 
 @pytest.mark.parametrize("race", ["inner", "outer"])
