@@ -42,7 +42,7 @@ from tqdm.auto import tqdm
 from cageless import __version__
 from cageless.atomic import atomic_write_text
 from cageless.bearing import Bearing, default_bearing
-from cageless.conditions import LabEntry, OperatingConditions, bearing_with_keys, discover_lab
+from cageless.conditions import LabEntry, OperatingConditions, bearing_with_keys, discover_lab, nested_videos_hint
 from cageless.errors import CagelessError
 from cageless.kinematics import startup_duration, theoretical_cage_speed
 from cageless.outputs import clean_stale_parts, output_lock
@@ -385,7 +385,7 @@ def _run_lab(folder: str | Path, out: Path, options: LabOptions | None, bearing:
     entries = [plausible_entry(e, options.force) for e in discover_lab(folder)]
     if not entries:  # before anything is made in the output folder
         raise CagelessError(f"{folder}: no videos found. A lab folder holds videos (cine, avi/mp4/mkv or image "
-                            "folders) with their conditions.")
+                            "folders) with their conditions." + nested_videos_hint(folder))
     (out / "traces").mkdir(parents=True, exist_ok=True)
     (out / "simulations").mkdir(parents=True, exist_ok=True)
     cache, timings, skipped = _Cache(out), {}, 0
