@@ -489,8 +489,9 @@ def _track_all(pool: Any, entries: list[LabEntry], bearings: dict[Path, Bearing]
         if first_of.setdefault(digest, e.video) != e.video:
             log.warning("%s holds the same bytes as %s (%s %s): each is a row of the report; remove the copy if it "
                         "was made by mistake", e.video.name, first_of[digest].name, VIDEO_HASH, digest[:12])
-        # Keyed on the video's XXH3-128: entries an earlier version keyed on its BLAKE3 do not match (a miss).
-        key = cache.key("track", {"input": digest,
+        # Keyed on the video's XXH3-128: entries an earlier version keyed on its BLAKE3 do not match (a miss). And
+        # on its name, so that a copy (same bytes, same conditions) keeps its own trace instead of the original's.
+        key = cache.key("track", {"input": digest, "video": e.video.name,
                                   "conditions": e.resolved.conditions.to_dict(),
                                   "bearing": bearings[e.video].to_dict(), "n_balls": n_balls, **cut})
         hit = cache.hit(key)
