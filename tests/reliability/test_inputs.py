@@ -461,3 +461,11 @@ def test_held_videos_in_a_sub_folder_beside_others_are_not_skipped_silently(tmp_
         entries = discover_lab(lab)
     assert [e.video.name for e in entries] == ["n3000_Fr500_Fa0.avi"]
     assert "'old runs' (2 videos)" in caplog.text and "notes" not in caplog.text
+
+
+def test_held_a_frame_rate_stated_too_low_is_named(tmp_path, capsys, mini_lab):
+    """newuser2's trial: an AVI's container holds at most 1000 frames/s, so a 16,000 frames/s recording tracked
+    without its rate looks static and is refused with "0 balls found"; the message named the lighting, the speed
+    and the scale but not the frame rate. Here the sample's 10,000 frames/s clip at --fps 1000."""
+    run = cli(capsys, "track", mini_lab / "clip_3000rpm.mkv", "--fps", "1000", "-o", tmp_path / "o", "-q")
+    assert_clean(run, 1, "0 balls found", "the frame rate (fps", "--fps")
