@@ -488,8 +488,9 @@ def _check_count(path: object, z: int, found: int, n_good: int, n_spans: int, ta
                              f"Check the stated speed (speed_rpm: balls far from the expected cage speed are "
                              f"rejected), px_per_mm (when stated, the balls are looked for near its pitch circle) "
                              f"and the bearing's ball count; if the video really shows {found} balls, "
-                             f"state it with --n-balls {found} (same ball and pitch diameters), or describe its bearing "
-                             f"(n_balls, ball_diameter_mm, pitch_diameter_mm in its sidecar or conditions.csv). "
+                             f"state it with --n-balls {found} (same ball and pitch diameters), or describe its "
+                             f"bearing (n_balls, ball_diameter_mm, pitch_diameter_mm in its sidecar or "
+                             f"conditions.csv). "
                              f"The QC image shows what was found.", table=table,
                              found=found, ring=ring)
     if n_good < 0.5 * n_spans:
