@@ -55,6 +55,8 @@ __all__ = [
     "ResolvedConditions",
     "LabEntry",
     "is_qc_folder",
+    "nested_video_folders",
+    "nested_videos_hint",
     "refuse_shared_names",
     "read_sidecar",
     "read_conditions_csv",
@@ -370,6 +372,32 @@ def find_videos(folder: str | Path) -> list[Path]:
     return found
 
 
+def nested_video_folders(folder: str | Path) -> list[tuple[Path, int]]:
+    """Sub-folders of a lab folder that hold video files of their own, with how many (they are not read: a lab
+    folder is its own files and its image-sequence sub-folders). Hidden and image-sequence folders are left out."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        return []
+    out = []
+    for p in sorted(folder.iterdir()):
+        if p.name.startswith(".") or not p.is_dir() or _is_image_sequence(p):
+            continue
+        n = sum(1 for f in p.iterdir() if f.is_file() and f.suffix.lower() in VIDEO_SUFFIXES)
+        if n:
+            out.append((p, n))
+    return out
+
+
+def nested_videos_hint(folder: str | Path) -> str:
+    """A sentence naming the sub-folders of ``folder`` that hold videos, or ``""`` when none do."""
+    nested = nested_video_folders(folder)
+    if not nested:
+        return ""
+    names = ", ".join(f"'{p.name}' ({n} video{'s' if n > 1 else ''})" for p, n in nested)
+    return (f" Videos in sub-folders are not read: {names}; point at such a folder itself (e.g. "
+            f"'{nested[0][0]}') to include them.")
+
+
 def _dangling_links(folder: Path) -> list[Path]:
     """Symbolic links in ``folder`` whose target is missing (they would otherwise be skipped silently)."""
     return [p for p in sorted(folder.iterdir()) if not p.name.startswith(".") and p.is_symlink() and not p.exists()]
@@ -410,6 +438,9 @@ def discover_lab(folder: str | Path, fallback: Mapping[str, float] | None = None
     """
     folder = Path(folder)
     videos = find_videos(folder)
+    hint = nested_videos_hint(folder)
+    if videos and hint:
+        log.warning("%s:%s", folder, hint)
     csv_path = folder / CONDITIONS_CSV
     csv_error: ConditionsError | None = None
     table: dict[str, dict[str, float]] = {}

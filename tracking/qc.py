@@ -156,7 +156,9 @@ def slip_warnings(angle: np.ndarray, speed: np.ndarray, slip: np.ndarray, valid:
         if not -QC_LIMITS["max_speed_shortfall"] <= ratio - 1.0 <= QC_LIMITS["max_speed_mismatch"]:
             out.append(f"the stated speed {speed_rpm:g} r/min disagrees with the video: balls in the loaded zone "
                        f"orbit {100 * (ratio - 1):+.1f} % off its pure-rolling cage speed (the video looks like "
-                       f"about {speed_rpm * ratio:.0f} r/min); check speed_rpm")
+                       f"about {speed_rpm * ratio:.0f} r/min); check speed_rpm, and for a bearing other than the "
+                       "configured one its ball_diameter_mm and pitch_diameter_mm (the cage speed follows from "
+                       "them; --n-balls alone keeps the configured bearing's)")
     good = valid & np.isfinite(slip)
     if good.any():
         mean_slip = float(np.mean(slip[good]))

@@ -447,10 +447,12 @@ def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, backgro
     if circle is None:
         table = _table(feats, reasons, burst_arr, ctx, direction)
         raise SelectionError(path, f"no {z} highlights moving together along one circle near the cage speed were "
-                             "found (0 balls found).", "Check the lighting, the speed_rpm, px_per_mm (when stated, "
-                             f"only circles within {PRIOR_RADIUS_TOL} ball diameters of its pitch circle are tried) "
-                             "and the bearing description; the QC image shows every candidate and why it was "
-                             "rejected.",
+                             "found (0 balls found).", "Check the lighting, the speed_rpm, the frame rate (fps: an "
+                             "AVI, MP4 or image sequence holds no camera time stamps, so give the recording rate in "
+                             "its sidecar, conditions.csv or --fps; at a rate stated too low the balls look static), "
+                             f"px_per_mm (when stated, only circles within {PRIOR_RADIUS_TOL} ball diameters of its "
+                             "pitch circle are tried) and the bearing description; the QC image shows every "
+                             "candidate and why it was rejected.",
                              table=table, found=0)
     feats = [_features(t, times, (circle[0], circle[1])) for t in tracks]
     anchors, counts = _choose_bursts(tracks, feats, reasons, burst_arr, spans, times, circle, tol, ctx)
@@ -486,7 +488,10 @@ def _check_count(path: object, z: int, found: int, n_good: int, n_spans: int, ta
                              f"Check the stated speed (speed_rpm: balls far from the expected cage speed are "
                              f"rejected), px_per_mm (when stated, the balls are looked for near its pitch circle) "
                              f"and the bearing's ball count; if the video really shows {found} balls, "
-                             f"state it with --n-balls {found}. The QC image shows what was found.", table=table,
+                             f"state it with --n-balls {found} (same ball and pitch diameters), or describe its "
+                             f"bearing (n_balls, ball_diameter_mm, pitch_diameter_mm in its sidecar or "
+                             f"conditions.csv). "
+                             f"The QC image shows what was found.", table=table,
                              found=found, ring=ring)
     if n_good < 0.5 * n_spans:
         raise SelectionError(path, f"{z} consistent balls were found in only {n_good} of {n_spans} sampled "

@@ -42,7 +42,7 @@ from tqdm.auto import tqdm
 from cageless import __version__
 from cageless.atomic import atomic_write_text
 from cageless.bearing import Bearing, default_bearing
-from cageless.conditions import LabEntry, OperatingConditions, bearing_with_keys, discover_lab
+from cageless.conditions import LabEntry, OperatingConditions, bearing_with_keys, discover_lab, nested_videos_hint
 from cageless.errors import CagelessError
 from cageless.kinematics import startup_duration, theoretical_cage_speed
 from cageless.outputs import clean_stale_parts, output_lock
@@ -390,7 +390,7 @@ def _run_lab(folder: str | Path, out: Path, options: LabOptions | None, bearing:
     entries = [plausible_entry(e, options.force) for e in discover_lab(folder)]
     if not entries:  # before anything is made in the output folder
         raise CagelessError(f"{folder}: no videos found. A lab folder holds videos (cine, avi/mp4/mkv or image "
-                            "folders) with their conditions.")
+                            "folders) with their conditions." + nested_videos_hint(folder))
     (out / "traces").mkdir(parents=True, exist_ok=True)
     (out / "simulations").mkdir(parents=True, exist_ok=True)
     cache, timings, skipped = _Cache(out), {}, 0
@@ -496,8 +496,9 @@ def _track_all(pool: Any, entries: list[LabEntry], bearings: dict[Path, Bearing]
         if first_of.setdefault(digest, e.video) != e.video:
             log.warning("%s holds the same bytes as %s (%s %s): each is a row of the report; remove the copy if it "
                         "was made by mistake", e.video.name, first_of[digest].name, VIDEO_HASH, digest[:12])
-        # Keyed on the video's XXH3-128: entries an earlier version keyed on its BLAKE3 do not match (a miss).
-        key = cache.key("track", {"input": digest,
+        # Keyed on the video's XXH3-128: entries an earlier version keyed on its BLAKE3 do not match (a miss). And
+        # on its name, so that a copy (same bytes, same conditions) keeps its own trace instead of the original's.
+        key = cache.key("track", {"input": digest, "video": e.video.name,
                                   "conditions": e.resolved.conditions.to_dict(),
                                   "bearing": bearings[e.video].to_dict(), "n_balls": n_balls, **cut})
         hit = cache.hit(key)

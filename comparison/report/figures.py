@@ -42,9 +42,15 @@ def _svg(draw: Callable[[Any], None], size: tuple[float, float] = (5.6, 3.0), po
     return text[text.index("<svg"):]
 
 
+#: Narrowest figure (inches) whose legend takes two columns: in a narrower one (the report's summary cards, 3.4 in)
+#: two columns of labels such as "measured: mean ± 1 std of samples" are wider than the figure and get cut.
+LEGEND_TWO_COLUMNS_IN = 4.5
+
+
 def _legend_below(fig: Any, ax: Any) -> None:
-    """The axes' legend under the plot, in two columns, where it covers no curve."""
-    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=2, fontsize=7, frameon=False)
+    """The axes' legend under the plot, where it covers no curve: two columns, one in a narrow figure."""
+    ncol = 2 if fig.get_figwidth() >= LEGEND_TWO_COLUMNS_IN else 1
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=ncol, fontsize=7, frameon=False)
 
 
 def _profile(ax: Any, prof: Any, scale: float, label: str, colour: str) -> None:

@@ -76,7 +76,7 @@ def _summary(d: ConditionDescription) -> dict[str, Any]:
             "theoretical": _slip_text(r.theoretical_slip_pct, r.theoretical_slip_se_pp),
             "experimental": _slip_text(r.experimental_slip_pct, r.experimental_slip_se_pp),
             "mae": f"{r.mae_pp:.2f} pp", "qc_pass": passed, "qc_reasons": reasons,
-            "svg": figures.slip_figure(d, size=(3.4, 2.7)) if d.comparison is not None else None}
+            "svg": figures.slip_figure(d, size=(3.4, 3.4)) if d.comparison is not None else None}
 
 
 def _slip_text(value_pct: float, se_pp: float) -> str:

@@ -189,3 +189,32 @@ def test_measured_slip_is_referred_to_the_models_contact_angle():
     assert "contact angle 10.70 deg" in c.row.message and c.row.status == "ok"
     plain = compare(measured, orbit_trace("simulation", bump(0.03), omega=c0, t_end=0.45), settle_s=0.05)
     assert plain.row.message == "" and plain.row.mae_pp < 0.01
+
+
+@pytest.mark.parametrize("size", [(5.6, 3.4), (3.4, 2.7), (3.4, 3.4)], ids=["full", "card-before", "card"])
+def test_slip_figure_legend_fits_inside_the_figure(monkeypatch, size):
+    """newuser2's trial: in the report's summary cards (the 3.4 in wide slip figure) the two-column legend was
+    wider than the figure, so its labels were cut on both sides ("asured: mean ± 1 std of samples"). Every
+    legend must lie inside the figure it is drawn in."""
+    import matplotlib.pyplot as plt
+
+    from cageless.comparison.report import describe_condition, figures
+
+    measured = orbit_trace("video", bump(0.06), t_end=0.2)
+    simulated = orbit_trace("simulation", bump(0.04), t_end=0.25)
+    d = describe_condition("x", compare(measured, simulated, settle_s=0.05), measured, simulated)
+    drawn = []
+    close = plt.close
+    monkeypatch.setattr(plt, "close", lambda fig=None: (drawn.append(fig), close(fig)))
+    figures.slip_figure(d, size=size)
+    fig = drawn[-1]
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    FigureCanvasAgg(fig).draw()  # plt.close detached the canvas; lay the figure out again as saved
+    renderer = fig.canvas.get_renderer()
+    box = fig.bbox
+    assert fig.legends
+    for legend in fig.legends:
+        ext = legend.get_window_extent(renderer)
+        assert ext.x0 >= box.x0 - 0.5 and ext.x1 <= box.x1 + 0.5, (ext, box)
+        assert ext.y0 >= box.y0 - 0.5 and ext.y1 <= box.y1 + 0.5, (ext, box)

@@ -434,3 +434,38 @@ def test_compare_given_the_traces_the_other_way_round_swaps_them(capsys, video_t
     row = [ln for ln in right.text.splitlines() if ln.startswith("| ")][-1]
     assert row in swapped.text
     assert float(row.split("|")[5].split("±")[0]) > 0  # the theoretical slip (%), in the row the two share
+
+
+@pytest.mark.parametrize("command", ["report", "track"])
+def test_held_videos_only_in_a_sub_folder_are_named(tmp_path, capsys, command):
+    """A lab folder whose clips sit in a sub-folder (newuser2's trial: 'day1/'): the refusal says where they are
+    and how to include them, instead of only "no videos found"."""
+    (tmp_path / "lab" / "day1").mkdir(parents=True)
+    (tmp_path / "lab" / "day1" / "n3000_Fr500_Fa0.cine").write_bytes(b"\0" * 64)
+    run = cli(capsys, command, tmp_path / "lab", "-o", tmp_path / "o", "-q")
+    assert_clean(run, 1, "no videos found", "'day1' (1 video)", str(tmp_path / "lab" / "day1"))
+
+
+def test_held_videos_in_a_sub_folder_beside_others_are_not_skipped_silently(tmp_path, caplog):
+    """Videos at the top level are read and a sub-folder's are not: a warning names the sub-folder."""
+    from cageless.conditions import discover_lab
+
+    lab = tmp_path / "lab"
+    (lab / "old runs").mkdir(parents=True)
+    (lab / "n3000_Fr500_Fa0.avi").write_bytes(b"\0" * 64)
+    for name in ("a.cine", "b.cine"):
+        (lab / "old runs" / name).write_bytes(b"\0" * 64)
+    (lab / "notes").mkdir()
+    (lab / "notes" / "log.txt").write_text("x")
+    with caplog.at_level("WARNING", logger="cageless.conditions"):
+        entries = discover_lab(lab)
+    assert [e.video.name for e in entries] == ["n3000_Fr500_Fa0.avi"]
+    assert "'old runs' (2 videos)" in caplog.text and "notes" not in caplog.text
+
+
+def test_held_a_frame_rate_stated_too_low_is_named(tmp_path, capsys, mini_lab):
+    """newuser2's trial: an AVI's container holds at most 1000 frames/s, so a 16,000 frames/s recording tracked
+    without its rate looks static and is refused with "0 balls found"; the message named the lighting, the speed
+    and the scale but not the frame rate. Here the sample's 10,000 frames/s clip at --fps 1000."""
+    run = cli(capsys, "track", mini_lab / "clip_3000rpm.mkv", "--fps", "1000", "-o", tmp_path / "o", "-q")
+    assert_clean(run, 1, "0 balls found", "the frame rate (fps", "--fps")

@@ -211,3 +211,22 @@ def test_a_video_copied_under_another_name_is_pointed_out(tmp_path, capsys, mini
     run = cli(capsys, "report", folder, "-o", tmp_path / "out", *QUICK_REPORT)
     assert_clean(run, 0, "WARNING: copy of clip.mkv holds the same bytes as clip_3000rpm.mkv (xxh3_128 ")
     assert len(pd.read_csv(tmp_path / "out" / "slip_table.csv")) == 2
+
+
+def test_a_copy_keeps_its_own_trace_on_a_re_run(tmp_path, capsys, mini_lab, in_process_pool):
+    """newuser2's trial: the tracking cache was keyed on the video's bytes and conditions only, so a copy and its
+    original shared one cache entry, and on a re-run both rows were served by one trace (the report's QC section
+    named the original's file on the copy's row). Each video keeps its own cached trace."""
+    folder = tmp_path / "lab"
+    shutil.copytree(mini_lab, folder)
+    shutil.copy(folder / "clip_3000rpm.mkv", folder / "copy of clip.mkv")
+    with open(folder / "conditions.csv", "a") as fh:
+        fh.write("copy of clip.mkv,3000,500,0,10000\n")
+    out = tmp_path / "out"
+    assert_clean(cli(capsys, "report", folder, "-o", out, *QUICK_REPORT), 0)
+    run = cli(capsys, "report", folder, "-o", out, *QUICK_REPORT)
+    assert_clean(run, 0)
+    assert _skipped(run.out) == 3  # two videos and one simulation, nothing redone
+    paths = sorted(job["path"] for job in json.loads((out / CACHE_NAME).read_text())["jobs"].values()
+                   if job["path"].startswith("traces/"))
+    assert paths == ["traces/clip_3000rpm.trace.h5", "traces/copy of clip.trace.h5"]

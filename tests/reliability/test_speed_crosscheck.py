@@ -76,3 +76,15 @@ def test_a_wrong_sidecar_speed_on_the_1800_rpm_video_is_never_silent(tmp_path, c
     run = cli(capsys, "track", lab, "-o", tmp_path / "o2", "--workers", "1", "-q")
     assert_clean(run, 0)
     assert "disagrees" not in run.text and "negative slip" not in run.text
+
+
+def test_the_speed_warning_names_the_bearing_diameters_too():
+    """The cage speed is 1/2 w_i (1 - D / d_m): a video of another bearing tracked with ``--n-balls`` alone keeps
+    the configured D and d_m, so its loaded zone reads off by their ratio although the speed is right (a 12-ball
+    corpus bearing, D / d_m = 0.249 against the paper's 0.207: -5.3 %, newuser2's trial). The warning must point
+    at the diameters as well as at the speed."""
+    angle, speed, slip, valid = _arrays(0.947)
+    out = [w for w in slip_warnings(angle, speed, slip, valid, OMEGA_C, 3000.0) if "disagrees" in w]
+    assert len(out) == 1
+    assert "check speed_rpm" in out[0]
+    assert "ball_diameter_mm" in out[0] and "pitch_diameter_mm" in out[0] and "--n-balls" in out[0]

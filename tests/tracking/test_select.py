@@ -217,3 +217,16 @@ def test_segments_of_an_mkv_start_at_anchors():
     assert _bounds_at_anchors(np.array([0, 504, 1009]), anchors).tolist() == [0, 591, 1009]
     assert _bounds_at_anchors(np.array([0, 336, 672, 1009]), anchors).tolist() == [0, 394, 591, 1009]
     assert _bounds_at_anchors(np.array([0, 504, 1009]), [0, 985]).tolist() == [0, 1009]  # none near: one pass
+
+
+def test_a_wrong_count_names_both_fixes():
+    """A clip of a 17-ball bearing tracked as the paper's 14-ball one (newuser2's trial): ``--n-balls 17`` alone is
+    refused (17 balls of 9.525 mm do not fit on 46.005 mm), so the refusal must also say how to describe the
+    other bearing, not only suggest ``--n-balls``."""
+    from cageless.tracking.select import SelectionError, _check_count
+
+    with pytest.raises(SelectionError) as info:
+        _check_count("clip.cine", 14, 17, 6, 6, pd.DataFrame(), None)  # type: ignore[arg-type]
+    text = str(info.value)
+    assert "--n-balls 17" in text
+    assert "ball_diameter_mm" in text and "pitch_diameter_mm" in text and "sidecar" in text

@@ -63,7 +63,7 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Run the workflow and print where the report is."""
-    from cageless.conditions import find_videos
+    from cageless.conditions import find_videos, nested_videos_hint
     from cageless.config import bearing_from_config
     from cageless.errors import CagelessError
     from cageless.app.lab import LabOptions, run_lab
@@ -92,7 +92,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
                          parameter_set=args.parameter_set or DEFAULT_SET)
     if not find_videos(args.lab):  # find_videos names a missing folder; say so before any output
         raise CagelessError(f"{args.lab}: no videos found. A lab folder holds videos (cine, avi/mp4/mkv or image "
-                            "folders) with their conditions.")
+                            "folders) with their conditions." + nested_videos_hint(args.lab))
     print(f"parameters: {note}" if note else f"parameters: set '{options.parameter_set}'")
     res = run_lab(args.lab, args.out, options, bearing_from_config(config), progress=not args.quiet,
                   bars=args.progress)

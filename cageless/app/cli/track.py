@@ -23,6 +23,7 @@ from cageless.conditions import (
     bearing_with_keys,
     discover_lab,
     is_qc_folder,
+    nested_videos_hint,
     refuse_shared_names,
     resolve_conditions,
 )
@@ -112,7 +113,8 @@ def collect_inputs(inputs: list[str], speed_rpm: float | None,
             if not found:
                 traces = " It holds cageless traces: point at the folder of videos instead." if any(
                     p.glob("*.trace.h5")) else ""
-                entries.append(LabEntry(video=p, error=CagelessError(f"{p}: no videos found in this folder.{traces}")))
+                entries.append(LabEntry(video=p, error=CagelessError(
+                    f"{p}: no videos found in this folder.{traces}{nested_videos_hint(p)}")))
             entries.extend(_with_typed(e, typed, named=False) for e in found)
         else:
             try:
