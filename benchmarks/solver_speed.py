@@ -80,6 +80,8 @@ CANDIDATES = {
     "ark4-3e-7": ("ark4 (IMEX), rtol 3e-7 (error test at 0.2 x rtol, cap 50 us)", "ark4", 3e-7, None),
     "ark4-7": ("ark4 (IMEX), rtol 1e-7 (error test at 0.2 x rtol, cap 50 us)", "ark4", 1e-7, None),
     "ark4-8": ("ark4 (IMEX), rtol 1e-8 (error test at 0.2 x rtol, cap 50 us)", "ark4", 1e-8, None),
+    "ark4-onset10": ("ark4 (IMEX), rtol 1e-6, a tenth of the contact-onset step", "ark4-onset10", 1e-6, None),
+    "ark4-7-onset10": ("ark4 (IMEX), rtol 1e-7, a tenth of the contact-onset step", "ark4-onset10", 1e-7, None),
 }
 DEFAULT_CANDIDATES = "auto,dp5,rosw6,rosw7,rosw3e-7,rosw8"
 
@@ -160,6 +162,8 @@ def _run(pr: Any, t: np.ndarray, method: str, rtol: float, cap: float | None) ->
     if method == "auto-planar-ark":
         with _ark_planar_only():
             return solve(pr, t, method="auto", rtol=rtol)
+    if method == "ark4-onset10":  # the onset control's step (Problem.onset_step) a tenth of the problem's
+        return _run(replace(pr, onset_step=0.1 * pr.onset_step), t, "ark4", rtol, cap)
     if method == "auto" and cap is None:
         return solve(pr, t, method="auto", rtol=rtol)
     if cap is None:
