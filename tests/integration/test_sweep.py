@@ -5,6 +5,7 @@ from __future__ import annotations
 import pandas as pd
 import pytest
 
+from cageless import __version__
 from cageless.app.cli import main
 from cageless.errors import ParameterError
 from cageless.simulation.sweep import parse_vary, run_sweep, sweep_grid
@@ -31,6 +32,7 @@ def test_sweep_cli_writes_tables_and_plot(tmp_path, capsys):
     summary = pd.read_csv(out / "summary.csv")
     assert len(runs) == 4 and set(runs.status) == {"ok"}
     assert list(summary.runs) == [2, 2] and (out / "peak_slip.png").stat().st_size > 1000
+    assert set(runs.software_version) == set(summary.software_version) == {__version__}
     assert "peak_slip_mean_pct" in capsys.readouterr().out
 
 
