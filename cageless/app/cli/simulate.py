@@ -264,5 +264,6 @@ def _summary_line(trace: Any, sol: Any, out: str) -> str:
             f"({sol.n_onset_retries} at contact onsets, {sol.n_force_jump_retries} at force jumps; "
             f"{sol.n_contact_changes} contact changes; {sol.n_stiff_steps} at the stability edge){uncounted}, "
             f"{sol.n_rhs} RHS calls, "
-            f"{trace.simulation.wall_s:.2f} s wall for {trace.time[-1]:g} s simulated; contact episodes "
+            f"{trace.simulation.wall_s:.2f} s wall in the solver ({trace.simulation.total_wall_s:.2f} s in all) for "
+            f"{trace.time[-1]:g} s simulated; contact episodes "
             f"{len(ev)} ({int((ev.kind == 'impact').sum())} impacts); {slip} -> {out}")
