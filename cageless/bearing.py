@@ -20,7 +20,7 @@ from typing import Any
 from cageless.errors import GeometryError, ParameterError, suggest
 
 __all__ = ["Geometry", "Material", "Masses", "Lubricant", "Bearing", "default_bearing", "clearance_note",
-           "CLEARANCE_NAME", "PITCH_NAME"]
+           "CLEARANCE_NAME", "PITCH_NAME", "derived_name"]
 
 #: Clearances smaller than this (m) are round-off of the race diameters and are taken as 0.
 _CLEARANCE_ROUND_OFF_M = 1e-12
@@ -308,6 +308,9 @@ class Bearing:
         ``d_m -/+ (D + P_d / 2)``. A new ball diameter without ``masses.ball_mass_kg`` scales the ball's mass
         as ``D^3`` (the same steel). Race diameters given are taken as they are.
 
+        A copy that differs from this bearing is named after it and the overrides (:func:`derived_name`, e.g.
+        ``"wang2026 (geometry.n_balls = 13)"``), and that name is what the outputs record.
+
         Raises
         ------
         ParameterError
@@ -330,11 +333,22 @@ class Bearing:
         _follow_the_ball(data, self, set(overrides), derived.get(PITCH_NAME))
         bearing = Bearing.from_dict(data)
         clearance = derived.get(CLEARANCE_NAME)
-        if clearance is None:
-            return bearing
-        if isinstance(clearance, bool) or not isinstance(clearance, int | float):
-            raise ParameterError(CLEARANCE_NAME, "must be a number in metres, e.g. 32e-6", clearance)
-        return dataclasses.replace(bearing, geometry=bearing.geometry.with_diametral_clearance(float(clearance)))
+        if clearance is not None:
+            if isinstance(clearance, bool) or not isinstance(clearance, int | float):
+                raise ParameterError(CLEARANCE_NAME, "must be a number in metres, e.g. 32e-6", clearance)
+            bearing = dataclasses.replace(bearing, geometry=bearing.geometry.with_diametral_clearance(float(clearance)))
+        if dataclasses.replace(bearing, name=self.name) == self:
+            return bearing  # nothing changed: the parameter set is still the named one
+        return dataclasses.replace(bearing, name=derived_name(self.name, overrides))
+
+
+def derived_name(name: str, changes: Mapping[str, Any]) -> str:
+    """The name of bearing ``name`` with ``changes`` (dotted name -> value) applied, e.g.
+    ``"wang2026 (geometry.n_balls = 13)"``: the changes are part of the name, so an output never claims the
+    named parameter set for a bearing that is not it."""
+    shown = ", ".join(f"{k} = {v:g}" if isinstance(v, int | float) and not isinstance(v, bool) else f"{k} = {v}"
+                      for k, v in sorted(changes.items()))
+    return f"{name} ({shown})" if shown else name
 
 
 def _follow_the_ball(data: dict[str, Any], base: Bearing, given: set[str], pitch_m: Any) -> None:

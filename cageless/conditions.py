@@ -44,6 +44,7 @@ from cageless.condition_sources import (
     read_sidecar,
 )
 from cageless.errors import CagelessError, ConditionsError, MissingConditionsError, ParameterError, suggest
+from cageless.limits import LIMITS, hard_problem
 from cageless.units import rpm_to_rad_s
 
 __all__ = [
@@ -72,7 +73,6 @@ log = logging.getLogger(__name__)
 VIDEO_SUFFIXES = (".cine", ".avi", ".mp4", ".mkv")
 IMAGE_SUFFIXES = (".tif", ".tiff", ".png")
 CONDITIONS_CSV = "conditions.csv"
-_POSITIVE_KEYS = ("speed_rpm", "fps", "px_per_mm")
 _NON_NEGATIVE_KEYS = ("radial_load_n", "axial_load_n")
 
 
@@ -83,17 +83,24 @@ class OperatingConditions:
     Parameters
     ----------
     speed_rpm
-        Inner-ring speed (rpm), finite and > 0.
+        Inner-ring speed (rpm), > 0 and at most :data:`~cageless.limits.MAX_SPEED_RPM` (600 000).
     radial_load_n
-        Radial load on the inner ring (N), >= 0; it acts toward -z.
+        Radial load on the inner ring (N), >= 0 and at most :data:`~cageless.limits.MAX_LOAD_N` (1 MN); it acts
+        toward -z.
     axial_load_n
-        Axial load (N), >= 0.
+        Axial load (N), >= 0 and at most :data:`~cageless.limits.MAX_LOAD_N`.
     fps
         Frame rate override (frames/s), or ``None`` to take it from the video.
     px_per_mm
         Image scale override (pixels/mm), or ``None`` to measure it from the ring.
     camera_roll_deg
-        Camera roll (deg), counter-clockwise from the bearing frame; ``None`` means 0.
+        Camera roll (deg), counter-clockwise from the bearing frame, within +-360; ``None`` means 0.
+
+    Raises
+    ------
+    ParameterError
+        For a value that breaks the hard rule the command line applies to it (:data:`cageless.limits.LIMITS`),
+        naming the parameter and the rule.
     """
 
     speed_rpm: float
@@ -112,12 +119,12 @@ class OperatingConditions:
                 raise ParameterError(key, "must be a number", value)
             if not math.isfinite(value):
                 raise ParameterError(key, "must be finite", value)
-            if key in _POSITIVE_KEYS and value <= 0:
-                raise ParameterError(key, "must be > 0", value)
-            if key in _NON_NEGATIVE_KEYS and value < 0:
-                raise ParameterError(
-                    key, "must be >= 0 (the load direction is fixed by the bearing frame)", value
-                )
+            problem = hard_problem(key, value)  # the command line's hard rules (cageless.limits)
+            if problem:
+                lim = LIMITS[key]
+                why = " (the load direction is fixed by the bearing frame)" if key in _NON_NEGATIVE_KEYS else ""
+                hint = (f"Plausible values are {lim.plausible()}." if value > lim.hard_hi else "")
+                raise ParameterError(key, f"{problem} {lim.unit}{why if value < 0 else ''}", value, hint=hint)
 
     @property
     def speed_rad_s(self) -> float:

@@ -31,7 +31,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from cageless.bearing import Bearing, default_bearing
+from cageless.bearing import Bearing, default_bearing, derived_name
 from cageless.errors import UsageError
 
 __all__ = ["load_config", "bearing_from_config"]
@@ -85,6 +85,7 @@ def bearing_from_config(config: Mapping[str, Any]) -> Bearing:
         for key, value in (values.items() if isinstance(values, Mapping) else [(None, values)])
     }
     bearing = bearing.with_overrides(overrides)
-    if overrides or name:
-        bearing = dataclasses.replace(bearing, name=name or f"{bearing.name}+overrides")
+    changes = {**overrides, **({"lubricant": "none"} if lubricant is False else {})}
+    if name or dataclasses.replace(bearing, name=default_bearing().name) != default_bearing():
+        bearing = dataclasses.replace(bearing, name=name or derived_name(default_bearing().name, changes))
     return bearing

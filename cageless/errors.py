@@ -23,6 +23,8 @@ __all__ = [
     "SolverError",
     "UsageError",
     "suggest",
+    "is_trace_name",
+    "trace_not_video",
 ]
 
 
@@ -146,3 +148,16 @@ class SolverError(CagelessError):
 
 class UsageError(CagelessError):
     """The command line or a configuration file was used wrongly (exit code 2)."""
+
+
+def is_trace_name(path: str | Path) -> bool:
+    """True for a path named like a cageless trace (``*.trace.h5``, any case)."""
+    return Path(path).name.lower().endswith(".trace.h5")
+
+
+def trace_not_video(path: str | Path) -> VideoError:
+    """The error for a trace given where a video belongs, saying what to do with a trace instead."""
+    return VideoError(path, "is a trace, not a video.",
+                      hint="Compare it with a simulated trace (`cageless compare VIDEO_TRACE SIM_TRACE`), or give "
+                      "`cageless report` the lab folder of videos it came from; read it in Python with "
+                      "cageless.trace.read_trace.")

@@ -22,11 +22,15 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from datetime import UTC, datetime
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from cageless.atomic import is_abandoned
 from cageless.errors import CagelessError, UsageError
 
-__all__ = ["check_output_file", "check_output_dir", "output_lock", "clean_stale_parts", "LOCK_NAME",
+if TYPE_CHECKING:
+    import pandas as pd
+
+__all__ = ["versioned_csv", "check_output_file", "check_output_dir", "output_lock", "clean_stale_parts", "LOCK_NAME",
            "FolderInUseError", "PART_RE"]
 
 log = logging.getLogger(__name__)
@@ -261,3 +265,11 @@ def clean_stale_parts(folder: str | Path, min_age_s: float = 2.0, recursive: boo
     if removed:
         log.info("removed %d temporary files left by interrupted runs in %s", len(removed), folder)
     return removed
+
+
+def versioned_csv(frame: pd.DataFrame, float_format: str = "%.6g") -> str:
+    """``frame`` as CSV text with a last column ``software_version`` (the cageless version that wrote it), so a
+    table read back with ``pandas.read_csv`` says where it came from, as a trace's ``software_version`` does."""
+    from cageless._version import __version__
+
+    return frame.assign(software_version=__version__).to_csv(index=False, float_format=float_format)

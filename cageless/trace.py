@@ -111,7 +111,12 @@ class SimulationInfo:
     atol: float
     n_steps: int
     n_rhs: int
+    #: Wall time (s) of the solver alone (its compilation on a first run included).
     wall_s: float
+    #: Wall time (s) of the whole run up to the written trace: setup, building the model, compiling, solving and
+    #: the observables (the file's own write, which follows, is not in it); None when not recorded (traces from
+    #: before it existed).
+    total_wall_s: float | None = None
 
 
 def empty_events() -> pd.DataFrame:
@@ -295,6 +300,8 @@ def _write_root_attrs(f: h5py.File, trace: Trace) -> None:
     for key, value in asdict(extra).items():  # type: ignore[arg-type]
         if key == "input_sha256" and not value:
             continue  # the input was hashed with another algorithm: input_hash names it
+        if value is None:
+            continue  # not recorded (a simulation's total_wall_s): absent from the file too
         a[key] = np.asarray(value, dtype=np.float64) if key == "centre_px" else value
 
 
@@ -393,7 +400,7 @@ def _read_body(path: Path, f: h5py.File) -> Trace:
         })
     elif source == "simulation":
         kwargs["simulation"] = SimulationInfo(**{
-            k: _scalar(_attr(a, k)) for k in SimulationInfo.__dataclass_fields__
+            k: _scalar(_attr(a, k)) for k in SimulationInfo.__dataclass_fields__ if k in a or k != "total_wall_s"
         })
     data = {}
     for name in ("time", *_BALL_DATASETS):

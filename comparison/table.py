@@ -14,6 +14,7 @@ from pathlib import Path
 import pandas as pd
 
 from cageless.atomic import atomic_write_text
+from cageless.outputs import versioned_csv
 from cageless.comparison.compare import SLIP_REFERENCES, ComparisonRow
 from cageless.comparison.metrics import SLIP_RATE_DEFINITION
 
@@ -102,8 +103,8 @@ def slip_reference_note(frame: pd.DataFrame) -> str:
 
 
 def to_csv(frame: pd.DataFrame) -> str:
-    """Machine-readable CSV with the raw column names."""
-    return frame.to_csv(index=False, float_format="%.6g")
+    """Machine-readable CSV with the raw column names, and the ``software_version`` that wrote it last."""
+    return versioned_csv(frame, "%.6g")
 
 
 def to_markdown(frame: pd.DataFrame) -> str:

@@ -86,6 +86,20 @@ STRIP_DAMPING_ON = ("on by the user: the paper's strip formulation of C_ho (Wang
                     "reproducing the paper; not the default physics")
 
 
+def _race_contact(s: Scene) -> tuple[bool, str]:
+    """Race contact is always on; the reason says which races the balls touch, from the clearance and the load."""
+    clearance = s.bearing.geometry.diametral_clearance_m
+    if clearance <= 0:
+        return True, ("zero clearance: the balls touch both races at rest; the loaded contacts' deflection and "
+                      "centrifugal force open small gaps on the unloaded side")
+    c = s.conditions
+    loaded = c.radial_load_n > 0 or c.axial_load_n > 0 or s.moment_load_nm > 0 or s.gravity_m_s2 > 0
+    closes = ("they touch the inner race where the load closes the clearance" if loaded else
+              "no load or gravity closes it, so the inner ring floats among them")
+    return True, (f"diametral clearance {1e6 * clearance:.3g} um: centrifugal force holds the balls on the outer "
+                  f"race; {closes}")
+
+
 def _dry(s: Scene) -> tuple[bool, str]:
     return (False, "the scene is lubricated: traction curve") if s.lubricated else (
         True, "dry scene: bare steel contacts rub with Coulomb-Stribeck friction")
@@ -104,7 +118,7 @@ def _drag(s: Scene) -> tuple[bool, str]:
 
 EFFECTS: tuple[EffectSpec, ...] = (
     EffectSpec("race_contact", "Hertz point contact Q = K delta^1.5 between ball and inner/outer groove",
-               _always("balls always touch the races"), flag="F_RACE", slots=("KI", "KO"), removable=False),
+               _race_contact, flag="F_RACE", slots=("KI", "KO"), removable=False),
     EffectSpec("lubricant_damping", "normal damping C_ho d(delta)/dt at race contacts, never tensile", _lubricated,
                needs_lubricant=True, flag="F_LUB", slots=("CHO",)),
     EffectSpec("strip_damping", "the paper's strip formulation of the race damping: C_ho spread over strips of the "
@@ -229,7 +243,12 @@ def _scene_level(s: Scene) -> tuple[str, str]:
         why.append("gravity along the shaft (vertical shaft)")
     if why:
         return "spatial", "needed for " + ", ".join(why)
-    return "planar", "pure radial load on an aligned bearing: ball centres stay in the mid-plane"
+    radial = s.conditions.radial_load_n
+    if radial > 0:
+        return "planar", f"pure radial load of {radial:g} N on an aligned bearing: ball centres stay in the mid-plane"
+    weight = ", the ring's weight its only load" if s.gravity_m_s2 > 0 else ""
+    return "planar", (f"radial and axial load 0 N on an aligned bearing{weight}: ball centres stay in the "
+                      "mid-plane")
 
 
 def choose_model(scene: Scene, level: str | None = None, effects: Mapping[str, bool] | None = None,

@@ -164,6 +164,7 @@ class Simulation:
         from cageless.simulation.solve import solve
 
         c = self.choices
+        begin = time.perf_counter()
         prov = Provenance.start(config={"scene": self.scene.to_dict(), "model": json.loads(self.model.to_json()),
                                         "solver": c.solver_config(), "parameters": self.parameters.to_dict(),
                                         "peak_estimator": peak_estimator(), "clearance": self._clearance(),
@@ -183,6 +184,8 @@ class Simulation:
                                       "switch_probes": sol.extra.get("switches", []),
                                       "onset_step_s": pr.onset_step, "wall_s": wall}
         trace = to_trace(self.scene, self.model, pr, sol, c.rtol, wall, provenance)
+        trace = dataclasses.replace(trace, simulation=dataclasses.replace(
+            trace.simulation, total_wall_s=time.perf_counter() - begin))
         if out is not None:
             write_trace(out, trace)
         self.problem, self.solution, self.trace = pr, sol, trace

@@ -426,6 +426,25 @@ def solve(problem: Problem, t_eval: npt.ArrayLike, method: str = "dp5", rtol: fl
     ParameterError
         For an unknown method (with a suggestion) or bad tolerances or times, before anything runs.
     """
+    t = _checked_times(problem, t_eval, method, rtol, max_step, force_jump)
+    if chunks is not None:
+        from cageless.simulation.auto_switch import solve_chunks
+
+        cap = float(max_step) if np.isfinite(max_step) else None
+        return solve_chunks(problem, t, rtol, method, cap, max(1, int(chunks)), progress, int(max_steps),
+                            float(force_jump))
+    return METHODS[method](problem, t, rtol, float(max_step), first_step, int(max_steps), float(force_jump))
+
+
+def _checked_times(problem: Problem, t_eval: npt.ArrayLike, method: str, rtol: float, max_step: float,
+                   force_jump: float) -> FloatArray:
+    """:func:`solve`'s arguments checked before anything runs; the sample times as an array.
+
+    Raises
+    ------
+    ParameterError
+        For an unknown method (with a suggestion) or bad tolerances, times or absolute tolerances.
+    """
     if method not in METHODS:
         raise ParameterError("method", "is not a solver" + (suggest(method, METHODS) or f"; use one of {list(METHODS)}"),
                              method)
@@ -440,10 +459,4 @@ def solve(problem: Problem, t_eval: npt.ArrayLike, method: str = "dp5", rtol: fl
         raise ParameterError("t_eval", f"must be increasing times >= t0 = {problem.t0}")
     if problem.atol.shape != problem.y0.shape or np.any(problem.atol <= 0):
         raise ParameterError("atol", "must be positive, one per state")
-    if chunks is not None:
-        from cageless.simulation.auto_switch import solve_chunks
-
-        cap = float(max_step) if np.isfinite(max_step) else None
-        return solve_chunks(problem, t, rtol, method, cap, max(1, int(chunks)), progress, int(max_steps),
-                            float(force_jump))
-    return METHODS[method](problem, t, rtol, float(max_step), first_step, int(max_steps), float(force_jump))
+    return t

@@ -21,6 +21,7 @@ import numpy as np
 import pandas as pd
 
 from cageless.atomic import atomic_write_text
+from cageless.outputs import versioned_csv
 from cageless.bearing import CLEARANCE_NAME, Bearing, default_bearing
 from cageless.errors import ParameterError, suggest
 
@@ -189,8 +190,8 @@ def write_sweep(runs: pd.DataFrame, names: Sequence[str], out: str | Path) -> di
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     summary = summarise(runs, names)
-    atomic_write_text(out / "runs.csv", runs.to_csv(index=False, float_format="%.6g"))
-    atomic_write_text(out / "summary.csv", summary.to_csv(index=False, float_format="%.6g"))
+    atomic_write_text(out / "runs.csv", versioned_csv(runs, "%.6g"))
+    atomic_write_text(out / "summary.csv", versioned_csv(summary, "%.6g"))
     if len(summary):
         plot_sweep(summary, names, out / "peak_slip.png")
     return {"runs": out / "runs.csv", "summary": out / "summary.csv", "plot": out / "peak_slip.png"}

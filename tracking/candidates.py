@@ -241,20 +241,7 @@ def link_tracklets(cands: list[Candidates], gate_px: float, max_misses: int = 2,
     dt = float(np.median(np.diff(times))) if times is not None and len(times) > 1 else 1.0
     for i, c in enumerate(cands):
         if live and len(c):
-            pred = np.array([t.predict(i, times) for t in live])
-            if times is None:
-                gap = np.array([i - t.frames[-1] for t in live], dtype=np.float64)
-            else:
-                gap = np.array([(times[i] - times[t.frames[-1]]) / dt for t in live])
-            d = np.hypot(pred[:, :1] - c.u[None, :], pred[:, 1:] - c.v[None, :])
-            per = np.array([fine if len(t.frames) >= 2 else gate_px for t in live])
-            gate = (per * gap)[:, None]
-            cost = np.where(d <= gate, d, 1e9)
-            from scipy.optimize import linear_sum_assignment  # on first use, see locate.fit_circle
-
-            rows, cols = linear_sum_assignment(cost)
-            ok = cost[rows, cols] < 1e9
-            rows, cols = rows[ok], cols[ok]
+            rows, cols = _assign(live, c, i, times, dt, (gate_px, fine))
         else:
             rows = cols = np.zeros(0, dtype=int)
         claimed = set(cols.tolist())
@@ -276,3 +263,24 @@ def link_tracklets(cands: list[Candidates], gate_px: float, max_misses: int = 2,
             if k not in claimed and c.response[k] >= start_response:
                 live.append(Tracklet([i], [float(c.u[k])], [float(c.v[k])], [float(c.response[k])]))
     return done + live
+
+
+def _assign(live: list[Tracklet], c: Candidates, i: int, times: np.ndarray | None, dt: float,
+            gates: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
+    """The live tracklets (rows) matched to frame ``i``'s candidates ``c`` (columns) by minimum total distance
+    from their predictions, each within its gate (``gates``: before and after it has a velocity, in pixels
+    per frame elapsed; ``dt`` the usual frame interval of ``times``)."""
+    pred = np.array([t.predict(i, times) for t in live])
+    if times is None:
+        gap = np.array([i - t.frames[-1] for t in live], dtype=np.float64)
+    else:
+        gap = np.array([(times[i] - times[t.frames[-1]]) / dt for t in live])
+    d = np.hypot(pred[:, :1] - c.u[None, :], pred[:, 1:] - c.v[None, :])
+    per = np.array([gates[1] if len(t.frames) >= 2 else gates[0] for t in live])
+    gate = (per * gap)[:, None]
+    cost = np.where(d <= gate, d, 1e9)
+    from scipy.optimize import linear_sum_assignment  # on first use, see locate.fit_circle
+
+    rows, cols = linear_sum_assignment(cost)
+    ok = cost[rows, cols] < 1e9
+    return rows[ok], cols[ok]

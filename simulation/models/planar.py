@@ -160,20 +160,7 @@ def _inner_race(y, p, j, z, w_i, c, s, fy, fz, torque, p_diss, obs):  # pragma: 
         q = p[P_KI] * d_i * np.sqrt(d_i)
         if obs is not None:
             obs[OBS_INNER_NORMAL] = q
-        if p[P_F_LUB] > 0.5:
-            ddot = -(vx * nx + vz * nz)
-            if p[P_F_STRIP] > 0.5:
-                r_i, vt = 0.5 * p[P_DI], vx * tx + vz * tz
-                q_d = strip_normal(q, d_i, ddot, 0.5 * (vt * (1.0 - 2.0 * r_i / ln) - half * om + w_i * r_i), True, p)
-            else:
-                q_d = max(q + p[P_CHO] * ddot, 0.0)
-            p_diss += (q_d - q) * ddot
-            q = q_d
-        if RACE_LAWS:
-            ddot = -(vx * nx + vz * nz)
-            f_x = race_extra(d_i, ddot, q, p)
-            p_diss += f_x * ddot
-            q += f_x
+        q, p_diss = _inner_normal(q, d_i, (vx, vz, nx, nz, tx, tz), ln, half, om, w_i, p, p_diss)
         f_t = 0.0
         r_i, vt = 0.5 * p[P_DI], vx * tx + vz * tz
         u_e = 0.5 * (vt * (1.0 - 2.0 * r_i / ln) - half * om + w_i * r_i)  # entraining speed along t
@@ -203,6 +190,29 @@ def _inner_race(y, p, j, z, w_i, c, s, fy, fz, torque, p_diss, obs):  # pragma: 
         ry -= gy
         rz -= gz
     return fy, fz, torque, ry, rz, p_in, p_diss
+
+
+@numba.njit(cache=True, fastmath=FASTMATH, inline="always")
+def _inner_normal(q, d_i, vn, ln, half, om, w_i, p, p_diss):  # pragma: no cover - compiled
+    """:func:`_inner_race`'s normal force from its elastic part ``q``: the lubricant damping (or the paper's
+    strips), never tensile, and the added race laws, with ``p_diss`` (the dissipated power) increased by their
+    work. ``vn`` holds the contact's relative velocity and its normal and tangent (vx, vz, nx, nz, tx, tz)."""
+    vx, vz, nx, nz, tx, tz = vn
+    if p[P_F_LUB] > 0.5:
+        ddot = -(vx * nx + vz * nz)
+        if p[P_F_STRIP] > 0.5:
+            r_i, vt = 0.5 * p[P_DI], vx * tx + vz * tz
+            q_d = strip_normal(q, d_i, ddot, 0.5 * (vt * (1.0 - 2.0 * r_i / ln) - half * om + w_i * r_i), True, p)
+        else:
+            q_d = max(q + p[P_CHO] * ddot, 0.0)
+        p_diss += (q_d - q) * ddot
+        q = q_d
+    if RACE_LAWS:
+        ddot = -(vx * nx + vz * nz)
+        f_x = race_extra(d_i, ddot, q, p)
+        p_diss += f_x * ddot
+        q += f_x
+    return q, p_diss
 
 
 @numba.njit(cache=True, fastmath=FASTMATH)

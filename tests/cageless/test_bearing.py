@@ -136,6 +136,21 @@ def test_effective_modulus():
     assert wang2026.material().effective_modulus_pa == pytest.approx(228.5714e9, rel=1e-6)
 
 
+def test_an_overridden_bearing_is_not_named_as_the_parameter_set():
+    """A bearing with other geometry is not "wang2026" (the paper's Table 1): the outputs would claim a parameter
+    set it is not. Its name carries the changes, and the scene a trace records (scene_json) carries the name."""
+    from cageless.conditions import OperatingConditions
+    from cageless.simulation.scene import Scene
+
+    b = default_bearing()
+    b13 = b.with_overrides({"geometry.n_balls": 13, "geometry.diametral_clearance_m": 32e-6})
+    assert b13.name == "wang2026 (geometry.diametral_clearance_m = 3.2e-05, geometry.n_balls = 13)"
+    assert b.with_overrides({"geometry.n_balls": 14}).name == "wang2026"  # the same bearing
+    assert b.with_overrides({}) == b
+    scene = Scene(conditions=OperatingConditions(3000.0, 500.0), bearing=b13)
+    assert scene.to_dict()["bearing"]["name"] == b13.name
+
+
 def test_dict_round_trip_and_overrides():
     b = default_bearing()
     assert Bearing.from_dict(b.to_dict()) == b
@@ -153,7 +168,10 @@ def test_bearing_from_config():
     b = bearing_from_config({"bearing": {"geometry": {"n_balls": 12}, "lubricant": False}})
     assert b.geometry.n_balls == 12
     assert b.lubricant is None
-    assert b.name == "wang2026+overrides"
+    assert b.name == "wang2026 (geometry.n_balls = 12, lubricant = none)"
+    assert bearing_from_config({"bearing": {"name": "rig B", "geometry": {"n_balls": 12}}}).name == "rig B"
+    # an override that changes nothing keeps the named set
+    assert bearing_from_config({"bearing": {"geometry": {"n_balls": 14}}}).name == "wang2026"
     assert bearing_from_config({}) == default_bearing()
 
 

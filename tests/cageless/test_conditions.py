@@ -276,3 +276,32 @@ def test_a_european_csv_reads_thousands_beside_a_bad_row(tmp_path):
     errors: dict[str, ConditionsError] = {}
     assert read_conditions_csv(path, row_errors=errors) == {"a.cine": {"speed_rpm": 6000.0, "radial_load_n": 500.5}}
     assert list(errors) == ["b.mkv"] and "'speed_rpm' = 'drei' is not a number" in str(errors["b.mkv"])
+
+
+@pytest.mark.parametrize(("kwargs", "parameter", "rule"), [
+    ({"speed_rpm": 1e9}, "speed_rpm", "must be > 0 and <= 600000 r/min"),
+    ({"speed_rpm": -3000.0}, "speed_rpm", "must be > 0 and <= 600000 r/min"),
+    ({"speed_rpm": float("nan")}, "speed_rpm", "must be finite"),
+    ({"speed_rpm": 3000.0, "radial_load_n": 5e6}, "radial_load_n", "must be >= 0 and <= 1000000 N"),
+    ({"speed_rpm": 3000.0, "axial_load_n": -1.0}, "axial_load_n",
+     "must be >= 0 and <= 1000000 N (the load direction is fixed by the bearing frame)"),
+    ({"speed_rpm": 3000.0, "camera_roll_deg": 400.0}, "camera_roll_deg", "must be >= -360 and <= 360 deg"),
+])
+def test_conditions_refuse_what_the_command_line_refuses(kwargs, parameter, rule):
+    """From Python as on the command line (the same hard rules, cageless.limits.LIMITS): 1e9 r/min was accepted
+    by the constructor. The bounds: 600 000 r/min and 1 MN, ten times the plausible ranges (cageless/limits.py)."""
+    with pytest.raises(ParameterError) as err:
+        OperatingConditions(**kwargs)
+    assert err.value.parameter == parameter and err.value.rule == rule
+
+
+def test_conditions_beyond_the_plausible_range_but_within_the_hard_rule_are_kept():
+    """What ``--force`` lets through on the command line, the constructor takes too."""
+    c = OperatingConditions(100_000.0, 200_000.0, 0.0)
+    assert (c.speed_rpm, c.radial_load_n) == (100_000.0, 200_000.0)
+    from cageless.errors import UsageError
+    from cageless.validate import check_value
+
+    rule = r"--speed-rpm 1e\+09: must be > 0 and <= 600000 \(the plausible range is 1 to 60000 r/min\)\."
+    with pytest.raises(UsageError, match=rule):
+        check_value("speed_rpm", 1e9, force=True)

@@ -113,6 +113,21 @@ def test_simulation_trace_with_groups_and_events(tmp_path):
         assert f["contacts/ball_ball_normal"].shape == (t, z)
         assert f["events"].shape == (2,)
         assert json.loads(f.attrs["scene_json"]) == {"speed_rpm": 3000}
+        # the layout docs/traces.md gives: kind is fixed-length ASCII, bytes to h5py; read_trace decodes it
+        assert f["events"].dtype["kind"] == np.dtype("S8") and f["events"]["kind"][0] == b"impact"
+    assert list(back.events.kind) == ["impact", "rubbing"] and isinstance(back.events.kind[0], str)
+    assert back.simulation.total_wall_s is None  # not recorded, as in traces from before it existed
+
+
+def test_total_wall_time_round_trips_and_older_traces_read(tmp_path):
+    import dataclasses
+
+    tr = make_trace(source="simulation", simulation=dataclasses.replace(SIM, total_wall_s=2.25))
+    path = write_trace(tmp_path / "t.trace.h5", tr)
+    assert read_trace(path).simulation.total_wall_s == 2.25 and read_trace(path).simulation.wall_s == 1.5
+    with h5py.File(path, "r+") as f:  # a trace written before total_wall_s existed
+        del f.attrs["total_wall_s"]
+    assert read_trace(path).simulation.total_wall_s is None
 
 
 def test_empty_event_table_round_trips(tmp_path):

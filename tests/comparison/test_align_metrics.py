@@ -6,6 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from cageless import __version__
 from cageless.errors import CagelessError, ParameterError
 from cageless.trace import SimulationInfo, Trace, VideoInfo
 from cageless.comparison.align import MismatchError, align_time, check_compatible, profiles
@@ -133,6 +134,10 @@ def test_compare_row_and_table_formats(tmp_path):
     assert unlabelled.startswith("| Speed (r/min) |")  # a single comparison without a label has no video column
     paths = write_tables([c.row, failed], tmp_path / "slip_table")
     assert sorted(paths) == ["csv", "html", "md", "tex"] and all(p.exists() for p in paths.values())
+    # provenance, as the traces have it: the version that wrote the table, a column pandas reads back
+    back = pd.read_csv(paths["csv"])
+    assert list(back.software_version) == [__version__] * 2 and back.columns[-1] == "software_version"
+    assert list(back.speed_rpm) == [1800, 3000]
 
 
 def test_figures_restore_rcparams_and_close(tmp_path):

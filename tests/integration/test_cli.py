@@ -212,6 +212,19 @@ def test_info_on_a_trace_says_what_to_do_with_it(tmp_path, capsys):
     assert "is a trace, not a video" in err and "cageless compare" in err and "read_trace" in err
 
 
+@pytest.mark.parametrize("typed", [[], ["--speed-rpm", "3000"]])
+def test_tracking_a_trace_says_it_is_a_trace(tmp_path, capsys, typed):
+    """`cageless track run.trace.h5`: told it is a trace and what takes one, not that its name holds no
+    conditions, and nothing is tracked (the tracker is not even compiled)."""
+    trace = tmp_path / "sim_3000rpm_Fr500.trace.h5"
+    trace.write_bytes(b"\x89HDF\r\n\x1a\n")
+    assert main(["track", str(trace), "-o", str(tmp_path / "out"), *typed]) == 1
+    err = capsys.readouterr().err
+    assert "is a trace, not a video" in err and "cageless compare" in err and "cageless report" in err
+    assert "conditions" not in err and "token" not in err and "compiling" not in err
+    assert not list((tmp_path / "out").glob("*.trace.h5"))
+
+
 def test_tracking_an_output_folder_says_so(tmp_path, capsys):
     """`cageless track out` (an output folder by mistake): its QC PNGs are not read as an image sequence."""
     out = tmp_path / "out"

@@ -5,6 +5,7 @@ from __future__ import annotations
 import pandas as pd
 import pytest
 
+from cageless import __version__
 from cageless.app.cli import main
 from cageless.errors import ParameterError
 from cageless.simulation.sweep import parse_vary, run_sweep, sweep_grid
@@ -31,6 +32,7 @@ def test_sweep_cli_writes_tables_and_plot(tmp_path, capsys):
     summary = pd.read_csv(out / "summary.csv")
     assert len(runs) == 4 and set(runs.status) == {"ok"}
     assert list(summary.runs) == [2, 2] and (out / "peak_slip.png").stat().st_size > 1000
+    assert set(runs.software_version) == set(summary.software_version) == {__version__}
     assert "peak_slip_mean_pct" in capsys.readouterr().out
 
 
@@ -53,3 +55,26 @@ def test_one_run_per_point_shows_no_spread():
     s = summarise(runs, ["x"])
     assert s.peak_slip_std_pct.isna().tolist() == [True, False] and s.peak_slip_std_pct.iloc[1] == 1.0
     assert s.runs.tolist() == [1, 2] and s.peak_slip_mean_pct.tolist() == [5.0, 10.0]
+
+
+def test_sweep_takes_the_bearing_options_of_simulate(tmp_path, monkeypatch):
+    """`--clearance-um` and `--dry` reach a sweep's runs as they reach `cageless simulate`'s (sweep refused them as
+    unknown options), through the same override path: the bearing is named after the change."""
+    import cageless.simulation.sweep as sweep_module
+    from cageless.errors import UsageError
+
+    seen = []
+
+    def stop(vary, seeds, *args, **kwargs):
+        seen.append(args[6])  # run_sweep(vary, seeds, speed, radial, axial, duration, settle, parameters, bearing, ...)
+        raise UsageError("stopped before running")
+
+    monkeypatch.setattr(sweep_module, "run_sweep", stop)
+    argv = ["sweep", "--vary", "cho_n_s_m=2500", "-q", "-o", str(tmp_path / "sw"), "--clearance-um", "32", "--dry",
+            "--vary", "geometry.ball_diameter_m=8e-3"]
+    assert main(argv) == 2
+    (bearing,) = seen
+    assert bearing.lubricant is None
+    assert bearing.geometry.diametral_clearance_m == pytest.approx(32e-6, rel=1e-9)
+    assert bearing.name == "wang2026 (lubricant = none) (geometry.diametral_clearance_m = 3.2e-05)"
+    assert main(["sweep", "--vary", "cho_n_s_m=2500", "-o", str(tmp_path / "x"), "--clearance-um", "-50"]) == 2

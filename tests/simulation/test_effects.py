@@ -43,6 +43,33 @@ def test_scene_rules():
     assert choose_model(scene(orientation="vertical")).level == "spatial"
 
 
+def _reasons(sc):
+    c = choose_model(sc)
+    return c.level_reason, {e.name: e.reason for e in c.effects}["race_contact"]
+
+
+def test_the_reasons_fit_the_scene():
+    """Each reason says what holds for its scene. Before, a scene with no load at all was "pure radial load", and
+    the race contact read "balls always touch the races" even with a 150 um clearance, where centrifugal force
+    holds the balls on the outer race and the inner race carries them only in the loaded zone."""
+    level, race = _reasons(scene())
+    assert level == "pure radial load of 500 N on an aligned bearing: ball centres stay in the mid-plane"
+    assert race.startswith("zero clearance: the balls touch both races at rest")
+    level, _ = _reasons(scene(conditions=OperatingConditions(3000.0)))
+    assert "radial and axial load 0 N" in level and "ring's weight its only load" in level
+    assert "pure radial" not in level
+    level, _ = _reasons(scene(conditions=OperatingConditions(3000.0), gravity_m_s2=0.0))
+    assert level.startswith("radial and axial load 0 N on an aligned bearing:") and "weight" not in level
+    level, _ = _reasons(scene(conditions=OperatingConditions(3000.0, 0.0, 400.0)))
+    assert level == "needed for axial load 400 N"
+    loose = default_bearing().with_overrides({"geometry.diametral_clearance_m": 150e-6})
+    _, race = _reasons(scene(bearing=loose))
+    assert race == ("diametral clearance 150 um: centrifugal force holds the balls on the outer race; they touch "
+                    "the inner race where the load closes the clearance")
+    _, race = _reasons(scene(bearing=loose, conditions=OperatingConditions(3000.0), gravity_m_s2=0.0))
+    assert race.endswith("no load or gravity closes it, so the inner ring floats among them")
+
+
 def test_explain_names_the_degrees_of_freedom_of_the_level():
     """--explain and a trace's effects_json say what each level integrates and leaves out, with the states of
     simulation/models/planar.py (5 Z + 6: r, theta, their rates and the spin per ball; ring y, z) and spatial.py

@@ -64,6 +64,9 @@ def test_run_writes_a_simulation_trace(tmp_path, capsys):
     assert effects["race_traction"]["forced"] and not effects["race_traction"]["on"]
     assert tr.simulation.solver.startswith("auto: dp5") and tr.simulation.n_steps > 0
     assert tr.provenance["config"]["solver"]["rtol"] == 1e-6
+    # wall_s is the solver's time, total_wall_s the whole run's (setup, model, compile, solve, observables)
+    sim = tr.simulation
+    assert 0 < sim.wall_s < sim.total_wall_s and f"({sim.total_wall_s:.2f} s in all)" in text
     # The ring carries the 500 N load plus its weight: it sits about 6 um below the centre.
     assert tr.groups["inner_ring"]["position"][:, 2].mean() == pytest.approx(-6.3e-6, rel=0.2)
 

@@ -55,7 +55,7 @@ ALL_LONG = [(name, s) for name, s in ALL if name in ("TUNING", "HOLDOUT")]
 #: 0.83 -> 0.288 mrad, speed 0.346 -> 0.063 %: a doubled, saturated highlight under 25 % flicker, whose pull
 #: towards its second lobe followed the light level), no clip fails anew, the largest changes 1020 0.137 ->
 #: 0.156 mrad, 1002 0.444 -> 0.450 mrad, 1018 speed 0.244 -> 0.268 %; with the static pattern in front of the
-#: balls subtracted (detect.static_pattern: lint specks standing out of the median background and of the frames'
+#: balls subtracted (static.static_pattern: lint specks standing out of the median background and of the frames'
 #: minimum by 8 times those images' own noise, up to 5 px across, with their tails; not where a pixel reads the
 #: data's maximum) TUNING 30: 1012 passes (angle 0.541 -> 0.279 mrad, speed 0.776 -> 0.374 %, slip 0.313 ->
 #: 0.158 pp), no clip fails anew; angle RMS over the set 3 % lower (geometric mean), better by over 10 % on 1003

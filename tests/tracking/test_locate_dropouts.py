@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cageless.tracking.detect import static_defects
+from cageless.tracking.static import static_defects
 from cageless.tracking.locate import BALL_BAND, BearingLocation
 from cageless.tracking.locate_motion import DROPOUT_GAIN, frame_gains, motion_map
 

@@ -1,10 +1,11 @@
-"""Lint in front of the balls, subtracted from the centroid (tracking/detect.py: static_pattern)."""
+"""Lint in front of the balls, subtracted from the centroid (tracking/static.py: static_pattern)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from cageless.tracking.detect import centroid_windows, static_defects, static_pattern
+from cageless.tracking.detect import centroid_windows
+from cageless.tracking.static import static_defects, static_pattern
 
 
 def _spot(shape: tuple[int, int], u: float, v: float, sigma: float, peak: float) -> np.ndarray:

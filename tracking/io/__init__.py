@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from cageless.errors import VideoError
+from cageless.errors import VideoError, is_trace_name, trace_not_video
 from cageless.tracking.io.base import FrameSource, VideoMetadata
 from cageless.tracking.io.cine import CineReader
 from cageless.tracking.io.cine_write import CINE_FORMATS, write_cine
@@ -57,10 +57,8 @@ def open_video(path: str | Path, fps: float | None = None, allow_truncated: bool
     if not path.exists():
         raise VideoError(path, "no such file or folder.")
     reader = VIDEO_SUFFIXES.get(path.suffix.lower())
-    if reader is None and path.name.endswith(".trace.h5"):
-        raise VideoError(path, "is a trace, not a video.",
-                         hint="Compare it with `cageless compare VIDEO_TRACE SIM_TRACE`, or read it in Python with "
-                         "cageless.trace.read_trace.")
+    if reader is None and is_trace_name(path):
+        raise trace_not_video(path)
     if reader is None:
         raise VideoError(path, f"is not a video cageless reads (suffix '{path.suffix}').",
                          hint="Use .cine, .avi, .mp4, .mkv, or a folder of numbered .tif/.png images.")

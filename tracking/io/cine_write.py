@@ -162,16 +162,10 @@ def write_cine(
     """
     n = len(frames) if n_frames is None else int(n_frames)  # type: ignore[arg-type]
     f, bpp = _check_args(fmt, real_bpp, fps, n)
-    stamps = np.arange(n) / fps if timestamps_s is None else np.asarray(timestamps_s, dtype=np.float64)
-    if stamps.shape != (n,) or not np.all(np.isfinite(stamps)) or np.any(np.diff(stamps) <= 0):
-        raise ParameterError("timestamps_s", f"must be {n} finite, strictly increasing times")
+    stamps = _frame_times(timestamps_s, fps, n)
     it = iter(frames)
-    first = np.asarray(next(it))
-    if first.ndim != 2:
-        raise ParameterError("frames[0]", f"must be 2-D, got shape {first.shape}")
+    first = _first_frame(next(it), f)
     height, width = first.shape
-    if f.bi_compression and (width * height) % (4 if f.bits == 10 else 2):
-        raise ParameterError("frames", f"{width} x {height} pixels cannot be packed in {f.bits}-bit groups")
     img = f.image_size(width, height)
     desc = description or f"written by cageless {__version__}"
     head = _headers(f, (width, height), fps, bpp, stamps, exposure_s, serial, desc)
@@ -179,6 +173,26 @@ def write_cine(
         fh.write(head)
         _write_images(fh, first, it, n, f, bpp, img)
     return Path(path)
+
+
+def _frame_times(timestamps_s: Sequence[float] | npt.ArrayLike | None, fps: float,
+                 n: int) -> npt.NDArray[np.float64]:
+    """The ``n`` frame times (s): ``timestamps_s`` checked, or ``i / fps``."""
+    stamps = np.arange(n) / fps if timestamps_s is None else np.asarray(timestamps_s, dtype=np.float64)
+    if stamps.shape != (n,) or not np.all(np.isfinite(stamps)) or np.any(np.diff(stamps) <= 0):
+        raise ParameterError("timestamps_s", f"must be {n} finite, strictly increasing times")
+    return stamps
+
+
+def _first_frame(frame: npt.ArrayLike, f: CineFormat) -> np.ndarray:
+    """The first frame as an array, checked: 2-D, and a pixel count the packed formats can group."""
+    first = np.asarray(frame)
+    if first.ndim != 2:
+        raise ParameterError("frames[0]", f"must be 2-D, got shape {first.shape}")
+    height, width = first.shape
+    if f.bi_compression and (width * height) % (4 if f.bits == 10 else 2):
+        raise ParameterError("frames", f"{width} x {height} pixels cannot be packed in {f.bits}-bit groups")
+    return first
 
 
 def _headers(f: CineFormat, size: tuple[int, int], fps: float, bpp: int, stamps: npt.NDArray[np.float64],

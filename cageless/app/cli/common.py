@@ -79,6 +79,32 @@ def common_options() -> ArgumentParser:
     return parent
 
 
+def add_bearing_options(parser: argparse.ArgumentParser) -> None:
+    """Add the bearing overrides of a command that simulates a scene (simulate, sweep): ``--clearance-um`` and
+    ``--dry``, applied by :func:`scene_bearing` on top of ``--config``'s ``[bearing.*]`` tables."""
+    parser.add_argument("--clearance-um", type=finite_float,
+                        help="diametral clearance (um), races moved apart symmetrically (default: the bearing's, 0 "
+                        "for the paper's; ISO 5753-1 C4 for this size is 23-41 um)")
+    parser.add_argument("--dry", action="store_true", help="no lubricant")
+
+
+def scene_bearing(args: argparse.Namespace, config: dict[str, Any]) -> Any:
+    """The bearing a simulating command runs: the configured one (``--config``'s ``[bearing.*]``), dry with
+    ``--dry``, with ``--clearance-um``'s clearance (:meth:`cageless.bearing.Bearing.with_overrides`, so its name
+    records the change)."""
+    import dataclasses
+
+    from cageless.bearing import CLEARANCE_NAME, derived_name
+    from cageless.config import bearing_from_config
+
+    bearing = bearing_from_config(config)
+    if args.dry and bearing.lubricant is not None:
+        bearing = dataclasses.replace(bearing, lubricant=None, name=derived_name(bearing.name, {"lubricant": "none"}))
+    if args.clearance_um is not None:
+        bearing = bearing.with_overrides({CLEARANCE_NAME: 1e-6 * args.clearance_um})
+    return bearing
+
+
 def add_parameter_set_option(parser: ArgumentParser) -> None:
     """Add ``--parameter-set`` to a command that simulates (simulate, sweep, report, calibrate)."""
     parser.add_argument("--parameter-set", metavar="NAME",

@@ -15,7 +15,7 @@ import math
 import re
 from typing import Any
 
-from cageless.app.cli.common import add_parameter_set_option, finite_float
+from cageless.app.cli.common import add_bearing_options, add_parameter_set_option, finite_float, scene_bearing
 from cageless.config import bearing_from_config
 
 __all__ = ["register", "run"]
@@ -84,10 +84,7 @@ def _add_scene_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--moment-load-nm", type=finite_float, default=0.0,
                    help="moment load on the inner ring about y (N m, default 0); selects the spatial level")
     p.add_argument("--oil-air-density", type=finite_float, help="oil-air mixture density (kg/m^3; default 42.4, 5 %% oil by volume, in a lubricated scene; 0 turns drag off)")
-    p.add_argument("--clearance-um", type=finite_float,
-                   help="diametral clearance (um), races moved apart symmetrically (default: the bearing's, 0 for "
-                   "the paper's; ISO 5753-1 C4 for this size is 23-41 um)")
-    p.add_argument("--dry", action="store_true", help="no lubricant")
+    add_bearing_options(p)
 
 
 def _add_solver_arguments(p: argparse.ArgumentParser) -> None:
@@ -106,8 +103,6 @@ def _add_solver_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Build the scene, choose the model, and explain it."""
-    import dataclasses
-
     from cageless.conditions import OperatingConditions
     from cageless.simulation.effects import parse_effect_overrides
     from cageless.simulation.scene import Scene
@@ -115,11 +110,7 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     bearing = bearing_from_config(config)
     _default_duration(args, bearing)
     _validate(args, bearing)
-    if args.dry:
-        bearing = dataclasses.replace(bearing, lubricant=None)
-    if args.clearance_um is not None:
-        geometry = bearing.geometry.with_diametral_clearance(1e-6 * args.clearance_um)
-        bearing = dataclasses.replace(bearing, geometry=geometry)
+    bearing = scene_bearing(args, config)
     scene = Scene(conditions=OperatingConditions(args.speed_rpm, args.radial_load_n, args.axial_load_n),
                   bearing=bearing, gravity_m_s2=args.gravity, orientation=args.orientation,
                   misalignment_rad=args.misalignment_rad, moment_load_nm=args.moment_load_nm,
@@ -273,5 +264,6 @@ def _summary_line(trace: Any, sol: Any, out: str) -> str:
             f"({sol.n_onset_retries} at contact onsets, {sol.n_force_jump_retries} at force jumps; "
             f"{sol.n_contact_changes} contact changes; {sol.n_stiff_steps} at the stability edge){uncounted}, "
             f"{sol.n_rhs} RHS calls, "
-            f"{trace.simulation.wall_s:.2f} s wall for {trace.time[-1]:g} s simulated; contact episodes "
+            f"{trace.simulation.wall_s:.2f} s wall in the solver ({trace.simulation.total_wall_s:.2f} s in all) for "
+            f"{trace.time[-1]:g} s simulated; contact episodes "
             f"{len(ev)} ({int((ev.kind == 'impact').sum())} impacts); {slip} -> {out}")

@@ -6,7 +6,7 @@ import argparse
 import sys
 from typing import Any
 
-from cageless.app.cli.common import add_parameter_set_option, finite_float
+from cageless.app.cli.common import add_bearing_options, add_parameter_set_option, finite_float, scene_bearing
 
 __all__ = ["register", "run"]
 
@@ -16,6 +16,7 @@ examples:
   cageless sweep --radial-load-n 500 --vary speed_rpm=1800,3000,6000 --vary cho_n_s_m=2500,7500 -o sweep
   cageless sweep --speed-rpm 1800 --vary film_thickness_m=1e-7:3.5e-7:6 --scheduler tcp://10.0.0.5:8786
   cageless sweep --speed-rpm 1800 --vary film_thickness_m=1e-7,3.5e-7 --effect ehl_film=off     a fixed film
+  cageless sweep --speed-rpm 3000 --clearance-um 32 --vary geometry.ball_diameter_m=8e-3,9.525e-3
 """
 
 
@@ -37,6 +38,7 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
     p.add_argument("--duration", type=finite_float, default=0.1, help="simulated time after the start-up, which is added to it (s, default 0.1)")
     p.add_argument("--settle", type=finite_float,
                    help="start-up left out (s; default three cage revolutions at each point, at least 0.04)")
+    add_bearing_options(p)
     add_parameter_set_option(p)
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", dest="set_values",
                    help="fixed model-parameter changes for every run")
@@ -49,7 +51,6 @@ def register(subparsers: Any, parent: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     """Run the sweep and print the summary."""
-    from cageless.config import bearing_from_config
     from cageless.errors import UsageError
     from cageless.simulation.sweep import parse_vary, run_sweep, summarise, write_sweep
     from cageless.app.calibrate import describe_calibration
@@ -60,9 +61,10 @@ def run(args: argparse.Namespace, config: dict[str, Any]) -> int:
     from cageless.outputs import check_output_dir
     from cageless.validate import check_options
 
-    check_options(args, ("speed_rpm", "radial_load_n", "axial_load_n", "duration", "settle", "workers"), force=False)
+    check_options(args, ("speed_rpm", "radial_load_n", "axial_load_n", "duration", "settle", "workers",
+                         "clearance_um"), force=False)
     check_output_dir(args.out, "-o")
-    bearing = bearing_from_config(config)
+    bearing = scene_bearing(args, config)  # --config's [bearing.*], --dry and --clearance-um, as simulate takes them
     vary = parse_vary(args.vary, bearing)
     fixed = parameter_values(args, config)  # [parameters] of --config, then --set
     from cageless.simulation.effects import parse_effect_overrides

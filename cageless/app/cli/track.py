@@ -28,7 +28,7 @@ from cageless.conditions import (
     resolve_conditions,
 )
 from cageless.config import bearing_from_config
-from cageless.errors import CagelessError, MissingConditionsError
+from cageless.errors import CagelessError, MissingConditionsError, is_trace_name, trace_not_video
 from cageless.outputs import check_output_dir, clean_stale_parts, output_lock
 from cageless.validate import check_options, plausible_entry
 
@@ -105,6 +105,8 @@ def collect_inputs(inputs: list[str], speed_rpm: float | None,
         p = Path(raw)
         if not p.exists():
             entries.append(LabEntry(video=p, error=CagelessError(f"{p}: no such file or folder.")))
+        elif p.is_file() and is_trace_name(p):  # before its conditions: a trace's name holds none
+            entries.append(LabEntry(video=p, error=trace_not_video(p)))
         elif p.is_dir() and is_qc_folder(p):
             entries.append(LabEntry(video=p, error=CagelessError(
                 f"{p}: is the QC folder of a cageless output (its images are QC figures, not a video's frames).")))
