@@ -1,7 +1,7 @@
 """The trace's self-assessed precision (tracking/precision.py) against the truth on the corpus.
 
     python benchmarks/tracking_precision.py [--cache DIR] [--sets HOLDOUT,FRESH,FRESH2,FRESH3] [--workers 1]
-                                            [--calibrate] [--long] [--json out.json]
+                                            [--calibrate [--sets TUNING,TUNING2]] [--long] [--json out.json]
 
 Tracks every short clip of the chosen seed sets (rendered once into ``--cache``/ci, default
 ``/tmp/cageless-corpus``, and reused), scores the trace against the clip's truth
@@ -11,8 +11,9 @@ warning fired; then the correlation of estimate and truth (of their logarithms t
 counts of "the estimate is over the bar" against "the truth is over the bar", angle and speed.
 
 ``--long`` runs the long variants instead (one cage revolution each, in ``--cache``/long; TUNING and HOLDOUT
-have them; their videos are kept). ``--calibrate`` (TUNING only: the other sets are never used for tuning)
-also prints the medians of the true error over the estimate with the gains in use divided out: what
+have them; their videos are kept). ``--calibrate`` (the tuning sets only, TUNING and TUNING2 by default: the
+other sets are never used for tuning) also prints the medians, over the clips of all the chosen sets, of the
+true error over the estimate with the gains in use divided out: what
 :data:`cageless.tracking.precision.ANGLE_GAIN` and ``SPEED_GAIN`` are set to (the gains a re-calibration would
 set).
 """
@@ -33,6 +34,9 @@ import numpy as np
 
 from cageless.tracking.synthetic.matrix import SETS
 from cageless.tracking.synthetic.score import BARS
+
+#: The seed sets tuned on (tracking/synthetic/matrix.py); --calibrate refuses the others.
+_TUNING_SETS = ("TUNING", "TUNING2")
 
 
 def _one(args: tuple[int, str, bool]) -> dict[str, Any]:
@@ -76,8 +80,13 @@ def summarise(name: str, results: list[dict[str, Any]]) -> str:
             "jump share", "QC warning", "bars", "why"]
     lines = [f"### {name}", "", "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     lines += [_row(r) for r in results]
+    return "\n".join(lines + ["", agreement(name, results), ""])
+
+
+def agreement(name: str, results: list[dict[str, Any]]) -> str:
+    """The estimate against the truth over ``results``: correlations, ratios, confusion and QC-warning counts."""
     ok = [r for r in results if "error" not in r and r["precision"]]
-    out = ["", f"{name}: {len(ok)} traces, {len(results) - len(ok)} clips refused (no trace)."]
+    out = [f"{name}: {len(ok)} traces, {len(results) - len(ok)} clips refused (no trace)."]
     for key, bar in (("angle_rms_mrad", BARS["angle_rms_mrad"]), ("speed_rms_pct", BARS["speed_rms_pct"])):
         true = np.array([r["score"][key] for r in ok])
         est = np.array([r["precision"][key] for r in ok])
@@ -86,7 +95,7 @@ def summarise(name: str, results: list[dict[str, Any]]) -> str:
         ratio = est / true
         out.append(f"{key}: correlation {np.corrcoef(true, est)[0, 1]:.3f} (of the logarithms "
                    f"{np.corrcoef(np.log(true), np.log(est))[0, 1]:.3f}); estimate / truth median "
-                   f"{np.median(ratio):.2f}, "
+                   f"{np.median(ratio):.2f} ({np.min(ratio):.2f}-{np.max(ratio):.2f}), "
                    f"within a factor of 2 on {int(np.sum((ratio > 0.5) & (ratio < 2)))} of {len(ok)}; bar {bar}: "
                    + _confusion(true, est, bar))
     warned = np.array([r["warned"] for r in ok])
@@ -94,7 +103,7 @@ def summarise(name: str, results: list[dict[str, Any]]) -> str:
     out.append(f"QC warning against failing any bar: warned & failing {int(np.sum(warned & failed))}, warned & "
                f"passing {int(np.sum(warned & ~failed))}, silent & failing {int(np.sum(~warned & failed))}, "
                f"silent & passing {int(np.sum(~warned & ~failed))}")
-    return "\n".join(lines + out + [""])
+    return "\n".join(out)
 
 
 def calibration(results: list[dict[str, Any]]) -> str:
@@ -109,19 +118,25 @@ def calibration(results: list[dict[str, Any]]) -> str:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--cache", type=Path, default=Path("/tmp/cageless-corpus"))
-    ap.add_argument("--sets", default="HOLDOUT,FRESH,FRESH2,FRESH3")
+    ap.add_argument("--sets", help="comma-separated seed sets (default HOLDOUT,FRESH,FRESH2,FRESH3; with "
+                    "--calibrate TUNING,TUNING2)")
     ap.add_argument("--workers", type=int, default=1)
-    ap.add_argument("--calibrate", action="store_true", help="TUNING only: print the gains it gives")
+    ap.add_argument("--calibrate", action="store_true", help="tuning sets only: print the gains they give")
     ap.add_argument("--long", action="store_true", help="the long variants (TUNING and HOLDOUT only)")
     ap.add_argument("--json", type=Path)
     args = ap.parse_args(argv)
-    names = ["TUNING"] if args.calibrate else args.sets.split(",")
+    sets = args.sets or ("TUNING,TUNING2" if args.calibrate else "HOLDOUT,FRESH,FRESH2,FRESH3")
+    names = sets.split(",")
     unknown = [n for n in names if n not in SETS]
     if unknown:
-        print(f"--sets {args.sets}: unknown set {unknown[0]}; choose from {', '.join(SETS)}", file=sys.stderr)
+        print(f"--sets {sets}: unknown set {unknown[0]}; choose from {', '.join(SETS)}", file=sys.stderr)
+        return 2
+    if args.calibrate and set(names) - set(_TUNING_SETS):
+        print(f"--calibrate --sets {sets}: calibrate on the tuning sets only ({', '.join(_TUNING_SETS)}); "
+              "the others are held out", file=sys.stderr)
         return 2
     if args.long and set(names) - {"TUNING", "HOLDOUT"}:
-        print(f"--long: only TUNING and HOLDOUT have long variants, not {args.sets}", file=sys.stderr)
+        print(f"--long: only TUNING and HOLDOUT have long variants, not {sets}", file=sys.stderr)
         return 2
     out: dict[str, list[dict[str, Any]]] = {}
     for name in names:
@@ -133,8 +148,13 @@ def main(argv: list[str] | None = None) -> int:
                 results = list(pool.map(_one, jobs))
         print(summarise(name, results), flush=True)
         if args.calibrate:
-            print(calibration(results))
+            print(f"{name}: " + calibration(results))
         out[name] = results
+    if len(out) > 1:
+        pooled = [r for results in out.values() for r in results]
+        print(agreement(" + ".join(out) + " pooled", pooled))
+        if args.calibrate:
+            print(f"{' + '.join(out)} pooled: " + calibration(pooled))
     if args.json:
         tmp = args.json.with_suffix(args.json.suffix + ".tmp")
         tmp.write_text(json.dumps(out, indent=1, default=float))

@@ -155,7 +155,11 @@ KNOWN_FAILURES: dict[int, str] = {
 #: 0.825 -> 0.824 %, the rest unchanged. With the track fit's window chosen by cross-validation (branch matrixacc,
 #: 2026-11-28; benchmarks/tracking_corpus.py --long --no-oracle) the seven failing seeds were re-measured, not the 57
 #: that pass: 7018 passes (0.64 -> 0.447 mrad), 1011 0.701 -> 0.554 mrad (speed 0.824 -> 0.738 %, slip 0.45 ->
-#: 0.416 pp), 1022 0.575 -> 0.548, 7009 0.623 -> 0.554 mrad; 7004, 7026 and 7031 as before.
+#: 0.416 pp), 1022 0.575 -> 0.548, 7009 0.623 -> 0.554 mrad; 7004, 7026 and 7031 as before. All 64 re-measured with
+#: the tracker of main 1f6ed9a (the cross-validated window; branch matrixacc2, 2026-11-28,
+#: benchmarks/tracking_corpus.py --long --no-oracle --sets TUNING,HOLDOUT): TUNING 30 and HOLDOUT 28 of 32, no
+#: status changed: the 58 marked "" pass (no swap, every ball found; nearest the bars 1029 0.487 mrad, 7018 0.447,
+#: 1024 0.410, 7008 0.402 mrad, 7006 speed 0.388 %) and the six below fail with the figures recorded here.
 _LONG_MEASURED: dict[int, str] = {
     1000: "",
     1001: "",
