@@ -506,19 +506,32 @@ def _check_tracks(path: Path, times: np.ndarray, angle: np.ndarray, valid: np.nd
 
 
 def _track_fit_frames(path: Path, times: np.ndarray, angle: np.ndarray, valid: np.ndarray,
-                      track_fit: int | str) -> tuple[int, dict[str, Any] | None]:
+                      track_fit: int | str, workers: int = 2) -> tuple[int, dict[str, Any] | None]:
     """The track fit's window (frames): ``track_fit`` itself, or for ``"auto"`` the cross-validated choice
-    (:func:`~cageless.tracking.track_window.choose_track_fit`) with its record for QC."""
+    (:func:`~cageless.tracking.track_window.choose_track_fit`, its trial fits on ``workers`` threads) with its
+    record for QC."""
     if isinstance(track_fit, str):
         if track_fit != "auto":
             raise TrackingError(path, f"track_fit = {track_fit!r} is not a window.",
                                 'Give "auto" or an odd number of frames of at least 5 (1: no track fit).')
-        choice = choose_track_fit(times, angle, valid)
+        choice = choose_track_fit(times, angle, valid, workers=workers)
         return choice.frames, choice.to_dict()
     if track_fit != 1 and (track_fit < 5 or track_fit % 2 == 0):
         raise TrackingError(path, f"track_fit = {track_fit} is not a window.",
                             'Give "auto" or an odd number of frames of at least 5 (1: no track fit).')
     return int(track_fit), None
+
+
+def _fit_and_speed(path: Path, times: np.ndarray, angle: np.ndarray, valid: np.ndarray, track_fit: int,
+                   options: TrackOptions) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The track fit's angles and validity (:func:`~cageless.tracking.kinematics.robust_track_fit`) and the speed
+    from them (:func:`~cageless.tracking.kinematics.revolution_speed`); a bad setting is a :class:`TrackingError`."""
+    try:
+        angle, valid = robust_track_fit(times, angle, valid, track_fit)
+        speed = revolution_speed(times, angle, options.window, options.polyorder)
+    except ParameterError as exc:
+        raise TrackingError(path, str(exc)) from exc
+    return angle, valid, speed
 
 
 def _selection_summary(sel: Selection, du: int, dv: int) -> dict[str, Any]:
@@ -543,17 +556,16 @@ def _finish(path: Path, video: FrameSource, table: pd.DataFrame, loc: BearingLoc
     times = video.times
     angle, place = remove_place_bias(times, angle, valid, orbit.radius)
     omega_c = theoretical_cage_speed(g, conditions.speed_rad_s)
-    track_fit, fit_choice = _track_fit_frames(path, times, angle, valid, options.track_fit)
-    precision = assess_table(table, order, times, angle, valid, orbit.centre, orbit.radius, omega_c, options.window,
-                             options.polyorder, track_fit)
-    try:
-        angle, valid = robust_track_fit(times, angle, valid, track_fit)
-    except ParameterError as exc:
-        raise TrackingError(path, str(exc)) from exc
-    try:
-        speed = revolution_speed(times, angle, options.window, options.polyorder)
-    except ParameterError as exc:
-        raise TrackingError(path, str(exc)) from exc
+    track_fit, fit_choice = _track_fit_frames(path, times, angle, valid, options.track_fit, options.threads)
+    with ThreadPoolExecutor(max_workers=1) as pool:  # the precision estimate beside the track fit and the speed
+        pending = pool.submit(assess_table, table, order, times, angle, valid, orbit.centre, orbit.radius, omega_c,
+                              options.window, options.polyorder, track_fit)
+        try:
+            angle, valid, speed = _fit_and_speed(path, times, angle, valid, track_fit, options)
+        except TrackingError:
+            pending.result()  # its error first, as when it ran first
+            raise
+        precision = pending.result()
     _check_tracks(path, times, angle, valid, omega_c)
     px_per_mm = conditions.px_per_mm or orbit.radius / (0.5 * g.pitch_diameter_m * 1e3)
     qc = build_qc(table, order, valid, orbit, loc, direction, px_per_mm, g.n_balls, warned)
