@@ -16,7 +16,9 @@ kernel can only reach a module its own module imports, so a file outside the clo
 helper, the solver's Python driver) is edited without recompiling anything, while a constant edited in
 a shared module outside the package (``cageless/units.py``) does recompile. A cache written under
 another digest no longer matches; numba recompiles and overwrites it. :func:`clear` removes a package's
-cache files when asked.
+cache files when asked. The digest is remembered beside the package's numba cache with the times, size and
+inode of every ``.py`` file of the package and of the closure outside it, and read from there while none of
+them has changed (0.1 s of CPU less at the start of a ``cageless track``).
 
 :func:`register` must run before the package's first kernel is decorated: each package calls it from its
 ``__init__``. The caches stay where numba puts them (``NUMBA_CACHE_DIR``, else ``__pycache__`` beside the
@@ -115,11 +117,81 @@ def kernel_sources(root: str | Path) -> list[Path]:
 
 @lru_cache(maxsize=None)
 def _digest(root: Path) -> str:
+    """:func:`source_digest`, from the stamp of the last computation when no file it covered has changed (see
+    :func:`_stamp`), else computed (and stamped)."""
+    stamp = _stamp(root)
+    known = _read_stamp(stamp, root) if stamp is not None else None
+    if known is not None:
+        return known
+    closure = kernel_sources(root)
     h = hashlib.sha256()
-    for path in kernel_sources(root):
+    for path in closure:
         h.update(Path(os.path.relpath(path, root)).as_posix().encode())
         h.update(path.read_bytes())
-    return h.hexdigest()
+    digest = h.hexdigest()
+    if stamp is not None:
+        _write_stamp(stamp, root, closure, digest)
+    return digest
+
+
+#: Files changed this recently (ns) are not stamped: a file's times have the kernel's clock tick as their
+#: resolution, so an edit that keeps the size within the same tick would not show (git's "racy" entries).
+_RACY_NS = 2_000_000_000
+
+
+def _stamp(root: Path) -> Path | None:
+    """Where the digest of ``root``'s kernel closure is remembered: beside numba's cache of the package (the
+    folder its kernels' cache files go to), or ``None`` when numba offers no such folder."""
+    stub = SimpleNamespace(__code__=SimpleNamespace(co_firstlineno=0))
+    try:
+        locators = SourcesLocator.base_locators(stub, str(root / "__init__.py"))
+        return Path(locators[0].get_cache_path()) / "cageless-kernel-closure.json" if locators else None
+    except Exception:  # noqa: BLE001 - numba's private locators: without one, compute the digest each time
+        return None
+
+
+def _file_key(path: Path) -> list[int]:
+    st = path.stat()
+    return [st.st_mtime_ns, st.st_ctime_ns, st.st_size, st.st_ino]
+
+
+def _tree_keys(root: Path) -> dict[str, list[int]]:
+    """Every ``.py`` file under ``root`` with its times, size and inode: a file added, removed or edited anywhere
+    in the package can change which files are kernels and what they import."""
+    return {str(p): _file_key(p) for p in sorted(root.rglob("*.py"))}
+
+
+def _read_stamp(stamp: Path, root: Path) -> str | None:
+    """The remembered digest, if every file of the package and of the closure outside it is as it was then."""
+    import json
+
+    try:
+        saved = json.loads(stamp.read_text())
+        if saved.get("root") != str(root) or saved.get("tree") != _tree_keys(root):
+            return None
+        if any(_file_key(Path(f)) != key for f, key in saved["outside"].items()):
+            return None
+        return str(saved["digest"])
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return None
+
+
+def _write_stamp(stamp: Path, root: Path, closure: list[Path], digest: str) -> None:
+    import json
+    import time
+
+    try:
+        tree = _tree_keys(root)
+        outside = {str(p): _file_key(p) for p in closure if not p.is_relative_to(root)}
+        newest = max(max(k[0], k[1]) for k in [*tree.values(), *outside.values()])
+        if newest > time.time_ns() - _RACY_NS:
+            return
+        from cageless.atomic import atomic_write_text
+
+        stamp.parent.mkdir(parents=True, exist_ok=True)
+        atomic_write_text(stamp, json.dumps({"root": str(root), "digest": digest, "tree": tree, "outside": outside}))
+    except (OSError, ValueError):  # a read-only cache folder: compute the digest each time
+        pass
 
 
 def source_digest(root: Path) -> str:

@@ -15,15 +15,15 @@ import math
 import sys
 import threading
 import warnings
-from collections import OrderedDict
+from collections.abc import Callable, Iterator
 from concurrent.futures import ThreadPoolExecutor
+from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
-from tqdm.auto import tqdm
 
 from cageless.atomic import atomic_path
 from cageless.bearing import Bearing
@@ -33,10 +33,11 @@ from cageless.kinematics import slip_rate, theoretical_cage_speed
 from cageless.outputs import is_foreign_file
 from cageless.provenance import VIDEO_HASH, Provenance
 from cageless.trace import Trace, VideoInfo, write_trace
+from cageless.tracking.cropped import _CroppedFrames, _CropView
 from cageless.tracking.detect import (DetectorParams, noise_sigma, spot_sigma, static_defects,
                                       static_pattern)
 from cageless.tracking.geometry import fit_orbit, orbital_angles
-from cageless.tracking.io import CineReader, FrameSource, open_video
+from cageless.tracking.io import FrameSource, open_video
 from cageless.tracking.kinematics import DEFAULT_WINDOW, revolution_speed, robust_track_fit
 from cageless.tracking.track_window import choose_track_fit
 from cageless.tracking.link import BallCountWarning, TrackSetup, track_frames
@@ -62,11 +63,6 @@ log = logging.getLogger(__name__)
 INPUT_HASH = VIDEO_HASH
 #: Quantile of the sampled frames that the ball selection subtracts (see :func:`_setup`).
 SELECT_QUANTILE = 0.25
-#: Frames served from a memory map between drops of their pages (fault-around maps whole frames:
-#: 8 full-size 16-bit frames are 16 MB).
-_DROP_EVERY = 8
-#: Single frames kept by a non-memory-mapped frame source between chunk reads (:class:`_CroppedFrames`).
-_SINGLE_FRAMES = 16
 #: Frames spread over the video whose minimum tells a static defect (bright in all of them) from a trace
 #: that passing highlights leave in the median background.
 _DEFECT_FRAMES = 16
@@ -131,91 +127,6 @@ class TrackResult:
     table: pd.DataFrame
     qc: QCReport
     path: Path | None = None
-
-
-class _CroppedFrames:
-    """Random access to cropped frames ``offset + i``: zero-copy views of a memory-mapped cine; otherwise
-    :meth:`block` reads whole chunks and keeps the last two, and a single frame outside them is read alone
-    (the last :data:`_SINGLE_FRAMES` kept): the set-up's spread sample frames each cost a 64-frame chunk before."""
-
-    def __init__(self, video: FrameSource, rows: slice, cols: slice, chunk: int, offset: int = 0,
-                 stop: int | None = None) -> None:
-        self.video, self.rows, self.cols, self.chunk, self.offset = video, rows, cols, chunk, offset
-        self.stop = len(video) if stop is None else stop
-        self._cache: OrderedDict[int, np.ndarray] = OrderedDict()
-        self._single: OrderedDict[int, np.ndarray] = OrderedDict()
-        # Memory-mapped 8/16-bit cine: hand out views; the window kernel touches only the pages it needs.
-        self.zero_copy = isinstance(video, CineReader) and not video._packed_bits
-        self._stack = video.frame_stack() if self.zero_copy else None  # type: ignore[attr-defined]
-        self._span = (offset, offset)
-
-    def __call__(self, i: int) -> np.ndarray:
-        if self.zero_copy:
-            j = self.offset + i
-            self._span = (min(self._span[0], j), max(self._span[1], j))
-            if self._span[1] - self._span[0] >= _DROP_EVERY:
-                self.video.drop_pages(*self._span)  # type: ignore[attr-defined]
-                self._span = (j, j)
-            if self._stack is not None:  # one ndarray slice, no per-frame objects
-                return self._stack[j, self.rows, self.cols]
-            return self.video.frame_view(j)[self.rows, self.cols]
-        k = i // self.chunk
-        block = self._cache.get(k)
-        if block is not None:
-            return block[i - k * self.chunk]
-        frame = self._single.get(i)
-        if frame is None:
-            frame = self.video[self.offset + i][self.rows, self.cols]
-            self._single[i] = frame
-            if len(self._single) > _SINGLE_FRAMES:
-                self._single.popitem(last=False)
-        return frame
-
-    @property
-    def block_size(self) -> int:
-        """Frames per :meth:`block` (a memory-mapped block's pages are dropped after the next is asked for)."""
-        return _DROP_EVERY if self.zero_copy else self.chunk
-
-    def block(self, a: int, b: int) -> np.ndarray:
-        """Frames ``a..b-1`` as one ``(frames, rows, cols)`` array (a view where possible), ``a`` a multiple of
-        :attr:`block_size` and ``b - a`` at most that."""
-        if not self.zero_copy:
-            k = a // self.chunk
-            return self._chunk(k)[a - k * self.chunk:b - k * self.chunk]
-        j, last = self.offset + a, self.offset + b - 1
-        if self._span != (j, j):  # the previous block is done: unmap its pages
-            self.video.drop_pages(*self._span)  # type: ignore[attr-defined]
-        self._span = (min(j, last), max(j, last))
-        if self._stack is not None:
-            return self._stack[j:last + 1, self.rows, self.cols]
-        return np.stack([self.video.frame_view(x)[self.rows, self.cols] for x in range(j, last + 1)])
-
-    def _chunk(self, k: int) -> np.ndarray:
-        block = self._cache.get(k)
-        if block is None:
-            a = self.offset + k * self.chunk
-            raw = self.video[a:min(a + self.chunk, self.stop)]
-            block = raw[:, self.rows, self.cols]  # a view: the window kernel reads any strides
-            self._cache[k] = block
-            if len(self._cache) > 2:
-                self._cache.popitem(last=False)
-        return block
-
-
-class _CropView:
-    """The rows and columns of a video that :func:`~cageless.tracking.locate.background_frame` needs, cropped:
-    per-pixel statistics over the crop are those of the full frames cropped, for less work."""
-
-    def __init__(self, video: FrameSource, rows: slice, cols: slice) -> None:
-        self.video, self.rows, self.cols = video, rows, cols
-        self.frame_shape = (len(range(*rows.indices(video.frame_shape[0]))),
-                            len(range(*cols.indices(video.frame_shape[1]))))
-
-    def __len__(self) -> int:
-        return len(self.video)
-
-    def frame_view(self, i: int) -> np.ndarray:
-        return self.video.frame_view(i)[self.rows, self.cols]
 
 
 def _locate(video: FrameSource, background: np.ndarray, bearing: Bearing, path: Path,
@@ -425,12 +336,9 @@ def track_video(
             refuse_selection(exc, path, video.__getitem__, loc.crop(video.frame_shape), out_dir)
         del sample  # its low quantile and motion map are done with (8 MB at full size)
         rows, cols = frames.rows, frames.cols
-        with tqdm(total=len(video), desc=path.name, unit="frame", disable=not progress, leave=False) as bar:
-            table = _track_all(path, fps, video, frames, times, setup, options, bar.update)
-        table, moved = relock_lobes(table, frames, setup.background, setup.mask,
-                                    options.detector.window_sigma * max(setup.highlight_sigma, 1.0),
-                                    options.detector.weight_sigma * setup.sigma_noise, options.detector.iterations,
-                                    setup.highlight_sigma, setup.static_compiled)
+        with _frame_bar(len(video), path.name, progress) as update:
+            table = _track_all(path, fps, video, frames, times, setup, options, update)
+        table, moved = _relock(table, frames, setup, options)
         table["u_px"] += cols.start
         table["v_px"] += rows.start
         trace, qc = _finish(path, video, table, loc, conditions, bearing, options, prov,
@@ -440,19 +348,45 @@ def track_video(
         shown_frame = video[selection_frame(sel.table)] if out_dir is not None else None
     for w in caught:  # recorded for QC; still shown to the caller
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-    written = None
-    if out_dir is not None:
-        out_dir = Path(out_dir)
-        # No trace without its QC, and a failed write loses no earlier trace: the new trace replaces the old
-        # one only once its QC is written (a re-run redoes both).
-        with atomic_path(target) as pending:
-            write_trace(pending, trace)
-            write_qc(out_dir / "qc", _stem(path), path, qc, table, trace, options.qc_frames, fps,
-                     allow_truncated=options.allow_truncated)
-            write_selection_qc(out_dir / "qc", _stem(path), shown_frame, selection_table, sel.ring,
-                               (cols.start, rows.start), f"{qc.n_balls_found} balls selected")
-        written = target
-    return TrackResult(trace=trace, table=table, qc=qc, path=written)
+    if target is None or out_dir is None:
+        return TrackResult(trace=trace, table=table, qc=qc, path=None)
+    _write(target, Path(out_dir), path, trace, qc, table, options, fps, shown_frame, selection_table, sel,
+           (cols.start, rows.start))
+    return TrackResult(trace=trace, table=table, qc=qc, path=target)
+
+
+def _relock(table: pd.DataFrame, frames: _CroppedFrames, setup: TrackSetup, options: TrackOptions
+            ) -> tuple[pd.DataFrame, Any]:
+    """:func:`~cageless.tracking.lobes.relock_lobes` with the set-up's background, mask and thresholds."""
+    det = options.detector
+    return relock_lobes(table, frames, setup.background, setup.mask, det.window_sigma * max(setup.highlight_sigma, 1.0),
+                        det.weight_sigma * setup.sigma_noise, det.iterations, setup.highlight_sigma,
+                        setup.static_compiled)
+
+
+def _write(target: Path, out_dir: Path, path: Path, trace: Trace, qc: QCReport, table: pd.DataFrame,
+           options: TrackOptions, fps: float | None, shown_frame: np.ndarray | None, selection_table: pd.DataFrame,
+           sel: Selection, offset: tuple[int, int]) -> None:
+    """Write the trace, its QC and the selection's QC. No trace without its QC, and a failed write loses no
+    earlier trace: the new trace replaces the old one only once its QC is written (a re-run redoes both)."""
+    with atomic_path(target) as pending:
+        write_trace(pending, trace)
+        write_qc(out_dir / "qc", _stem(path), path, qc, table, trace, options.qc_frames, fps,
+                 allow_truncated=options.allow_truncated)
+        write_selection_qc(out_dir / "qc", _stem(path), shown_frame, selection_table, sel.ring, offset,
+                           f"{qc.n_balls_found} balls selected")
+
+
+@contextmanager
+def _frame_bar(total: int, name: str, progress: bool) -> Iterator[Callable[[int], Any]]:
+    """The frames' progress bar's ``update`` (a no-op without ``progress``: tqdm is then not imported)."""
+    if not progress:
+        yield lambda n=1: None
+        return
+    from tqdm.auto import tqdm
+
+    with tqdm(total=total, desc=name, unit="frame", leave=False) as bar:
+        yield bar.update
 
 
 def _track_all(path: Path, fps: float | None, video: FrameSource, frames: _CroppedFrames, times: np.ndarray,
@@ -506,19 +440,32 @@ def _check_tracks(path: Path, times: np.ndarray, angle: np.ndarray, valid: np.nd
 
 
 def _track_fit_frames(path: Path, times: np.ndarray, angle: np.ndarray, valid: np.ndarray,
-                      track_fit: int | str) -> tuple[int, dict[str, Any] | None]:
+                      track_fit: int | str, workers: int = 2) -> tuple[int, dict[str, Any] | None]:
     """The track fit's window (frames): ``track_fit`` itself, or for ``"auto"`` the cross-validated choice
-    (:func:`~cageless.tracking.track_window.choose_track_fit`) with its record for QC."""
+    (:func:`~cageless.tracking.track_window.choose_track_fit`, its trial fits on ``workers`` threads) with its
+    record for QC."""
     if isinstance(track_fit, str):
         if track_fit != "auto":
             raise TrackingError(path, f"track_fit = {track_fit!r} is not a window.",
                                 'Give "auto" or an odd number of frames of at least 5 (1: no track fit).')
-        choice = choose_track_fit(times, angle, valid)
+        choice = choose_track_fit(times, angle, valid, workers=workers)
         return choice.frames, choice.to_dict()
     if track_fit != 1 and (track_fit < 5 or track_fit % 2 == 0):
         raise TrackingError(path, f"track_fit = {track_fit} is not a window.",
                             'Give "auto" or an odd number of frames of at least 5 (1: no track fit).')
     return int(track_fit), None
+
+
+def _fit_and_speed(path: Path, times: np.ndarray, angle: np.ndarray, valid: np.ndarray, track_fit: int,
+                   options: TrackOptions) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The track fit's angles and validity (:func:`~cageless.tracking.kinematics.robust_track_fit`) and the speed
+    from them (:func:`~cageless.tracking.kinematics.revolution_speed`); a bad setting is a :class:`TrackingError`."""
+    try:
+        angle, valid = robust_track_fit(times, angle, valid, track_fit)
+        speed = revolution_speed(times, angle, options.window, options.polyorder)
+    except ParameterError as exc:
+        raise TrackingError(path, str(exc)) from exc
+    return angle, valid, speed
 
 
 def _selection_summary(sel: Selection, du: int, dv: int) -> dict[str, Any]:
@@ -543,17 +490,16 @@ def _finish(path: Path, video: FrameSource, table: pd.DataFrame, loc: BearingLoc
     times = video.times
     angle, place = remove_place_bias(times, angle, valid, orbit.radius)
     omega_c = theoretical_cage_speed(g, conditions.speed_rad_s)
-    track_fit, fit_choice = _track_fit_frames(path, times, angle, valid, options.track_fit)
-    precision = assess_table(table, order, times, angle, valid, orbit.centre, orbit.radius, omega_c, options.window,
-                             options.polyorder, track_fit)
-    try:
-        angle, valid = robust_track_fit(times, angle, valid, track_fit)
-    except ParameterError as exc:
-        raise TrackingError(path, str(exc)) from exc
-    try:
-        speed = revolution_speed(times, angle, options.window, options.polyorder)
-    except ParameterError as exc:
-        raise TrackingError(path, str(exc)) from exc
+    track_fit, fit_choice = _track_fit_frames(path, times, angle, valid, options.track_fit, options.threads)
+    with ThreadPoolExecutor(max_workers=1) as pool:  # the precision estimate beside the track fit and the speed
+        pending = pool.submit(assess_table, table, order, times, angle, valid, orbit.centre, orbit.radius, omega_c,
+                              options.window, options.polyorder, track_fit)
+        try:
+            angle, valid, speed = _fit_and_speed(path, times, angle, valid, track_fit, options)
+        except TrackingError:
+            pending.result()  # its error first, as when it ran first
+            raise
+        precision = pending.result()
     _check_tracks(path, times, angle, valid, omega_c)
     px_per_mm = conditions.px_per_mm or orbit.radius / (0.5 * g.pitch_diameter_m * 1e3)
     qc = build_qc(table, order, valid, orbit, loc, direction, px_per_mm, g.n_balls, warned)

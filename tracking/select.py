@@ -221,7 +221,7 @@ def _speed_reason(ratio: float, omega: float, ctx: _Context) -> str:
 
 
 #: Frames of a burst whose candidates are found together (on ``workers`` threads): as many as a memory-mapped
-#: source keeps mapped (tracking/pipeline.py), so that the pages of those before are dropped, not held.
+#: source keeps mapped (tracking/cropped.py), so that the pages of those before are dropped, not held.
 _FRAMES_AT_ONCE = 8
 
 

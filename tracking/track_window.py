@@ -21,7 +21,9 @@ The samples scored are the same for every window: measured, kept by the shortest
 window that drops the samples it cannot follow, at an impact, is still charged for them) and at least
 ``max(LADDER) // 2`` frames from a block's end. On long clips :data:`BLOCKS` blocks of :data:`BLOCK_FRAMES`
 frames spread over the clip are scored, which bounds the cost (10 fits of 1,000 frames: 0.2 s of CPU for
-14 balls).
+14 balls). The fits of the (block, window) pairs are independent and shared among ``workers`` threads (the
+compiled fit releases the GIL); their scores are summed in the same order whatever the number, so the choice
+and its record are the same bits.
 
 Public API::
 
@@ -30,6 +32,7 @@ Public API::
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
@@ -103,7 +106,7 @@ def _leverage(keep: np.ndarray, frames: int) -> np.ndarray:
 
 
 def choose_track_fit(time_s: npt.ArrayLike, angle: npt.ArrayLike, valid: npt.ArrayLike,
-                     ladder: tuple[int, ...] = LADDER) -> TrackFitChoice:
+                     ladder: tuple[int, ...] = LADDER, workers: int = 2) -> TrackFitChoice:
     """The window of :data:`LADDER` with the least leave-one-out error of the robust track fit.
 
     Parameters
@@ -116,6 +119,8 @@ def choose_track_fit(time_s: npt.ArrayLike, angle: npt.ArrayLike, valid: npt.Arr
         Measured (True) or interpolated (False) samples, shape (T, Z).
     ladder
         Candidate windows (frames), odd, at least 5, increasing.
+    workers
+        Threads the trial fits are shared among (the same result with any number).
 
     Returns
     -------
@@ -132,22 +137,33 @@ def choose_track_fit(time_s: npt.ArrayLike, angle: npt.ArrayLike, valid: npt.Arr
     if len(cands) < 2:
         return TrackFitChoice(DEFAULT_TRACK_FIT, cands, (), 0)
     edge = max(cands) // 2
+    trials = _trial_residuals(t, a, ok, blocks, cands, workers)
     sse = np.zeros(len(cands))
     count = 0
-    for b in blocks:
-        tb, ab, vb = t[b], a[b], ok[b]
-        res = np.empty((len(cands),) + ab.shape)
-        scored = vb.copy()
-        for i, n in enumerate(cands):
-            fit, keep = robust_track_fit(tb, ab, vb, n)
-            res[i] = (ab - fit) / (1.0 - _leverage(keep, n))
-            if i == 0:
-                scored &= keep
+    for k, b in enumerate(blocks):
+        res = np.stack([trials[k * len(cands) + i][0] for i in range(len(cands))])
+        scored = ok[b] & trials[k * len(cands)][1]  # kept by the shortest window's fit
         scored[:edge] = False
-        scored[len(tb) - edge:] = False
+        scored[len(scored) - edge:] = False
         sse += np.where(scored, res * res, 0.0).sum(axis=(1, 2))
         count += int(scored.sum())
     if count == 0:
         return TrackFitChoice(DEFAULT_TRACK_FIT, cands, (), 0)
     cv = np.sqrt(sse / count)
     return TrackFitChoice(int(cands[int(np.argmin(cv))]), cands, tuple(float(1e3 * v) for v in cv), count)
+
+
+def _trial_residuals(t: np.ndarray, a: np.ndarray, ok: np.ndarray, blocks: list[slice], cands: tuple[int, ...],
+                     workers: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Each (block, window) pair's leave-one-out residuals and kept samples, block-major, on ``workers``
+    threads."""
+    def one(job: tuple[slice, int]) -> tuple[np.ndarray, np.ndarray]:
+        b, n = job
+        fit, keep = robust_track_fit(t[b], a[b], ok[b], n, workers=1)
+        return (a[b] - fit) / (1.0 - _leverage(keep, n)), keep
+
+    jobs = [(b, n) for b in blocks for n in cands]
+    if workers <= 1:
+        return [one(job) for job in jobs]
+    with ThreadPoolExecutor(max_workers=workers) as pool:
+        return list(pool.map(one, jobs))
