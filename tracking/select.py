@@ -441,35 +441,49 @@ def select_balls(frames: Callable[[int], np.ndarray], times: np.ndarray, backgro
     movers = np.array([k for k, r in enumerate(reasons) if not r], dtype=int)
     tol = max(1.5, RADIAL_TOL * ctx.ball_px)
     circle = _ball_circle(tracks, feats, movers, burst_arr, ctx, tol)
-    ring_args = dict(ball_px=ctx.ball_px, sigma_px=ctx.sigma_px, radial_tol_px=tol, response_sigma=float(noise or 1),
-                     k_sigma=k_sigma, z=z, gap=ctx.gap, omega_c=ctx.omega_c, omega_i=omega_i,
-                     pixel_threshold=pixel_threshold)
     if circle is None:
-        table = _table(feats, reasons, burst_arr, ctx, direction)
-        raise SelectionError(path, f"no {z} highlights moving together along one circle near the cage speed were "
-                             "found (0 balls found).", "Check the lighting, the speed_rpm, the frame rate (fps: an "
-                             "AVI, MP4 or image sequence holds no camera time stamps, so give the recording rate in "
-                             "its sidecar, conditions.csv or --fps; at a rate stated too low the balls look static), "
-                             f"px_per_mm (when stated, only circles within {PRIOR_RADIUS_TOL} ball diameters of its "
-                             "pitch circle are tried) and the bearing description; the QC image shows every "
-                             "candidate and why it was rejected.",
-                             table=table, found=0)
+        raise _no_circle(path, z, _table(feats, reasons, burst_arr, ctx, direction))
     feats = [_features(t, times, (circle[0], circle[1])) for t in tracks]
     anchors, counts = _choose_bursts(tracks, feats, reasons, burst_arr, spans, times, circle, tol, ctx)
     table = _table(feats, reasons, burst_arr, ctx, direction)
-    sel_speed = table.loc[table.status == "selected", "speed_ratio"]
-    ring = BallRing(centre=(circle[0], circle[1]), radius=circle[2], direction=direction,
-                    omega=float(np.median(sel_speed) * ctx.omega_c) if len(sel_speed) else ctx.omega_c, **ring_args)
-    # A ball can be hidden or missed in a stretch of the clip (a land, a dark frame, a glint crossing it), but
-    # the spacing cannot invent one: the count is the largest that at least half the stretches show.
-    found = int(sorted(counts, reverse=True)[(len(counts) - 1) // 2]) if counts else 0
-    good = [a for a in anchors if a is not None]
+    ring = _ball_ring(circle, direction, table, ctx, tol, float(noise or 1))
+    found, good = _majority_count(counts), [a for a in anchors if a is not None]
     log.info("%s: ball circle r = %.1f px, counts per burst %s, %d of %d bursts with %d balls", path, circle[2],
              counts, len(good), len(spans), z)
     _check_count(path, z, found, len(good), len(spans), table, ring)
     if scale_stated:
         check_radius(path, circle[2], r_prior, ctx.ball_px, table=table, ring=ring, found=found)
     return Selection(ring=ring, anchors=good, table=table, counts=counts)
+
+
+def _no_circle(path: object, z: int, table: pd.DataFrame) -> SelectionError:
+    """The error of a clip where no circle of ``z`` highlights moving together was found (0 balls)."""
+    return SelectionError(path, f"no {z} highlights moving together along one circle near the cage speed were "
+                          "found (0 balls found).", "Check the lighting, the speed_rpm, the frame rate (fps: an "
+                          "AVI, MP4 or image sequence holds no camera time stamps, so give the recording rate in "
+                          "its sidecar, conditions.csv or --fps; at a rate stated too low the balls look static), "
+                          f"px_per_mm (when stated, only circles within {PRIOR_RADIUS_TOL} ball diameters of its "
+                          "pitch circle are tried) and the bearing description; the QC image shows every "
+                          "candidate and why it was rejected.",
+                          table=table, found=0)
+
+
+def _ball_ring(circle: tuple[float, float, float], direction: int, table: pd.DataFrame, ctx: _Context, tol: float,
+               response_sigma: float) -> BallRing:
+    """The chosen circle as a :class:`BallRing`, turning at the median speed of the selected tracks."""
+    sel_speed = table.loc[table.status == "selected", "speed_ratio"]
+    return BallRing(centre=(circle[0], circle[1]), radius=circle[2], direction=direction,
+                    omega=float(np.median(sel_speed) * ctx.omega_c) if len(sel_speed) else ctx.omega_c,
+                    ball_px=ctx.ball_px, sigma_px=ctx.sigma_px, radial_tol_px=tol, response_sigma=response_sigma,
+                    k_sigma=ctx.k_sigma, z=ctx.z, gap=ctx.gap, omega_c=ctx.omega_c, omega_i=ctx.omega_i,
+                    pixel_threshold=ctx.pixel_threshold)
+
+
+def _majority_count(counts: list[int]) -> int:
+    """The ball count of the clip from its bursts' counts. A ball can be hidden or missed in a stretch of the clip
+    (a land, a dark frame, a glint crossing it), but the spacing cannot invent one: the count is the largest that
+    at least half the stretches show."""
+    return int(sorted(counts, reverse=True)[(len(counts) - 1) // 2]) if counts else 0
 
 
 def _check_count(path: object, z: int, found: int, n_good: int, n_spans: int, table: pd.DataFrame,
